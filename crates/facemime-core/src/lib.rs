@@ -1,0 +1,12 @@
+//! facemime-core: the pure-Rust algorithms of facemime (no Python in here).
+//!
+//! Conventions shared by every module:
+//! - Images are row-major `u8` buffers of shape (H, W, C), C = 1..=4 channels.
+//! - Points are (x, y) pixels, x to the right, y down, (0, 0) at the *centre* of the top-left
+//!   pixel, so pixel centres sit on integer coordinates.
+//! - Depth is a float along the view direction, **larger = nearer the camera**.
+
+pub mod error;
+pub mod raster;
+
+pub use error::CoreError;

@@ -1,0 +1,14 @@
+//! Texture-mapping rasteriser (method.md §3, the paper's eq. 18).
+//!
+//! - [`span`]: which pixels a triangle covers, scan line by scan line, with exact integer edge
+//!   functions so that triangles sharing an edge cover every pixel exactly once.
+//! - [`sampler`]: nearest and bilinear texture lookups in 16.16 fixed point.
+//! - [`mesh`]: a whole textured mesh: back-face culling, far-to-near order or a z-buffer.
+
+pub mod image;
+pub mod mesh;
+pub mod sampler;
+pub mod span;
+
+pub use image::{ImageMut, ImageRef, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};
+pub use mesh::{coverage, render_mesh_into, DepthMode, Filter, RenderOptions, RenderStats};

@@ -1,0 +1,14 @@
+//! `facemime._core`: the private native module. Converts numpy arrays to core views, releases
+//! the GIL around the work and maps core errors once (see `error.rs`). One file per domain.
+
+use pyo3::prelude::*;
+
+mod error;
+mod raster;
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    raster::register(m)?;
+    Ok(())
+}

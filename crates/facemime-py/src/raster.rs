@@ -1,0 +1,77 @@
+//! Bindings of `facemime_core::raster`.
+
+use facemime_core::raster::{self, DepthMode, Filter, ImageMut, ImageRef, RenderOptions};
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyReadwriteArray3};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use crate::error::CoreErr;
+
+fn contiguous<'a>(name: &str, s: Option<&'a [u8]>) -> PyResult<&'a [u8]> {
+    s.ok_or_else(|| PyValueError::new_err(format!("{name} must be a C-contiguous uint8 array")))
+}
+
+/// Renders a textured mesh into `out` (H, W, C) uint8 in place; returns
+/// (drawn, culled, degenerate, pixels). See `facemime.render` for the documented API.
+#[pyfunction]
+#[pyo3(signature = (out, texture, tex_points, points, depth, triangles, filter, depth_mode, cull_back_faces))]
+#[allow(clippy::too_many_arguments)]
+fn render_mesh_into(
+    py: Python<'_>,
+    mut out: PyReadwriteArray3<u8>,
+    texture: PyReadonlyArray3<u8>,
+    tex_points: PyReadonlyArray2<f64>,
+    points: PyReadonlyArray2<f64>,
+    depth: PyReadonlyArray1<f64>,
+    triangles: PyReadonlyArray2<u32>,
+    filter: &str,
+    depth_mode: &str,
+    cull_back_faces: bool,
+) -> PyResult<(usize, usize, usize, usize)> {
+    let filter = match filter {
+        "nearest" => Filter::Nearest,
+        "bilinear" => Filter::Bilinear,
+        other => return Err(PyValueError::new_err(format!("filter must be 'nearest' or 'bilinear', got {other:?}"))),
+    };
+    let depth_mode = match depth_mode {
+        "painter" => DepthMode::Painter,
+        "zbuffer" => DepthMode::ZBuffer,
+        other => return Err(PyValueError::new_err(format!("depth must be 'painter' or 'zbuffer', got {other:?}"))),
+    };
+    let opts = RenderOptions { filter, depth: depth_mode, cull_back_faces };
+    let tshape = texture.as_array().shape().to_vec();
+    let oshape = out.as_array().shape().to_vec();
+    let tex_data = contiguous("texture", texture.as_slice().ok())?;
+    let out_data = out
+        .as_slice_mut()
+        .map_err(|_| PyValueError::new_err("out must be a C-contiguous, writeable uint8 array"))?;
+    let (tp, p, z, t) = (tex_points.as_array(), points.as_array(), depth.as_array(), triangles.as_array());
+    let stats = py.detach(|| -> Result<_, CoreErr> {
+        let tex = ImageRef::new(tex_data, tshape[1], tshape[0], tshape[2])?;
+        let mut img = ImageMut::new(out_data, oshape[1], oshape[0], oshape[2])?;
+        Ok(raster::render_mesh_into(&mut img, &tex, tp, p, z, t, opts)?)
+    })?;
+    Ok((stats.drawn, stats.culled, stats.degenerate, stats.pixels))
+}
+
+/// (height, width) uint32 count of the triangles covering each pixel.
+#[pyfunction]
+fn coverage<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<f64>,
+    triangles: PyReadonlyArray2<u32>,
+    width: usize,
+    height: usize,
+) -> PyResult<Bound<'py, PyArray2<u32>>> {
+    let (p, t) = (points.as_array(), triangles.as_array());
+    let cov = py.detach(|| raster::coverage(p, t, width, height)).map_err(CoreErr)?;
+    Ok(cov.into_pyarray(py))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(render_mesh_into, m)?)?;
+    m.add_function(wrap_pyfunction!(coverage, m)?)?;
+    m.add("MAX_IMAGE_SIDE", raster::MAX_IMAGE_SIDE)?;
+    m.add("MAX_IMAGE_PIXELS", raster::MAX_IMAGE_PIXELS)?;
+    Ok(())
+}

@@ -1,0 +1,7 @@
+"""Synthesis (method.md §3): orthographic projection, back-face culling, far-to-near order and
+per-triangle affine texture mapping, the last three in the Rust core."""
+
+from facemime.render.projection import Pose, project, rotation_matrix
+from facemime.render.texture_map import RenderStats, coverage, render_mesh, render_mesh_into
+
+__all__ = ["Pose", "project", "rotation_matrix", "RenderStats", "coverage", "render_mesh", "render_mesh_into"]

@@ -1,0 +1,82 @@
+"""Argument checks shared by the public API: each raises :class:`InvalidInputError` with one
+line naming the argument, what was expected and what was given."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from facemime.errors import InvalidInputError
+
+
+def _describe(a: object) -> str:
+    if isinstance(a, np.ndarray):
+        return f"array of shape {a.shape} and dtype {a.dtype}"
+    return type(a).__name__
+
+
+def float_array(name: str, a: object, shape: tuple[int | None, ...]) -> np.ndarray:
+    """``a`` as a C-contiguous float64 array of the given shape (None = any size), all finite.
+
+    >>> float_array("points", [[0, 1], [2, 3]], (None, 2)).dtype
+    dtype('float64')
+    """
+    try:
+        arr = np.ascontiguousarray(a, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InvalidInputError(f"{name} must be a numeric array of shape {_shape_text(shape)}, got {_describe(a)}") from None
+    if arr.ndim != len(shape) or any(s is not None and s != d for s, d in zip(shape, arr.shape)):
+        raise InvalidInputError(f"{name} must have shape {_shape_text(shape)}, got {arr.shape}")
+    if not np.isfinite(arr).all():
+        raise InvalidInputError(f"{name} must be finite, found NaN or inf")
+    return arr
+
+
+def index_array(name: str, a: object, columns: int, count: int) -> np.ndarray:
+    """``a`` as a C-contiguous (F, columns) uint32 array of indices into ``count`` items."""
+    arr = np.asarray(a)
+    if arr.ndim != 2 or arr.shape[1] != columns:
+        raise InvalidInputError(f"{name} must have shape (F, {columns}), got {_describe(arr)}")
+    if arr.size and not np.issubdtype(arr.dtype, np.integer):
+        raise InvalidInputError(f"{name} must hold integer indices, got dtype {arr.dtype}")
+    if arr.size and (arr.min() < 0 or arr.max() >= count):
+        bad = int(arr.min()) if arr.min() < 0 else int(arr.max())
+        raise InvalidInputError(f"{name} index {bad} is out of range for {count} vertices")
+    return np.ascontiguousarray(arr, dtype=np.uint32)
+
+
+def image(name: str, a: object) -> np.ndarray:
+    """``a`` as a C-contiguous uint8 image, (H, W) gray or (H, W, C) with C in 1..4."""
+    if not isinstance(a, np.ndarray) or a.dtype != np.uint8:
+        raise InvalidInputError(f"{name} must be a uint8 numpy array (H, W) or (H, W, C), got {_describe(a)}")
+    if a.ndim not in (2, 3) or (a.ndim == 3 and not 1 <= a.shape[2] <= 4) or 0 in a.shape:
+        raise InvalidInputError(f"{name} must have shape (H, W) or (H, W, C) with C in 1..4, got {a.shape}")
+    return np.ascontiguousarray(a)
+
+
+def image_size(name: str, size: object) -> tuple[int, int]:
+    """``size`` as a (width, height) pair of positive ints within the core's limits."""
+    from facemime import _core
+
+    try:
+        w, h = (int(v) for v in size)  # type: ignore[union-attr]
+    except (TypeError, ValueError):
+        raise InvalidInputError(f"{name} must be a (width, height) pair of integers, got {size!r}") from None
+    if w <= 0 or h <= 0:
+        raise InvalidInputError(f"{name} must be positive, got {w}x{h}")
+    if w > _core.MAX_IMAGE_SIDE or h > _core.MAX_IMAGE_SIDE or w * h > _core.MAX_IMAGE_PIXELS:
+        raise InvalidInputError(
+            f"{name} {w}x{h} is too large: at most {_core.MAX_IMAGE_SIDE} pixels per side and "
+            f"{_core.MAX_IMAGE_PIXELS} pixels in all"
+        )
+    return w, h
+
+
+def choice(name: str, value: object, allowed: tuple[str, ...]) -> str:
+    """``value`` if it is one of ``allowed``."""
+    if value not in allowed:
+        raise InvalidInputError(f"{name} must be one of {', '.join(map(repr, allowed))}, got {value!r}")
+    return value  # type: ignore[return-value]
+
+
+def _shape_text(shape: tuple[int | None, ...]) -> str:
+    return "(" + ", ".join("N" if s is None else str(s) for s in shape) + ("," if len(shape) == 1 else "") + ")"
