@@ -56,8 +56,8 @@ def render_mesh_into(
     depth : (N,) float array
         Depth of each vertex, larger = nearer the camera.
     triangles : (F, 3) int array
-        Vertex indices. A triangle faces the camera when its vertices run clockwise on the image
-        (counter-clockwise in the y-up model view, the outward winding of a model).
+        Vertex indices. A triangle faces the camera when its vertices run counter-clockwise as
+        seen on the image (a model's outward winding, counter-clockwise seen from outside).
     filter : {'nearest', 'bilinear'}
     depth_test : {'painter', 'zbuffer'}
         'painter' draws whole triangles far to near by mean depth (the paper); 'zbuffer' tests
@@ -75,7 +75,7 @@ def render_mesh_into(
     >>> out = np.zeros((8, 8, 3), np.uint8)
     >>> pts = np.array([[-0.5, -0.5], [7.5, -0.5], [7.5, 7.5], [-0.5, 7.5]])  # pixel edges
     >>> uv = np.array([[0.0, 0.0], [1, 0], [1, 1], [0, 1]])
-    >>> render_mesh_into(out, tex, uv, pts, np.zeros(4), [[0, 1, 2], [0, 2, 3]]).pixels
+    >>> render_mesh_into(out, tex, uv, pts, np.zeros(4), [[0, 3, 2], [0, 2, 1]]).pixels
     64
     """
     if not (isinstance(out, np.ndarray) and out.flags.c_contiguous and out.flags.writeable):
@@ -120,7 +120,7 @@ def render_mesh(
     Returns a uint8 image shaped like the texture: (H, W) for gray, (H, W, C) otherwise.
 
     >>> img = render_mesh(np.full((2, 2), 9, np.uint8), [[0, 0], [1, 0], [0, 1]],
-    ...                   [[1.0, 1], [5, 1], [1, 5]], np.zeros(3), [[0, 1, 2]], (6, 6), background=3)
+    ...                   [[1.0, 1], [5, 1], [1, 5]], np.zeros(3), [[0, 2, 1]], (6, 6), background=3)
     >>> img.shape, int(img[2, 2]), int(img[5, 5])
     ((6, 6), 9, 3)
     """

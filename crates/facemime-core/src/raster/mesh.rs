@@ -115,8 +115,10 @@ fn check_triangles(triangles: &ArrayView2<u32>, n: usize) -> Result<()> {
 /// - `points`: (N, 2) image position of each vertex, pixels (x, y), y down.
 /// - `depth`: (N,) depth of each vertex, larger = nearer the camera (any unit).
 /// - `triangles`: (F, 3) vertex indices. A triangle faces the camera when its vertices run
-///   counter-clockwise in a y-*up* view, i.e. clockwise on the image (y down); with
-///   `cull_back_faces` the others are skipped, otherwise both sides are drawn.
+///   counter-clockwise *as seen* on the image (a model's outward winding survives the y flip of
+///   the projection); in y-down pixel coordinates that is a negative cross product
+///   (B - A) x (C - A). With `cull_back_faces` the others are skipped, otherwise both sides
+///   are drawn.
 ///
 /// Every destination pixel P' of a triangle takes the texture at `P = A + M (P' - A')`
 /// (eq. 18), so deformed triangles never leave holes.
@@ -180,7 +182,7 @@ fn draw<S: Sampler, const C: usize>(
         let area2 = signed_area2(&dst);
         if area2 == 0.0 {
             stats.degenerate += 1;
-        } else if opts.cull_back_faces && area2 < 0.0 {
+        } else if opts.cull_back_faces && area2 > 0.0 {
             stats.culled += 1;
         } else {
             order.push(((depth[tri[0] as usize] + depth[tri[1] as usize] + depth[tri[2] as usize]) / 3.0, f));
@@ -221,10 +223,21 @@ fn draw<S: Sampler, const C: usize>(
             let row = y * width;
             let span = &mut data[(row + x0) * C..(row + x1 + 1) * C];
             if zbuf.is_empty() {
-                for px in span.chunks_exact_mut(C) {
-                    px.copy_from_slice(&S::sample::<C>(texture, u, v));
-                    u += du;
-                    v += dv;
+                let last = (x1 - x0) as i64;
+                if S::in_bounds(texture, u, v) && S::in_bounds(texture, u + du * last, v + dv * last) {
+                    // The footprint is affine along the span: both ends inside means all inside.
+                    for px in span.chunks_exact_mut(C) {
+                        // SAFETY: in_bounds holds at both ends, hence at every pixel between.
+                        px.copy_from_slice(&unsafe { S::sample_unchecked::<C>(texture, u, v) });
+                        u += du;
+                        v += dv;
+                    }
+                } else {
+                    for px in span.chunks_exact_mut(C) {
+                        px.copy_from_slice(&S::sample::<C>(texture, u, v));
+                        u += du;
+                        v += dv;
+                    }
                 }
                 pixels += x1 - x0 + 1;
             } else {
@@ -291,8 +304,8 @@ mod tests {
         let dst = src.mapv(|v| v + 5.0);
         let mut out = vec![0u8; 48 * 48 * 3];
         let mut img = ImageMut::new(&mut out, 48, 48, 3).unwrap();
-        // Image-clockwise = front-facing: (2,2) -> (28,2) -> (2,28) is clockwise on the image.
-        let tris = arr2(&[[0u32, 1, 2]]);
+        // Counter-clockwise as seen = front-facing: (2,2) -> (2,28) -> (28,2) on the image.
+        let tris = arr2(&[[0u32, 2, 1]]);
         let s = render_mesh_into(&mut img, &texr, src.view(), dst.view(), arr1(&[0.0; 3]).view(), tris.view(), opts(Filter::Nearest, DepthMode::Painter)).unwrap();
         assert_eq!(s.drawn, 1);
         for y in 0..48 {
@@ -315,8 +328,8 @@ mod tests {
         let p = arr2(&[[0.0, 0.0], [7.0, 0.0], [0.0, 7.0]]);
         let mut out = vec![0u8; 8 * 8 * 3];
         let mut img = ImageMut::new(&mut out, 8, 8, 3).unwrap();
-        // (0,0) -> (0,7) -> (7,0) runs counter-clockwise on the image: a back face.
-        let s = render_mesh_into(&mut img, &texr, p.view(), p.view(), arr1(&[0.0; 3]).view(), arr2(&[[0u32, 2, 1]]).view(), opts(Filter::Bilinear, DepthMode::Painter)).unwrap();
+        // (0,0) -> (7,0) -> (0,7) runs clockwise as seen on the image: a back face.
+        let s = render_mesh_into(&mut img, &texr, p.view(), p.view(), arr1(&[0.0; 3]).view(), arr2(&[[0u32, 1, 2]]).view(), opts(Filter::Bilinear, DepthMode::Painter)).unwrap();
         assert_eq!((s.drawn, s.culled, s.pixels), (0, 1, 0));
         assert!(out.iter().all(|&v| v == 0));
     }
@@ -332,7 +345,7 @@ mod tests {
         let z = arr1(&[1.0, 1.0, 1.0, 2.0, 2.0, 2.0]);
         for mode in [DepthMode::Painter, DepthMode::ZBuffer] {
             // Near triangle listed first so that draw order alone would be wrong.
-            let tris = arr2(&[[3u32, 5, 4], [0, 2, 1]]);
+            let tris = arr2(&[[3u32, 4, 5], [0, 1, 2]]);
             let mut out = vec![0u8; 20 * 20];
             let mut img = ImageMut::new(&mut out, 20, 20, 1).unwrap();
             render_mesh_into(&mut img, &texr, tp.view(), pts.view(), z.view(), tris.view(), opts(Filter::Nearest, mode)).unwrap();

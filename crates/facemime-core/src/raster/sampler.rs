@@ -10,7 +10,17 @@ pub const ONE: i64 = 1 << FRAC_BITS;
 
 /// Reads one texel value (C channels) at a fixed-point texture position.
 pub trait Sampler {
+    /// Lookup with edge clamping, valid for any position.
     fn sample<const C: usize>(tex: &ImageRef, u: i64, v: i64) -> [u8; C];
+
+    /// Whether [`Sampler::sample_unchecked`] is valid at (u, v): every texel it reads exists.
+    fn in_bounds(tex: &ImageRef, u: i64, v: i64) -> bool;
+
+    /// Lookup without clamping or bounds checks.
+    ///
+    /// # Safety
+    /// `Self::in_bounds(tex, u, v)` must hold and `tex.data` must hold W·H·C bytes.
+    unsafe fn sample_unchecked<const C: usize>(tex: &ImageRef, u: i64, v: i64) -> [u8; C];
 }
 
 /// Nearest texel (round half up).
@@ -33,6 +43,20 @@ impl Sampler for Nearest {
         let mut px = [0u8; C];
         px.copy_from_slice(&tex.data[i..i + C]);
         px
+    }
+
+    #[inline(always)]
+    fn in_bounds(tex: &ImageRef, u: i64, v: i64) -> bool {
+        let (x, y) = ((u + ONE / 2) >> FRAC_BITS, (v + ONE / 2) >> FRAC_BITS);
+        x >= 0 && y >= 0 && x < tex.width as i64 && y < tex.height as i64
+    }
+
+    #[inline(always)]
+    unsafe fn sample_unchecked<const C: usize>(tex: &ImageRef, u: i64, v: i64) -> [u8; C] {
+        let x = ((u + ONE / 2) >> FRAC_BITS) as usize;
+        let y = ((v + ONE / 2) >> FRAC_BITS) as usize;
+        let p = tex.data.as_ptr().add((y * tex.width + x) * C);
+        std::ptr::read_unaligned(p as *const [u8; C])
     }
 }
 
@@ -61,6 +85,30 @@ impl Sampler for Bilinear {
                 + d[i10 + c] as u32 * w10
                 + d[i11 + c] as u32 * w11;
             px[c] = ((s + (1 << 15)) >> 16) as u8;
+        }
+        px
+    }
+
+    #[inline(always)]
+    fn in_bounds(tex: &ImageRef, u: i64, v: i64) -> bool {
+        let (x, y) = (u >> FRAC_BITS, v >> FRAC_BITS);
+        x >= 0 && y >= 0 && x + 1 < tex.width as i64 && y + 1 < tex.height as i64
+    }
+
+    #[inline(always)]
+    unsafe fn sample_unchecked<const C: usize>(tex: &ImageRef, u: i64, v: i64) -> [u8; C] {
+        let fx = ((u >> (FRAC_BITS - 8)) & 0xFF) as u32;
+        let fy = ((v >> (FRAC_BITS - 8)) & 0xFF) as u32;
+        let stride = tex.width * C;
+        let p00 = tex.data.as_ptr().add(((v >> FRAC_BITS) as usize) * stride + ((u >> FRAC_BITS) as usize) * C);
+        let (p01, p10) = (p00.add(C), p00.add(stride));
+        let p11 = p10.add(C);
+        // Horizontal then vertical interpolation, 8-bit weights, one rounding at the end.
+        let mut px = [0u8; C];
+        for c in 0..C {
+            let top = *p00.add(c) as u32 * (256 - fx) + *p01.add(c) as u32 * fx;
+            let bottom = *p10.add(c) as u32 * (256 - fx) + *p11.add(c) as u32 * fx;
+            px[c] = ((top * (256 - fy) + bottom * fy + (1 << 15)) >> 16) as u8;
         }
         px
     }

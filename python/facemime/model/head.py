@@ -1,0 +1,177 @@
+"""Head models: vertices, triangles, named vertex groups and deformation units.
+
+Coordinates are model space: right-handed, x to the subject's left, y up, z towards the camera.
+The generic head is in millimetres with its origin between the outer eye corners, which are
+90 mm apart. Triangles wind counter-clockwise seen from outside (normals point out of the face).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from facemime.errors import InputFileError, InvalidInputError, ModelFormatError
+
+HEAD_FORMAT = "facemime.head/1"
+
+#: Groups ordered like the snake contours (image-left to image-right), one vertex per knot.
+CONTOUR_GROUPS = (
+    "mouth_outer_upper", "mouth_outer_lower", "mouth_inner_upper", "mouth_inner_lower",
+    "brow_left_upper", "brow_left_lower", "brow_right_upper", "brow_right_lower",
+)
+#: Groups every facemime head file must have.
+REQUIRED_GROUPS = CONTOUR_GROUPS + ("eye_left", "eye_right", "nose", "face_outline")
+
+
+@dataclass(frozen=True, eq=False)
+class HeadModel:
+    """A wire-frame head.
+
+    Attributes
+    ----------
+    vertices : (N, 3) float64 array
+        Rest positions in model space (see the module docstring), in ``unit``.
+    triangles : (F, 3) int64 array
+        Vertex indices, outward (counter-clockwise from outside) winding.
+    uv : (N, 2) float64 array or None
+        Texture coordinates in [0, 1] from the texture's top-left corner.
+    groups : dict of str -> (K,) int64 array
+        Named, ordered vertex groups.
+    units : dict of str -> (N, 3) float64 array
+        Deformation (animation) units: displacement of every vertex at activation 1.
+    shape_units : dict of str -> (N, 3) float64 array
+        Shape units (per-person shape, CANDIDE), same layout.
+    descriptions : dict of str -> str
+        What each unit does.
+    """
+
+    vertices: np.ndarray
+    triangles: np.ndarray
+    uv: np.ndarray | None = None
+    groups: dict[str, np.ndarray] = field(default_factory=dict)
+    units: dict[str, np.ndarray] = field(default_factory=dict)
+    shape_units: dict[str, np.ndarray] = field(default_factory=dict)
+    descriptions: dict[str, str] = field(default_factory=dict)
+    name: str = "head"
+    unit: str = "mm"
+
+    def __post_init__(self) -> None:
+        problem = _first_problem(self.vertices, self.triangles, self.uv, self.groups, (self.units, self.shape_units))
+        if problem:
+            raise InvalidInputError(f"head model {self.name!r}: {problem}")
+
+    def deform(self, weights: Mapping[str, float] | None = None, shape: Mapping[str, float] | None = None) -> np.ndarray:
+        """Vertices with deformation units (and shape units) applied: (N, 3) float64.
+
+        >>> head = generic_head()
+        >>> moved = head.deform({"jaw_drop": 1.0})
+        >>> bool(moved[head.groups["mouth_outer_lower"][5], 1] < head.vertices[head.groups["mouth_outer_lower"][5], 1])
+        True
+        """
+        v = self.vertices.copy()
+        for table, kind in ((self.units, "deformation unit"), (self.shape_units, "shape unit")):
+            for name, w in ((weights if table is self.units else shape) or {}).items():
+                if name not in table:
+                    raise InvalidInputError(f"unknown {kind} {name!r}; this model has: {', '.join(table) or 'none'}")
+                v += float(w) * table[name]
+        return v
+
+
+def _first_problem(
+    v: np.ndarray,
+    t: np.ndarray,
+    uv: np.ndarray | None,
+    groups: Mapping[str, np.ndarray],
+    tables: tuple[Mapping[str, np.ndarray], ...],
+) -> str | None:
+    """The first thing wrong with a model's arrays, as text, or None."""
+    if not (isinstance(v, np.ndarray) and v.ndim == 2 and v.shape[1] == 3 and len(v) >= 3):
+        return f"vertices must have shape (N, 3) with N >= 3, got {getattr(v, 'shape', type(v).__name__)}"
+    n = len(v)
+    if not np.isfinite(v).all():
+        return "vertices hold NaN or inf"
+    if not (isinstance(t, np.ndarray) and t.ndim == 2 and t.shape[1] == 3 and len(t) >= 1):
+        return f"triangles must have shape (F, 3) with F >= 1, got {getattr(t, 'shape', type(t).__name__)}"
+    if t.min() < 0 or t.max() >= n:
+        bad = int(t.min() if t.min() < 0 else t.max())
+        return f"triangle {int(np.argwhere((t < 0) | (t >= n))[0, 0])} uses vertex {bad}, but there are {n} vertices"
+    area = np.linalg.norm(np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]]), axis=1)
+    scale = max(float(np.ptp(v, axis=0).max()), 1e-12)
+    if (area <= 1e-9 * scale**2).any():
+        return f"triangle {int(np.argmax(area <= 1e-9 * scale**2))} is degenerate (zero area)"
+    if uv is not None and (uv.shape != (n, 2) or not np.isfinite(uv).all()):
+        return f"uv must have shape ({n}, 2) and be finite, got {uv.shape}"
+    for name, g in groups.items():
+        if g.ndim != 1 or len(g) == 0 or g.min() < 0 or g.max() >= n:
+            return f"group {name!r} must list vertex indices in 0..{n - 1}"
+    for table in tables:
+        for name, d in table.items():
+            if d.shape != (n, 3) or not np.isfinite(d).all():
+                return f"unit {name!r} must have shape ({n}, 3) and be finite"
+    return None
+
+
+def load_head(path: str | Path) -> HeadModel:
+    """Load and validate a ``facemime.head/1`` JSON model file.
+
+    Raises :class:`InputFileError` if it cannot be read and :class:`ModelFormatError`, naming the
+    file and the problem, if it is not a valid model.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise InputFileError(f"{path}: no such model file") from None
+    except (OSError, UnicodeDecodeError) as e:
+        raise InputFileError(f"{path}: cannot read model file ({e.__class__.__name__})") from None
+    return _parse_head(text, str(path))
+
+
+def generic_head() -> HeadModel:
+    """The generic head shipped with facemime (about 120 vertices, millimetres)."""
+    text = resources.files("facemime.model").joinpath("data/generic_head.json").read_text(encoding="utf-8")
+    return _parse_head(text, "generic_head.json")
+
+
+def _parse_head(text: str, where: str) -> HeadModel:
+    try:
+        doc = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise ModelFormatError(f"{where}: not valid JSON ({e.msg} at line {e.lineno})") from None
+    if not isinstance(doc, dict) or doc.get("format") != HEAD_FORMAT:
+        found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
+        raise ModelFormatError(f"{where}: expected format {HEAD_FORMAT!r}, got {found!r}")
+    try:
+        vertices = np.asarray(doc["vertices"], dtype=np.float64)
+        n = len(vertices)
+        triangles = np.asarray(doc["triangles"], dtype=np.int64)
+        uv = np.asarray(doc["uv"], dtype=np.float64) if doc.get("uv") is not None else None
+        groups = {str(k): np.asarray(g, dtype=np.int64) for k, g in doc["groups"].items()}
+        units, descriptions = {}, {}
+        for name, u in doc.get("deformation_units", {}).items():
+            dense = np.zeros((n, 3))
+            for row in u["displacements"]:
+                i, dx, dy, dz = row
+                if not (isinstance(i, int) and 0 <= i < n):
+                    raise ModelFormatError(f"{where}: deformation unit {name!r} names vertex {i!r}, but there are {n} vertices")
+                dense[i] = (dx, dy, dz)
+            units[str(name)] = dense
+            descriptions[str(name)] = str(u.get("description", ""))
+    except ModelFormatError:
+        raise
+    except KeyError as e:
+        raise ModelFormatError(f"{where}: missing field {e.args[0]!r}") from None
+    except (TypeError, ValueError, AttributeError) as e:
+        raise ModelFormatError(f"{where}: malformed model ({e})") from None
+    missing = [g for g in REQUIRED_GROUPS if g not in groups]
+    if missing:
+        raise ModelFormatError(f"{where}: missing vertex groups {', '.join(missing)}")
+    problem = _first_problem(vertices, triangles, uv, groups, (units,))
+    if problem:
+        raise ModelFormatError(f"{where}: {problem}")
+    return HeadModel(vertices, triangles, uv, groups, units, {}, descriptions, str(doc.get("name", where)), str(doc.get("unit", "mm")))

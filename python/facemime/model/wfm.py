@@ -1,0 +1,139 @@
+"""Loader for CANDIDE ``.wfm`` wire-frame models (CANDIDE-3, J. Ahlberg, Linköping University).
+
+A ``.wfm`` file is text: ``# VERTEX LIST:`` (count, then x y z per line), ``# FACE LIST:``
+(count, then three vertex indices), ``# ANIMATION UNITS LIST:`` and ``# SHAPE UNITS LIST:``
+(count, then per unit a ``# name`` line, a count and ``vertex dx dy dz`` lines),
+``# ANIMATION PARAMETERS:`` / ``# SHAPE PARAMETERS:`` (one value per unit) and ``# TEXTURE:``
+(u v per vertex, v from the top). Other ``#`` lines are comments.
+
+CANDIDE's x axis points to the image's left (the subject's right); the loader mirrors x so that
+the model follows facemime's right-handed convention (x to the subject's left, y up, z towards
+the camera). The mirror also turns CANDIDE's face order (clockwise seen from outside) into
+facemime's outward, counter-clockwise winding. The unit stays CANDIDE's own (about 1 = half
+the face height).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from facemime.errors import InputFileError, InvalidInputError, ModelFormatError
+from facemime.model.head import HeadModel
+
+_SECTIONS = ("VERTEX LIST", "FACE LIST", "ANIMATION UNITS LIST", "SHAPE UNITS LIST",
+             "ANIMATION PARAMETERS", "SHAPE PARAMETERS", "TEXTURE", "END OF FILE")
+
+
+class _Lines:
+    """Numbered, non-empty lines of a section, consumed in order, with error context."""
+
+    def __init__(self, where: str, section: str, lines: list[tuple[int, str]]):
+        self.where, self.section, self.lines, self.pos = where, section, lines, 0
+
+    def fail(self, what: str) -> ModelFormatError:
+        line = self.lines[min(self.pos, len(self.lines) - 1)][0] if self.lines else "?"
+        return ModelFormatError(f"{self.where}: {self.section}, line {line}: {what}")
+
+    def next(self) -> str:
+        if self.pos >= len(self.lines):
+            raise self.fail("section ends early")
+        self.pos += 1
+        return self.lines[self.pos - 1][1]
+
+    def numbers(self, count: int, kind: type) -> list:
+        parts = self.next().split()
+        try:
+            if len(parts) != count:
+                raise ValueError
+            return [kind(p) for p in parts]
+        except ValueError:
+            self.pos -= 1
+            raise self.fail(f"expected {count} {'integers' if kind is int else 'numbers'}, got {' '.join(parts)!r}") from None
+
+    def count(self) -> int:
+        (n,) = self.numbers(1, int)
+        if n < 0:
+            raise self.fail(f"negative count {n}")
+        return n
+
+
+def load_wfm(path: str | Path) -> HeadModel:
+    """Load a CANDIDE ``.wfm`` file as a :class:`HeadModel` in facemime's axes.
+
+    Animation units become ``units``, shape units ``shape_units`` (each named as in the file);
+    the file's texture coordinates become ``uv``. The model has no named vertex groups.
+    Raises :class:`InputFileError` or :class:`ModelFormatError` naming the file, section and line.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="latin-1")
+    except FileNotFoundError:
+        raise InputFileError(f"{path}: no such model file") from None
+    except OSError as e:
+        raise InputFileError(f"{path}: cannot read model file ({e.strerror})") from None
+    where = str(path)
+    # Split at known section titles only: unit names are "# ..." lines inside their section.
+    sections: dict[str, list[tuple[int, str]]] = {}
+    current: list[tuple[int, str]] | None = None
+    for lineno, raw in enumerate(text.splitlines(), 1):
+        line = raw.strip()
+        if not line:
+            continue
+        head = line.lstrip("#").strip().rstrip(":").upper()
+        if line.startswith("#") and head in _SECTIONS:
+            current = sections.setdefault(head, [])
+        elif current is not None:
+            current.append((lineno, line))
+    for required in ("VERTEX LIST", "FACE LIST"):
+        if required not in sections:
+            raise ModelFormatError(f"{where}: no '# {required}:' section; is this a CANDIDE .wfm file?")
+
+    s = _Lines(where, "VERTEX LIST", sections["VERTEX LIST"])
+    vertices = np.array([s.numbers(3, float) for _ in range(s.count())], dtype=np.float64).reshape(-1, 3)
+    n = len(vertices)
+    s = _Lines(where, "FACE LIST", sections["FACE LIST"])
+    faces = np.array([s.numbers(3, int) for _ in range(s.count())], dtype=np.int64).reshape(-1, 3)
+    if faces.size and (faces.min() < 0 or faces.max() >= n):
+        raise ModelFormatError(f"{where}: FACE LIST uses vertex {int(faces.max() if faces.max() >= n else faces.min())}, but there are {n} vertices")
+
+    def units(section: str) -> dict[str, np.ndarray]:
+        s = _Lines(where, section, sections.get(section, []))
+        if not s.lines:
+            return {}
+        out: dict[str, np.ndarray] = {}
+        for k in range(s.count()):
+            name = s.next()
+            if not name.startswith("#"):
+                s.pos -= 1
+                raise s.fail(f"expected '# <unit name>' for unit {k}, got {name!r}")
+            name = name.lstrip("#").strip() or f"unit {k}"
+            d = np.zeros((n, 3))
+            for _ in range(s.count()):
+                i, *delta = s.numbers(4, float)
+                if not (float(i).is_integer() and 0 <= i < n):
+                    s.pos -= 1
+                    raise s.fail(f"unit {name!r} names vertex {i:g}, but there are {n} vertices")
+                d[int(i)] = delta
+            out[name] = d * [-1, 1, 1]
+        return out
+
+    uv = None
+    if sections.get("TEXTURE"):
+        s = _Lines(where, "TEXTURE", sections["TEXTURE"])
+        uv = np.array([s.numbers(2, float) for _ in range(n)], dtype=np.float64)
+    model_units = units("ANIMATION UNITS LIST")
+    shape_units = units("SHAPE UNITS LIST")
+    try:  # the model's own validation names what is wrong (degenerate triangle, ...)
+        return HeadModel(
+            vertices=vertices * [-1, 1, 1],
+            triangles=faces,
+            uv=uv,
+            units=model_units,
+            shape_units=shape_units,
+            name=path.stem,
+            unit="CANDIDE units",
+        )
+    except InvalidInputError as e:
+        raise ModelFormatError(f"{where}: {e}") from None

@@ -1,0 +1,70 @@
+"""Pictures of a head model: textured (the Rust rasteriser), flat-shaded and wireframe views.
+
+Poses and coordinates as in :mod:`facemime.render.projection`.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from facemime.model.head import HeadModel
+from facemime.render.projection import Pose, project
+from facemime.render.texture_map import render_mesh
+
+LIGHT = np.array([0.3, 0.4, 1.0]) / np.linalg.norm([0.3, 0.4, 1.0])  # model-space, towards the light
+
+
+def render_head(
+    model: HeadModel,
+    texture: np.ndarray,
+    pose: Pose,
+    size: tuple[int, int],
+    *,
+    vertices: np.ndarray | None = None,
+    background: np.ndarray | tuple[int, ...] | int | None = None,
+    filter: str = "bilinear",
+    depth_test: str = "painter",
+) -> np.ndarray:
+    """The textured model (or ``vertices``, a deformed copy of its vertices) seen in ``pose``,
+    drawn into a new (H, W, 3) image of ``size`` = (width, height)."""
+    points, depth = project(model.vertices if vertices is None else vertices, pose)
+    if model.uv is None:
+        raise ValueError(f"head model {model.name!r} has no texture coordinates")
+    return render_mesh(texture, model.uv, points, depth, model.triangles, size,
+                       background=background, filter=filter, depth_test=depth_test)
+
+
+def render_shaded(model: HeadModel, pose: Pose, size: tuple[int, int], *, vertices: np.ndarray | None = None,
+                  colour: tuple[int, int, int] = (205, 180, 160), background: int = 255) -> np.ndarray:
+    """Flat Lambert shading of the front faces, far to near: an (H, W, 3) preview image."""
+    v = model.vertices if vertices is None else vertices
+    points, depth = project(v, pose)
+    w, h = size
+    img = np.full((h, w, 3), background, np.uint8)
+    t = model.triangles
+    a, b, c = v[t[:, 0]], v[t[:, 1]], v[t[:, 2]]
+    normals = np.cross(b - a, c - a)
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    from facemime.render.projection import rotation_matrix
+
+    view_normals = normals @ rotation_matrix(pose.yaw, pose.pitch, pose.roll).T
+    light = 0.25 + 0.75 * np.clip(view_normals @ LIGHT, 0, 1)
+    order = np.argsort(depth[t].mean(axis=1))
+    for f in order:
+        if view_normals[f, 2] <= 0:
+            continue  # back face
+        poly = np.round(points[t[f]] * 16).astype(np.int32)
+        cv2.fillConvexPoly(img, poly, tuple(float(light[f] * ch) for ch in colour), cv2.LINE_AA, 4)
+    return img
+
+
+def draw_wireframe(image: np.ndarray, points: np.ndarray, triangles: np.ndarray,
+                   colour: tuple[int, int, int] = (40, 220, 90), thickness: int = 1) -> np.ndarray:
+    """Draw every triangle edge of a projected mesh (``points`` (N, 2) pixels) onto ``image``
+    in place and return it."""
+    edges = np.sort(np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]]), axis=1)
+    for i, j in np.unique(edges, axis=0):
+        p, q = (np.round(points[[i, j]] * 16).astype(int)).tolist()
+        cv2.line(image, tuple(p), tuple(q), colour, thickness, cv2.LINE_AA, 4)
+    return image
