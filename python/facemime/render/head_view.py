@@ -8,8 +8,9 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from facemime.errors import InvalidInputError
 from facemime.model.head import HeadModel
-from facemime.render.projection import Pose, project
+from facemime.render.projection import Pose, project, rotation_matrix
 from facemime.render.texture_map import render_mesh
 
 LIGHT = np.array([0.3, 0.4, 1.0]) / np.linalg.norm([0.3, 0.4, 1.0])  # model-space, towards the light
@@ -30,7 +31,7 @@ def render_head(
     drawn into a new (H, W, 3) image of ``size`` = (width, height)."""
     points, depth = project(model.vertices if vertices is None else vertices, pose)
     if model.uv is None:
-        raise ValueError(f"head model {model.name!r} has no texture coordinates")
+        raise InvalidInputError(f"head model {model.name!r} has no texture coordinates (uv)")
     return render_mesh(texture, model.uv, points, depth, model.triangles, size,
                        background=background, filter=filter, depth_test=depth_test)
 
@@ -46,8 +47,6 @@ def render_shaded(model: HeadModel, pose: Pose, size: tuple[int, int], *, vertic
     a, b, c = v[t[:, 0]], v[t[:, 1]], v[t[:, 2]]
     normals = np.cross(b - a, c - a)
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-    from facemime.render.projection import rotation_matrix
-
     view_normals = normals @ rotation_matrix(pose.yaw, pose.pitch, pose.roll).T
     light = 0.25 + 0.75 * np.clip(view_normals @ LIGHT, 0, 1)
     order = np.argsort(depth[t].mean(axis=1))
@@ -68,3 +67,19 @@ def draw_wireframe(image: np.ndarray, points: np.ndarray, triangles: np.ndarray,
         p, q = (np.round(points[[i, j]] * 16).astype(int)).tolist()
         cv2.line(image, tuple(p), tuple(q), colour, thickness, cv2.LINE_AA, 4)
     return image
+
+
+def views_sheet(model: HeadModel, texture: np.ndarray | None, cell: int = 320,
+                yaws: tuple[float, ...] = (-60, -30, 0, 30, 60), vertices: np.ndarray | None = None) -> np.ndarray:
+    """One picture of a model seen at several yaw angles (degrees): a row of textured renders
+    (when a texture is given), a row of flat-shaded renders with the wireframe on top."""
+    v = model.vertices if vertices is None else vertices
+    columns = []
+    for yaw in yaws:
+        pose = Pose.framing(model.vertices, (cell, cell), 0.88, yaw=yaw)
+        shaded = render_shaded(model, pose, (cell, cell), vertices=v)
+        rows = [draw_wireframe(shaded, project(v, pose)[0], model.triangles, (30, 110, 40))]
+        if texture is not None:
+            rows.insert(0, render_head(model, texture, pose, (cell, cell), vertices=v, background=(36, 36, 40)))
+        columns.append(np.vstack(rows))
+    return np.hstack(columns)

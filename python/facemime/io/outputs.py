@@ -1,0 +1,61 @@
+"""Output files: never overwrite what exists unless asked, never leave half-written files."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Iterable
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from facemime.errors import FacemimeError, InvalidInputError
+
+
+class OutputExistsError(FacemimeError, FileExistsError):
+    """An output file exists and overwriting was not allowed."""
+
+
+def check_outputs(paths: Iterable[str | Path], force: bool) -> None:
+    """Refuse (with one message naming them) to overwrite existing files unless ``force``;
+    check that each parent folder can be created."""
+    paths = [Path(p) for p in paths]
+    existing = [str(p) for p in paths if p.exists()]
+    if existing and not force:
+        raise OutputExistsError(f"{', '.join(existing)} already exist{'s' if len(existing) == 1 else ''}; "
+                                "use --force to overwrite")
+    for p in paths:
+        if p.is_dir():
+            raise InvalidInputError(f"{p} is a folder, expected a file name")
+        parent = p.parent
+        while not parent.exists():
+            parent = parent.parent
+        if not parent.is_dir() or not os.access(parent, os.W_OK):
+            raise InvalidInputError(f"cannot write {p}: {parent} is not a writeable folder")
+
+
+def temporary_sibling(path: Path) -> Path:
+    """A new, unique file name next to ``path`` with the same suffix (same filesystem, so the
+    final rename is atomic)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".part{path.suffix}", dir=path.parent)
+    os.close(fd)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; the final file gets the usual mode
+    return Path(tmp)
+
+
+def write_image(path: str | Path, image: np.ndarray) -> Path:
+    """Write an RGB or gray uint8 image (PNG, JPEG, ... by suffix) atomically."""
+    path = Path(path)
+    tmp = temporary_sibling(path)
+    try:
+        bgr = image[..., ::-1] if image.ndim == 3 else image
+        if not cv2.imwrite(str(tmp), np.ascontiguousarray(bgr)):
+            raise InvalidInputError(f"cannot write image {path}: unsupported file type {path.suffix!r}")
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return path
