@@ -40,7 +40,7 @@ pub struct RenderStats {
     pub drawn: usize,
     /// Triangles skipped as back-facing.
     pub culled: usize,
-    /// Triangles skipped because their image or texture triangle has zero area.
+    /// Triangles skipped because their image triangle has zero area.
     pub degenerate: usize,
     /// Pixel writes (a pixel drawn twice counts twice).
     pub pixels: usize,
@@ -201,10 +201,6 @@ fn draw<S: Sampler, const C: usize>(
         let dst = [corner(points, tri[0]), corner(points, tri[1]), corner(points, tri[2])];
         let src = [corner(tex_points, tri[0]), corner(tex_points, tri[1]), corner(tex_points, tri[2])];
         let z = [depth[tri[0] as usize], depth[tri[1] as usize], depth[tri[2] as usize]];
-        if signed_area2(&src) == 0.0 {
-            stats.degenerate += 1;
-            continue;
-        }
         let Some(map) = TriangleMap::new(dst, src, z) else {
             stats.degenerate += 1;
             continue;

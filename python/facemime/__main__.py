@@ -1,0 +1,5 @@
+"""``python -m facemime``: the same as the ``facemime`` command."""
+
+from facemime.cli.main import main
+
+main()

@@ -1,0 +1,59 @@
+import subprocess
+import sys
+
+import av
+import cv2
+import pytest
+
+from facemime.cli.main import main
+
+
+def run(capsys, *args):
+    with pytest.raises(SystemExit) as exc:
+        main(list(args))
+        raise SystemExit(0)
+    out, err = capsys.readouterr()
+    return exc.value.code or 0, out, err
+
+
+def test_demo_writes_views_stills_and_a_playable_video(tmp_path, capsys):
+    code, out, err = run(capsys, "demo", "--out", str(tmp_path / "d"))
+    assert code == 0
+    names = {p.name for p in (tmp_path / "d").iterdir()}
+    assert names == {"head_views.png", "deformation_units.png", "head.mp4"}
+    assert out.split() == [str(tmp_path / "d" / n) for n in ("head_views.png", "deformation_units.png", "head.mp4")]
+    views = cv2.imread(str(tmp_path / "d" / "head_views.png"))
+    assert views.shape == (640, 1600, 3) and views.std() > 20
+    with av.open(str(tmp_path / "d" / "head.mp4")) as c:
+        assert c.streams.video[0].codec_context.name == "h264"
+        assert sum(1 for _ in c.decode(video=0)) == 150
+    # A second run refuses to overwrite, in one line, and changes nothing.
+    before = (tmp_path / "d" / "head.mp4").stat().st_mtime_ns
+    code, out, err = run(capsys, "demo", "--out", str(tmp_path / "d"))
+    assert code == 1 and err.count("\n") == 1 and err.startswith("facemime: error:") and "--force" in err
+    assert (tmp_path / "d" / "head.mp4").stat().st_mtime_ns == before
+
+
+def test_model_preview_of_a_candide_file(tmp_path, capsys, candide_path):
+    code, out, _ = run(capsys, "model-preview", str(candide_path), "--out", str(tmp_path / "c.png"))
+    assert code == 0 and out.strip() == str(tmp_path / "c.png")
+    assert cv2.imread(str(tmp_path / "c.png")).shape == (320, 1600, 3)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["model-preview", "missing.wfm", "--out", "x.png"], "missing.wfm: no such model file"),
+        (["model-preview", "BAD", "--out", "y.png"], "not valid JSON"),
+    ],
+)
+def test_errors_are_one_line_without_traceback(tmp_path, capsys, monkeypatch, args, message):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "BAD").write_text("{")
+    code, _, err = run(capsys, *args)
+    assert code == 1 and message in err and "Traceback" not in err and err.count("\n") == 1
+
+
+def test_installed_command_runs():
+    done = subprocess.run([sys.executable, "-m", "facemime", "--version"], capture_output=True, text=True)
+    assert done.returncode == 0 and done.stdout.startswith("facemime, version")

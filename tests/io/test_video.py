@@ -1,0 +1,48 @@
+import av
+import numpy as np
+import pytest
+
+from facemime.errors import InvalidInputError
+from facemime.io import VideoWriter, check_outputs
+from facemime.io.outputs import OutputExistsError
+
+
+@pytest.mark.parametrize(("suffix", "codec"), [(".mp4", "h264"), (".webm", "vp9")])
+def test_written_video_plays_back(tmp_path, suffix, codec):
+    path = tmp_path / f"clip{suffix}"
+    frames = [np.full((31, 45, 3), 25 * i, np.uint8) for i in range(8)]  # odd size gets padded
+    with VideoWriter(path, fps=25) as w:
+        for f in frames:
+            w.write(f)
+    with av.open(str(path)) as c:
+        stream = c.streams.video[0]
+        decoded = [f.to_ndarray(format="rgb24") for f in c.decode(stream)]
+        assert stream.codec_context.name == codec and stream.codec_context.pix_fmt == "yuv420p"
+    assert len(decoded) == 8 and decoded[0].shape == (32, 46, 3)
+    assert abs(int(decoded[5][10, 10, 0]) - 125) <= 3
+    assert [p.name for p in tmp_path.iterdir()] == [path.name]  # no temporary file left
+
+
+def test_failed_write_leaves_nothing(tmp_path):
+    path = tmp_path / "clip.mp4"
+    with pytest.raises(RuntimeError), VideoWriter(path, fps=10) as w:
+        w.write(np.zeros((16, 16, 3), np.uint8))
+        raise RuntimeError("interrupted")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_bad_video_arguments(tmp_path):
+    with pytest.raises(InvalidInputError, match=r"must end in \.mp4 or \.webm"):
+        VideoWriter(tmp_path / "x.avi", 25)
+    with pytest.raises(InvalidInputError, match="size changed"), VideoWriter(tmp_path / "x.mp4", 25) as w:
+        w.write(np.zeros((16, 16, 3), np.uint8))
+        w.write(np.zeros((18, 16, 3), np.uint8))
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_existing_outputs_are_not_overwritten_without_force(tmp_path):
+    (tmp_path / "a.png").write_bytes(b"mine")
+    with pytest.raises(OutputExistsError, match="a.png already exists; use --force"):
+        check_outputs([tmp_path / "a.png", tmp_path / "b.png"], force=False)
+    check_outputs([tmp_path / "a.png"], force=True)
+    assert (tmp_path / "a.png").read_bytes() == b"mine"
