@@ -206,7 +206,8 @@ fn draw<S: Sampler, const C: usize>(
             continue;
         };
         stats.drawn += 1;
-        let to_fixed = |v: f64| (v * ONE as f64).round() as i64;
+        // Round half away from zero with a cast: f64::round is a libm call on baseline x86-64.
+        let to_fixed = |v: f64| (v * ONE as f64 + 0.5f64.copysign(v)) as i64;
         let (du, dv) = (to_fixed(map.m[0][0]), to_fixed(map.m[1][0]));
         let data = &mut *out.data;
         let zbuf = &mut zbuf;
@@ -222,12 +223,8 @@ fn draw<S: Sampler, const C: usize>(
                 let last = (x1 - x0) as i64;
                 if S::in_bounds(texture, u, v) && S::in_bounds(texture, u + du * last, v + dv * last) {
                     // The footprint is affine along the span: both ends inside means all inside.
-                    for px in span.chunks_exact_mut(C) {
-                        // SAFETY: in_bounds holds at both ends, hence at every pixel between.
-                        px.copy_from_slice(&unsafe { S::sample_unchecked::<C>(texture, u, v) });
-                        u += du;
-                        v += dv;
-                    }
+                    // SAFETY: in_bounds holds at both ends, hence at every pixel between.
+                    unsafe { S::fill_span_unchecked::<C>(texture, u, v, du, dv, span) };
                 } else {
                     for px in span.chunks_exact_mut(C) {
                         px.copy_from_slice(&S::sample::<C>(texture, u, v));

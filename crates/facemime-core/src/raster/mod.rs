@@ -8,6 +8,8 @@
 pub mod image;
 pub mod mesh;
 pub mod sampler;
+#[cfg(target_arch = "x86_64")]
+mod simd;
 pub mod span;
 
 pub use image::{ImageMut, ImageRef, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};

@@ -21,6 +21,19 @@ pub trait Sampler {
     /// # Safety
     /// `Self::in_bounds(tex, u, v)` must hold and `tex.data` must hold W·H·C bytes.
     unsafe fn sample_unchecked<const C: usize>(tex: &ImageRef, u: i64, v: i64) -> [u8; C];
+
+    /// Fills `out` (whole pixels of C bytes) with the samples at (u + k·du, v + k·dv).
+    ///
+    /// # Safety
+    /// `Self::in_bounds` must hold at the first and the last pixel of the span.
+    #[inline(always)]
+    unsafe fn fill_span_unchecked<const C: usize>(tex: &ImageRef, mut u: i64, mut v: i64, du: i64, dv: i64, out: &mut [u8]) {
+        for px in out.chunks_exact_mut(C) {
+            px.copy_from_slice(&Self::sample_unchecked::<C>(tex, u, v));
+            u += du;
+            v += dv;
+        }
+    }
 }
 
 /// Nearest texel (round half up).
@@ -118,5 +131,18 @@ impl Sampler for Bilinear {
             ],
             w,
         )
+    }
+
+    #[inline(always)]
+    unsafe fn fill_span_unchecked<const C: usize>(tex: &ImageRef, mut u: i64, mut v: i64, du: i64, dv: i64, out: &mut [u8]) {
+        #[cfg(target_arch = "x86_64")]
+        if super::simd::bilinear_span_avx2::<C>(tex, u, v, du, dv, out) > 0 {
+            return;
+        }
+        for px in out.chunks_exact_mut(C) {
+            px.copy_from_slice(&Self::sample_unchecked::<C>(tex, u, v));
+            u += du;
+            v += dv;
+        }
     }
 }

@@ -36,24 +36,32 @@ impl Edge {
     }
 }
 
-/// Smallest integer x with d·x >= n (d > 0), or a value outside [lo, hi] when it lies there.
-#[inline]
-fn ceil_div(n: i64, d: i64, lo: i64, hi: i64) -> i64 {
-    let est = (n as f64 / d as f64).ceil();
-    if est < (lo - 2) as f64 {
-        return lo - 1;
+/// ceil(n / d) for d > 0, exactly, stepped from row to row without division: the numerator
+/// grows by `dn` per row and the state keeps n = d·x - s with 0 <= s < d.
+struct CeilStepper {
+    x: i64,
+    s: i64,
+    d: i64,
+    dq: i64,
+    dr: i64,
+}
+
+impl CeilStepper {
+    fn new(n: i64, d: i64, dn: i64) -> Self {
+        let x = -((-n).div_euclid(d));
+        Self { x, s: d * x - n, d, dq: dn.div_euclid(d), dr: dn.rem_euclid(d) }
     }
-    if est > (hi + 2) as f64 {
-        return hi + 1;
+
+    #[inline(always)]
+    fn step(&mut self) {
+        // n + dn = d·(x + dq) - (s - dr)
+        self.x += self.dq;
+        self.s -= self.dr;
+        if self.s < 0 {
+            self.s += self.d;
+            self.x += 1;
+        }
     }
-    let mut x = est as i64;
-    while d * x < n {
-        x += 1;
-    }
-    while d * (x - 1) >= n {
-        x -= 1;
-    }
-    x
 }
 
 /// Calls `f(y, x_start, x_end)` (x_end inclusive) for every row of pixels the triangle `tri`
@@ -84,7 +92,8 @@ fn fill_snapped(
     height: usize,
     f: &mut impl FnMut(usize, usize, usize),
 ) {
-    let snap = |p: [f64; 2]| ((p[0] * SUB as f64).round() as i64, (p[1] * SUB as f64).round() as i64);
+    let round = |v: f64| (v + 0.5f64.copysign(v)) as i64; // no libm call, unlike f64::round
+    let snap = |p: [f64; 2]| (round(p[0] * SUB as f64), round(p[1] * SUB as f64));
     let (p0, mut p1, mut p2) = (snap(tri[0]), snap(tri[1]), snap(tri[2]));
     let area2 = (p1.0 - p0.0) * (p2.1 - p0.1) - (p1.1 - p0.1) * (p2.0 - p0.0);
     if area2 == 0 {
@@ -107,20 +116,38 @@ fn fill_snapped(
     if row_first > row_last || col_first > col_last {
         return;
     }
-    'rows: for py in row_first..=row_last {
-        let (mut lo, mut hi) = (col_first, col_last);
-        for e in &edges {
-            let r = e.b * py + e.c; // E = a·px + r >= 0
-            if e.a > 0 {
-                lo = lo.max(ceil_div(-r, e.a, col_first, col_last));
-            } else if e.a < 0 {
-                // -a·px <= r  <=>  px <= floor(r / -a)  <=>  px < ceil((r + 1) / -a)
-                hi = hi.min(ceil_div(r + 1, -e.a, col_first, col_last) - 1);
-            } else if r < 0 {
-                continue 'rows;
+    // Per edge, the first (a > 0) or one past the last (a < 0) pixel of each row, stepped
+    // exactly from row to row; flat edges (a = 0) exclude the rows where they are negative.
+    let mut lower: [Option<CeilStepper>; 3] = [None, None, None];
+    let mut upper: [Option<CeilStepper>; 3] = [None, None, None];
+    let mut flat: [Option<(i64, i64)>; 3] = [None, None, None]; // (r, dr) with r = b·py + c
+    for (k, e) in edges.iter().enumerate() {
+        let r = e.b * row_first + e.c; // E = a·px + r >= 0
+        if e.a > 0 {
+            lower[k] = Some(CeilStepper::new(-r, e.a, -e.b)); // px >= ceil(-r / a)
+        } else if e.a < 0 {
+            upper[k] = Some(CeilStepper::new(r + 1, -e.a, e.b)); // px < ceil((r + 1) / -a)
+        } else {
+            flat[k] = Some((r, e.b));
+        }
+    }
+    for py in row_first..=row_last {
+        let (mut lo, mut hi, mut empty) = (col_first, col_last, false);
+        for k in 0..3 {
+            if let Some(b) = &mut lower[k] {
+                lo = lo.max(b.x);
+                b.step();
+            }
+            if let Some(b) = &mut upper[k] {
+                hi = hi.min(b.x - 1);
+                b.step();
+            }
+            if let Some((r, dr)) = &mut flat[k] {
+                empty |= *r < 0;
+                *r += *dr;
             }
         }
-        if lo <= hi {
+        if !empty && lo <= hi {
             f(py as usize, lo as usize, hi as usize);
         }
     }
