@@ -8,6 +8,11 @@ pub const MAX_IMAGE_SIDE: usize = 16_384;
 /// Largest number of pixels (W·H) of any image the core reads or writes.
 pub const MAX_IMAGE_PIXELS: usize = 1 << 26;
 
+/// Checks that a `width` x `height` image is non-empty and within the size limits.
+pub fn check_size(what: &str, width: usize, height: usize) -> Result<()> {
+    check_dims(what, width * height, width, height, 1)
+}
+
 fn check_dims(what: &str, len: usize, width: usize, height: usize, channels: usize) -> Result<()> {
     if width == 0 || height == 0 {
         return invalid!("{what} must not be empty, got {width}x{height}");

@@ -2,7 +2,7 @@
 
 use ndarray::{Array2, ArrayView1, ArrayView2};
 
-use super::image::{ImageMut, ImageRef};
+use super::image::{check_size, ImageMut, ImageRef};
 use super::sampler::{Bilinear, Nearest, Sampler, ONE};
 use super::span::for_each_span;
 use crate::error::Result;
@@ -264,8 +264,7 @@ pub fn coverage(
     let n = points.nrows();
     check_points("points", &points, n)?;
     check_triangles(&triangles, n)?;
-    let mut data = vec![0u8; width * height];
-    ImageMut::new(&mut data, width, height, 1)?; // validates the size
+    check_size("coverage image", width, height)?;
     let mut cov = Array2::<u32>::zeros((height, width));
     for tri in triangles.outer_iter() {
         let dst = [corner(&points, tri[0]), corner(&points, tri[1]), corner(&points, tri[2])];
