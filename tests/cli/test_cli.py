@@ -45,11 +45,16 @@ def test_model_preview_of_a_candide_file(tmp_path, capsys, candide_path):
     [
         (["model-preview", "missing.wfm", "--out", "x.png"], "missing.wfm: no such model file"),
         (["model-preview", "BAD", "--out", "y.png"], "not valid JSON"),
+        (["model-preview", "--out", "y.gifx"], "its name must end in one of .png"),
+        (["model-preview", "--out", "/proc/preview.png"], "cannot write /proc/preview.png"),
+        (["model-preview", "BIN", "--out", "z.png"], "not a text file"),
+        (["model-preview", ".", "--out", "z.png"], "is a folder, expected a model file"),
     ],
 )
 def test_errors_are_one_line_without_traceback(tmp_path, capsys, monkeypatch, args, message):
     monkeypatch.chdir(tmp_path)
     (tmp_path / "BAD").write_text("{")
+    (tmp_path / "BIN").write_bytes(bytes(range(128, 256)))
     code, _, err = run(capsys, *args)
     assert code == 1 and message in err and "Traceback" not in err and err.count("\n") == 1
 

@@ -46,10 +46,11 @@ def demo(out_dir: Path, force: bool) -> None:
 def model_preview(model: Path | None, out_file: Path, force: bool) -> None:
     """Render a head model (facemime .json or CANDIDE .wfm; default: the built-in head) from
     five angles, textured, shaded and as a wireframe, into one PNG."""
-    from facemime.io import check_outputs, write_image
+    from facemime.io import check_image_suffix, check_outputs, write_image
     from facemime.model import generic_head, load_head, load_wfm, painted_texture
     from facemime.render.head_view import views_sheet
 
+    check_image_suffix(out_file)
     check_outputs([out_file], force)
     if model is None:
         head = generic_head()

@@ -1,6 +1,6 @@
 """Files in and out: video, images, output paths."""
 
-from facemime.io.outputs import check_outputs, write_image
+from facemime.io.outputs import check_image_suffix, check_outputs, write_image
 from facemime.io.video import VideoWriter
 
-__all__ = ["VideoWriter", "check_outputs", "write_image"]
+__all__ = ["VideoWriter", "check_image_suffix", "check_outputs", "write_image"]

@@ -17,6 +17,20 @@ class OutputExistsError(FacemimeError, FileExistsError):
     """An output file exists and overwriting was not allowed."""
 
 
+class OutputFileError(FacemimeError, OSError):
+    """An output file cannot be written there."""
+
+
+#: Image file types :func:`write_image` writes.
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp")
+
+
+def check_image_suffix(path: str | Path) -> None:
+    """Refuse an image file name whose type :func:`write_image` cannot write."""
+    if Path(path).suffix.lower() not in IMAGE_SUFFIXES:
+        raise InvalidInputError(f"cannot write image {path}: its name must end in one of {', '.join(IMAGE_SUFFIXES)}")
+
+
 def check_outputs(paths: Iterable[str | Path], force: bool) -> None:
     """Refuse (with one message naming them) to overwrite existing files unless ``force``;
     check that each parent folder can be created."""
@@ -38,8 +52,11 @@ def check_outputs(paths: Iterable[str | Path], force: bool) -> None:
 def temporary_sibling(path: Path) -> Path:
     """A new, unique file name next to ``path`` with the same suffix (same filesystem, so the
     final rename is atomic)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".part{path.suffix}", dir=path.parent)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".part{path.suffix}", dir=path.parent)
+    except OSError as e:
+        raise OutputFileError(f"cannot write {path}: {e.strerror or e}") from None
     os.close(fd)
     umask = os.umask(0)
     os.umask(umask)
@@ -50,11 +67,12 @@ def temporary_sibling(path: Path) -> Path:
 def write_image(path: str | Path, image: np.ndarray) -> Path:
     """Write an RGB or gray uint8 image (PNG, JPEG, ... by suffix) atomically."""
     path = Path(path)
+    check_image_suffix(path)
     tmp = temporary_sibling(path)
     try:
         bgr = image[..., ::-1] if image.ndim == 3 else image
         if not cv2.imwrite(str(tmp), np.ascontiguousarray(bgr)):
-            raise InvalidInputError(f"cannot write image {path}: unsupported file type {path.suffix!r}")
+            raise OutputFileError(f"cannot write image {path}")
         os.replace(tmp, path)
     finally:
         tmp.unlink(missing_ok=True)

@@ -127,8 +127,12 @@ def load_head(path: str | Path) -> HeadModel:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise InputFileError(f"{path}: no such model file") from None
-    except (OSError, UnicodeDecodeError) as e:
-        raise InputFileError(f"{path}: cannot read model file ({e.__class__.__name__})") from None
+    except UnicodeDecodeError:
+        raise ModelFormatError(f"{path}: not a text file; expected a {HEAD_FORMAT} JSON model") from None
+    except IsADirectoryError:
+        raise InputFileError(f"{path}: is a folder, expected a model file") from None
+    except OSError as e:
+        raise InputFileError(f"{path}: cannot read model file ({e.strerror})") from None
     return _parse_head(text, str(path))
 
 
