@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from facemime import _core
 from facemime.errors import InvalidInputError
 
 
@@ -55,8 +56,6 @@ def image(name: str, a: object) -> np.ndarray:
 
 def image_size(name: str, size: object) -> tuple[int, int]:
     """``size`` as a (width, height) pair of positive ints within the core's limits."""
-    from facemime import _core
-
     try:
         w, h = (int(v) for v in size)  # type: ignore[union-attr]
     except (TypeError, ValueError):

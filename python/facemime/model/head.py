@@ -74,8 +74,8 @@ class HeadModel:
         True
         """
         v = self.vertices.copy()
-        for table, kind in ((self.units, "deformation unit"), (self.shape_units, "shape unit")):
-            for name, w in ((weights if table is self.units else shape) or {}).items():
+        for table, given, kind in ((self.units, weights, "deformation unit"), (self.shape_units, shape, "shape unit")):
+            for name, w in (given or {}).items():
                 if name not in table:
                     raise InvalidInputError(f"unknown {kind} {name!r}; this model has: {', '.join(table) or 'none'}")
                 v += float(w) * table[name]
