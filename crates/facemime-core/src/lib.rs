@@ -8,5 +8,6 @@
 
 pub mod error;
 pub mod raster;
+pub mod snake;
 
 pub use error::CoreError;

@@ -17,7 +17,10 @@ impl From<CoreErr> for PyErr {
     fn from(e: CoreErr) -> PyErr {
         let msg = e.0.to_string();
         Python::attach(|py| {
-            match py.import("facemime.errors").and_then(|m| m.getattr("InvalidInputError")) {
+            match py
+                .import("facemime.errors")
+                .and_then(|m| m.getattr("InvalidInputError"))
+            {
                 Ok(cls) => PyErr::from_type(cls.cast_into().expect("an exception class"), msg),
                 Err(_) => PyValueError::new_err(msg),
             }

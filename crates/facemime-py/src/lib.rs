@@ -5,10 +5,12 @@ use pyo3::prelude::*;
 
 mod error;
 mod raster;
+mod snake;
 
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     raster::register(m)?;
+    snake::register(m)?;
     Ok(())
 }

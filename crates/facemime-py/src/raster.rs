@@ -1,7 +1,9 @@
 //! Bindings of `facemime_core::raster`.
 
 use facemime_core::raster::{self, DepthMode, Filter, ImageMut, ImageRef, RenderOptions};
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyReadwriteArray3};
+use numpy::{
+    IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyReadwriteArray3,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -31,21 +33,38 @@ fn render_mesh_into(
     let filter = match filter {
         "nearest" => Filter::Nearest,
         "bilinear" => Filter::Bilinear,
-        other => return Err(PyValueError::new_err(format!("filter must be 'nearest' or 'bilinear', got {other:?}"))),
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "filter must be 'nearest' or 'bilinear', got {other:?}"
+            )))
+        }
     };
     let depth_mode = match depth_mode {
         "painter" => DepthMode::Painter,
         "zbuffer" => DepthMode::ZBuffer,
-        other => return Err(PyValueError::new_err(format!("depth must be 'painter' or 'zbuffer', got {other:?}"))),
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "depth must be 'painter' or 'zbuffer', got {other:?}"
+            )))
+        }
     };
-    let opts = RenderOptions { filter, depth: depth_mode, cull_back_faces };
+    let opts = RenderOptions {
+        filter,
+        depth: depth_mode,
+        cull_back_faces,
+    };
     let tshape = texture.as_array().shape().to_vec();
     let oshape = out.as_array().shape().to_vec();
     let tex_data = contiguous("texture", texture.as_slice().ok())?;
     let out_data = out
         .as_slice_mut()
         .map_err(|_| PyValueError::new_err("out must be a C-contiguous, writeable uint8 array"))?;
-    let (tp, p, z, t) = (tex_points.as_array(), points.as_array(), depth.as_array(), triangles.as_array());
+    let (tp, p, z, t) = (
+        tex_points.as_array(),
+        points.as_array(),
+        depth.as_array(),
+        triangles.as_array(),
+    );
     let stats = py.detach(|| -> Result<_, CoreErr> {
         let tex = ImageRef::new(tex_data, tshape[1], tshape[0], tshape[2])?;
         let mut img = ImageMut::new(out_data, oshape[1], oshape[0], oshape[2])?;
@@ -64,7 +83,9 @@ fn coverage<'py>(
     height: usize,
 ) -> PyResult<Bound<'py, PyArray2<u32>>> {
     let (p, t) = (points.as_array(), triangles.as_array());
-    let cov = py.detach(|| raster::coverage(p, t, width, height)).map_err(CoreErr)?;
+    let cov = py
+        .detach(|| raster::coverage(p, t, width, height))
+        .map_err(CoreErr)?;
     Ok(cov.into_pyarray(py))
 }
 

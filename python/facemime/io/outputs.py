@@ -64,6 +64,20 @@ def temporary_sibling(path: Path) -> Path:
     return Path(tmp)
 
 
+def write_text(path: str | Path, text: str) -> Path:
+    """Write a UTF-8 text file atomically."""
+    path = Path(path)
+    tmp = temporary_sibling(path)
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, path)
+    except OSError as e:
+        raise OutputFileError(f"cannot write {path}: {e.strerror or e}") from None
+    finally:
+        tmp.unlink(missing_ok=True)
+    return path
+
+
 def write_image(path: str | Path, image: np.ndarray) -> Path:
     """Write an RGB or gray uint8 image (PNG, JPEG, ... by suffix) atomically."""
     path = Path(path)

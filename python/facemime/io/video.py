@@ -1,4 +1,4 @@
-"""Video output that browsers play: H.264 in MP4 (``.mp4``) or VP9 in WebM (``.webm``),
+"""Video input (any FFmpeg-readable file, decoded to RGB) and video output that browsers play: H.264 in MP4 (``.mp4``) or VP9 in WebM (``.webm``),
 4:2:0 chroma, encoded by FFmpeg through PyAV. Frames are RGB uint8 (H, W, 3)."""
 
 from __future__ import annotations
@@ -6,12 +6,13 @@ from __future__ import annotations
 import os
 from fractions import Fraction
 from pathlib import Path
+from collections.abc import Iterator
 from types import TracebackType
 
 import av
 import numpy as np
 
-from facemime.errors import InvalidInputError
+from facemime.errors import InputFileError, InvalidInputError
 from facemime.io.outputs import temporary_sibling
 
 CODECS = {".mp4": ("libx264", {"crf": "20", "preset": "veryfast", "movflags": "+faststart"}),
@@ -85,3 +86,56 @@ class VideoWriter:
         finally:
             if self._tmp is not None:
                 self._tmp.unlink(missing_ok=True)
+
+
+class VideoReader:
+    """Decode a video file into RGB uint8 (H, W, 3) frames, in order.
+
+    ``width``, ``height`` (pixels), ``fps`` and ``frames`` (the container's frame count, 0 when
+    unknown) are known after opening. A missing or unreadable file, or a file with no video
+    stream, raises :class:`InputFileError` with one line naming it.
+    """
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+        if not self.path.exists():
+            raise InputFileError(f"video {self.path} does not exist")
+        if not self.path.is_file():
+            raise InputFileError(f"video {self.path} is not a file")
+        try:
+            self._container = av.open(str(self.path), "r")
+        except (av.FFmpegError, OSError, UnicodeDecodeError) as e:
+            raise InputFileError(f"cannot read video {self.path}: {_reason(e)}") from None
+        if not self._container.streams.video:
+            self._container.close()
+            raise InputFileError(f"cannot read video {self.path}: it has no video stream")
+        self._stream = self._container.streams.video[0]
+        self._stream.thread_type = "AUTO"
+        self.width, self.height = self._stream.codec_context.width, self._stream.codec_context.height
+        rate = self._stream.average_rate or self._stream.guessed_rate
+        self.fps = float(rate) if rate else 25.0
+        self.frames = int(self._stream.frames or 0)
+        if self.width <= 0 or self.height <= 0:
+            self._container.close()
+            raise InputFileError(f"cannot read video {self.path}: no frame size in its stream")
+
+    def __iter__(self) -> Iterator[np.ndarray]:
+        try:
+            for frame in self._container.decode(self._stream):
+                yield frame.to_ndarray(format="rgb24")
+        except (av.FFmpegError, OSError) as e:
+            raise InputFileError(f"cannot decode video {self.path}: {_reason(e)}") from None
+
+    def close(self) -> None:
+        self._container.close()
+
+    def __enter__(self) -> "VideoReader":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def _reason(e: BaseException) -> str:
+    text = getattr(e, "strerror", None) or str(e)
+    return text.split(":")[-1].strip() if "Errno" in text else text.strip() or type(e).__name__

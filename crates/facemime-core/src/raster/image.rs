@@ -45,7 +45,12 @@ impl<'a> ImageRef<'a> {
     /// Wraps a row-major buffer of `height * width * channels` bytes.
     pub fn new(data: &'a [u8], width: usize, height: usize, channels: usize) -> Result<Self> {
         check_dims("texture", data.len(), width, height, channels)?;
-        Ok(Self { data, width, height, channels })
+        Ok(Self {
+            data,
+            width,
+            height,
+            channels,
+        })
     }
 }
 
@@ -61,6 +66,11 @@ impl<'a> ImageMut<'a> {
     /// Wraps a row-major buffer of `height * width * channels` bytes.
     pub fn new(data: &'a mut [u8], width: usize, height: usize, channels: usize) -> Result<Self> {
         check_dims("output image", data.len(), width, height, channels)?;
-        Ok(Self { data, width, height, channels })
+        Ok(Self {
+            data,
+            width,
+            height,
+            channels,
+        })
     }
 }

@@ -71,12 +71,27 @@ impl TriangleMap {
         let inv = [[dc[1] / det, -dc[0] / det], [-db[1] / det, db[0] / det]];
         let (sb, sc) = (sub(src[1], src[0]), sub(src[2], src[0]));
         let m = [
-            [sb[0] * inv[0][0] + sc[0] * inv[1][0], sb[0] * inv[0][1] + sc[0] * inv[1][1]],
-            [sb[1] * inv[0][0] + sc[1] * inv[1][0], sb[1] * inv[0][1] + sc[1] * inv[1][1]],
+            [
+                sb[0] * inv[0][0] + sc[0] * inv[1][0],
+                sb[0] * inv[0][1] + sc[0] * inv[1][1],
+            ],
+            [
+                sb[1] * inv[0][0] + sc[1] * inv[1][0],
+                sb[1] * inv[0][1] + sc[1] * inv[1][1],
+            ],
         ];
         let (zb, zc) = (z[1] - z[0], z[2] - z[0]);
-        let depth_grad = [zb * inv[0][0] + zc * inv[1][0], zb * inv[0][1] + zc * inv[1][1]];
-        Some(Self { origin: dst[0], src: src[0], m, depth: z[0], depth_grad })
+        let depth_grad = [
+            zb * inv[0][0] + zc * inv[1][0],
+            zb * inv[0][1] + zc * inv[1][1],
+        ];
+        Some(Self {
+            origin: dst[0],
+            src: src[0],
+            m,
+            depth: z[0],
+            depth_grad,
+        })
     }
 }
 
@@ -90,7 +105,11 @@ fn signed_area2(t: &[[f64; 2]; 3]) -> f64 {
 
 fn check_points(name: &str, p: &ArrayView2<f64>, n: usize) -> Result<()> {
     if p.ncols() != 2 || p.nrows() != n {
-        return invalid!("{name} must have shape ({n}, 2), got ({}, {})", p.nrows(), p.ncols());
+        return invalid!(
+            "{name} must have shape ({n}, 2), got ({}, {})",
+            p.nrows(),
+            p.ncols()
+        );
     }
     if let Some(v) = p.iter().find(|v| !(v.is_finite() && v.abs() <= MAX_COORD)) {
         return invalid!("{name} must be finite and within ±{MAX_COORD:e} pixels, found {v}");
@@ -100,7 +119,10 @@ fn check_points(name: &str, p: &ArrayView2<f64>, n: usize) -> Result<()> {
 
 fn check_triangles(triangles: &ArrayView2<u32>, n: usize) -> Result<()> {
     if triangles.ncols() != 3 {
-        return invalid!("triangles must have shape (F, 3), got (F, {})", triangles.ncols());
+        return invalid!(
+            "triangles must have shape (F, 3), got (F, {})",
+            triangles.ncols()
+        );
     }
     if let Some(&i) = triangles.iter().find(|&&i| i as usize >= n) {
         return invalid!("triangles index vertex {i}, but there are only {n} vertices");
@@ -149,14 +171,30 @@ pub fn render_mesh_into(
         );
     }
     match (out.channels, opts.filter) {
-        (1, Filter::Nearest) => draw::<Nearest, 1>(out, texture, &tex_points, &points, &depth, &triangles, opts),
-        (2, Filter::Nearest) => draw::<Nearest, 2>(out, texture, &tex_points, &points, &depth, &triangles, opts),
-        (3, Filter::Nearest) => draw::<Nearest, 3>(out, texture, &tex_points, &points, &depth, &triangles, opts),
-        (4, Filter::Nearest) => draw::<Nearest, 4>(out, texture, &tex_points, &points, &depth, &triangles, opts),
-        (1, Filter::Bilinear) => draw::<Bilinear, 1>(out, texture, &tex_points, &points, &depth, &triangles, opts),
-        (2, Filter::Bilinear) => draw::<Bilinear, 2>(out, texture, &tex_points, &points, &depth, &triangles, opts),
-        (3, Filter::Bilinear) => draw::<Bilinear, 3>(out, texture, &tex_points, &points, &depth, &triangles, opts),
-        (4, Filter::Bilinear) => draw::<Bilinear, 4>(out, texture, &tex_points, &points, &depth, &triangles, opts),
+        (1, Filter::Nearest) => {
+            draw::<Nearest, 1>(out, texture, &tex_points, &points, &depth, &triangles, opts)
+        }
+        (2, Filter::Nearest) => {
+            draw::<Nearest, 2>(out, texture, &tex_points, &points, &depth, &triangles, opts)
+        }
+        (3, Filter::Nearest) => {
+            draw::<Nearest, 3>(out, texture, &tex_points, &points, &depth, &triangles, opts)
+        }
+        (4, Filter::Nearest) => {
+            draw::<Nearest, 4>(out, texture, &tex_points, &points, &depth, &triangles, opts)
+        }
+        (1, Filter::Bilinear) => {
+            draw::<Bilinear, 1>(out, texture, &tex_points, &points, &depth, &triangles, opts)
+        }
+        (2, Filter::Bilinear) => {
+            draw::<Bilinear, 2>(out, texture, &tex_points, &points, &depth, &triangles, opts)
+        }
+        (3, Filter::Bilinear) => {
+            draw::<Bilinear, 3>(out, texture, &tex_points, &points, &depth, &triangles, opts)
+        }
+        (4, Filter::Bilinear) => {
+            draw::<Bilinear, 4>(out, texture, &tex_points, &points, &depth, &triangles, opts)
+        }
         (c, _) => invalid!("images must have 1 to 4 channels, got {c}"),
     }
 }
@@ -178,14 +216,21 @@ fn draw<S: Sampler, const C: usize>(
     // Visible triangles with their mean depth, then far to near for the painter's order.
     let mut order: Vec<(f64, usize)> = Vec::with_capacity(triangles.nrows());
     for (f, tri) in triangles.outer_iter().enumerate() {
-        let dst = [corner(points, tri[0]), corner(points, tri[1]), corner(points, tri[2])];
+        let dst = [
+            corner(points, tri[0]),
+            corner(points, tri[1]),
+            corner(points, tri[2]),
+        ];
         let area2 = signed_area2(&dst);
         if area2 == 0.0 {
             stats.degenerate += 1;
         } else if opts.cull_back_faces && area2 > 0.0 {
             stats.culled += 1;
         } else {
-            order.push(((depth[tri[0] as usize] + depth[tri[1] as usize] + depth[tri[2] as usize]) / 3.0, f));
+            order.push((
+                (depth[tri[0] as usize] + depth[tri[1] as usize] + depth[tri[2] as usize]) / 3.0,
+                f,
+            ));
         }
     }
     if opts.depth == DepthMode::Painter {
@@ -198,9 +243,21 @@ fn draw<S: Sampler, const C: usize>(
     let width = out.width;
     for &(_, f) in &order {
         let tri = triangles.row(f);
-        let dst = [corner(points, tri[0]), corner(points, tri[1]), corner(points, tri[2])];
-        let src = [corner(tex_points, tri[0]), corner(tex_points, tri[1]), corner(tex_points, tri[2])];
-        let z = [depth[tri[0] as usize], depth[tri[1] as usize], depth[tri[2] as usize]];
+        let dst = [
+            corner(points, tri[0]),
+            corner(points, tri[1]),
+            corner(points, tri[2]),
+        ];
+        let src = [
+            corner(tex_points, tri[0]),
+            corner(tex_points, tri[1]),
+            corner(tex_points, tri[2]),
+        ];
+        let z = [
+            depth[tri[0] as usize],
+            depth[tri[1] as usize],
+            depth[tri[2] as usize],
+        ];
         let Some(map) = TriangleMap::new(dst, src, z) else {
             stats.degenerate += 1;
             continue;
@@ -221,7 +278,9 @@ fn draw<S: Sampler, const C: usize>(
             let span = &mut data[(row + x0) * C..(row + x1 + 1) * C];
             if zbuf.is_empty() {
                 let last = (x1 - x0) as i64;
-                if S::in_bounds(texture, u, v) && S::in_bounds(texture, u + du * last, v + dv * last) {
+                if S::in_bounds(texture, u, v)
+                    && S::in_bounds(texture, u + du * last, v + dv * last)
+                {
                     // The footprint is affine along the span: both ends inside means all inside.
                     // SAFETY: in_bounds holds at both ends, hence at every pixel between.
                     unsafe { S::fill_span_unchecked::<C>(texture, u, v, du, dv, span) };
@@ -267,9 +326,15 @@ pub fn coverage(
     check_size("coverage image", width, height)?;
     let mut cov = Array2::<u32>::zeros((height, width));
     for tri in triangles.outer_iter() {
-        let dst = [corner(&points, tri[0]), corner(&points, tri[1]), corner(&points, tri[2])];
+        let dst = [
+            corner(&points, tri[0]),
+            corner(&points, tri[1]),
+            corner(&points, tri[2]),
+        ];
         for_each_span(dst, width, height, &mut |y, x0, x1| {
-            cov.row_mut(y).slice_mut(ndarray::s![x0..=x1]).mapv_inplace(|c| c + 1);
+            cov.row_mut(y)
+                .slice_mut(ndarray::s![x0..=x1])
+                .mapv_inplace(|c| c + 1);
         });
     }
     Ok(cov)
@@ -281,11 +346,17 @@ mod tests {
     use ndarray::{arr1, arr2, Array3};
 
     fn opts(filter: Filter, depth: DepthMode) -> RenderOptions {
-        RenderOptions { filter, depth, cull_back_faces: true }
+        RenderOptions {
+            filter,
+            depth,
+            cull_back_faces: true,
+        }
     }
 
     fn gradient_texture(w: usize, h: usize) -> Array3<u8> {
-        Array3::from_shape_fn((h, w, 3), |(y, x, c)| ((x * 7 + y * 13 + c * 50) % 256) as u8)
+        Array3::from_shape_fn((h, w, 3), |(y, x, c)| {
+            ((x * 7 + y * 13 + c * 50) % 256) as u8
+        })
     }
 
     #[test]
@@ -298,7 +369,16 @@ mod tests {
         let mut img = ImageMut::new(&mut out, 48, 48, 3).unwrap();
         // Counter-clockwise as seen = front-facing: (2,2) -> (2,28) -> (28,2) on the image.
         let tris = arr2(&[[0u32, 2, 1]]);
-        let s = render_mesh_into(&mut img, &texr, src.view(), dst.view(), arr1(&[0.0; 3]).view(), tris.view(), opts(Filter::Nearest, DepthMode::Painter)).unwrap();
+        let s = render_mesh_into(
+            &mut img,
+            &texr,
+            src.view(),
+            dst.view(),
+            arr1(&[0.0; 3]).view(),
+            tris.view(),
+            opts(Filter::Nearest, DepthMode::Painter),
+        )
+        .unwrap();
         assert_eq!(s.drawn, 1);
         for y in 0..48 {
             for x in 0..48 {
@@ -306,7 +386,10 @@ mod tests {
                 let inside = sx > 2 && sy > 2 && sx + sy < 30;
                 if inside {
                     for c in 0..3 {
-                        assert_eq!(out[(y * 48 + x) * 3 + c], tex[[sy as usize, sx as usize, c]]);
+                        assert_eq!(
+                            out[(y * 48 + x) * 3 + c],
+                            tex[[sy as usize, sx as usize, c]]
+                        );
                     }
                 }
             }
@@ -321,7 +404,16 @@ mod tests {
         let mut out = vec![0u8; 8 * 8 * 3];
         let mut img = ImageMut::new(&mut out, 8, 8, 3).unwrap();
         // (0,0) -> (7,0) -> (0,7) runs clockwise as seen on the image: a back face.
-        let s = render_mesh_into(&mut img, &texr, p.view(), p.view(), arr1(&[0.0; 3]).view(), arr2(&[[0u32, 1, 2]]).view(), opts(Filter::Bilinear, DepthMode::Painter)).unwrap();
+        let s = render_mesh_into(
+            &mut img,
+            &texr,
+            p.view(),
+            p.view(),
+            arr1(&[0.0; 3]).view(),
+            arr2(&[[0u32, 1, 2]]).view(),
+            opts(Filter::Bilinear, DepthMode::Painter),
+        )
+        .unwrap();
         assert_eq!((s.drawn, s.culled, s.pixels), (0, 1, 0));
         assert!(out.iter().all(|&v| v == 0));
     }
@@ -331,16 +423,47 @@ mod tests {
         // Texture: left half 10, right half 200; far triangle samples the left, near the right.
         let tex = Array3::from_shape_fn((4, 4, 1), |(_, x, _)| if x < 2 { 10u8 } else { 200 });
         let texr = ImageRef::new(tex.as_slice().unwrap(), 4, 4, 1).unwrap();
-        let pts = arr2(&[[0.0, 0.0], [0.0, 19.0], [19.0, 0.0], [0.0, 0.0], [0.0, 19.0], [19.0, 0.0]]);
-        let tp = arr2(&[[0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [3.0, 0.0], [3.0, 0.0], [3.0, 0.0]]);
-        let tp = tp + arr2(&[[0.0, 0.0], [0.0, 1.0], [1.0, 0.0], [0.0, 0.0], [0.0, 1.0], [-0.01, 0.0]]) * 0.001;
+        let pts = arr2(&[
+            [0.0, 0.0],
+            [0.0, 19.0],
+            [19.0, 0.0],
+            [0.0, 0.0],
+            [0.0, 19.0],
+            [19.0, 0.0],
+        ]);
+        let tp = arr2(&[
+            [0.0, 0.0],
+            [0.0, 0.0],
+            [0.0, 0.0],
+            [3.0, 0.0],
+            [3.0, 0.0],
+            [3.0, 0.0],
+        ]);
+        let tp = tp
+            + arr2(&[
+                [0.0, 0.0],
+                [0.0, 1.0],
+                [1.0, 0.0],
+                [0.0, 0.0],
+                [0.0, 1.0],
+                [-0.01, 0.0],
+            ]) * 0.001;
         let z = arr1(&[1.0, 1.0, 1.0, 2.0, 2.0, 2.0]);
         for mode in [DepthMode::Painter, DepthMode::ZBuffer] {
             // Near triangle listed first so that draw order alone would be wrong.
             let tris = arr2(&[[3u32, 4, 5], [0, 1, 2]]);
             let mut out = vec![0u8; 20 * 20];
             let mut img = ImageMut::new(&mut out, 20, 20, 1).unwrap();
-            render_mesh_into(&mut img, &texr, tp.view(), pts.view(), z.view(), tris.view(), opts(Filter::Nearest, mode)).unwrap();
+            render_mesh_into(
+                &mut img,
+                &texr,
+                tp.view(),
+                pts.view(),
+                z.view(),
+                tris.view(),
+                opts(Filter::Nearest, mode),
+            )
+            .unwrap();
             assert_eq!(out[5 * 20 + 5], 200, "{mode:?}");
         }
     }
@@ -352,10 +475,28 @@ mod tests {
         let p = arr2(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
         let mut out = vec![0u8; 3];
         let mut img = ImageMut::new(&mut out, 1, 1, 3).unwrap();
-        let err = render_mesh_into(&mut img, &texr, p.view(), p.view(), arr1(&[0.0; 3]).view(), arr2(&[[0u32, 1, 7]]).view(), opts(Filter::Nearest, DepthMode::Painter)).unwrap_err();
+        let err = render_mesh_into(
+            &mut img,
+            &texr,
+            p.view(),
+            p.view(),
+            arr1(&[0.0; 3]).view(),
+            arr2(&[[0u32, 1, 7]]).view(),
+            opts(Filter::Nearest, DepthMode::Painter),
+        )
+        .unwrap_err();
         assert!(err.to_string().contains("vertex 7"));
         let nan = arr2(&[[f64::NAN, 0.0], [1.0, 0.0], [0.0, 1.0]]);
-        assert!(render_mesh_into(&mut img, &texr, p.view(), nan.view(), arr1(&[0.0; 3]).view(), arr2(&[[0u32, 1, 2]]).view(), opts(Filter::Nearest, DepthMode::Painter)).is_err());
+        assert!(render_mesh_into(
+            &mut img,
+            &texr,
+            p.view(),
+            nan.view(),
+            arr1(&[0.0; 3]).view(),
+            arr2(&[[0u32, 1, 2]]).view(),
+            opts(Filter::Nearest, DepthMode::Painter)
+        )
+        .is_err());
     }
 
     #[test]

@@ -27,7 +27,14 @@ pub trait Sampler {
     /// # Safety
     /// `Self::in_bounds` must hold at the first and the last pixel of the span.
     #[inline(always)]
-    unsafe fn fill_span_unchecked<const C: usize>(tex: &ImageRef, mut u: i64, mut v: i64, du: i64, dv: i64, out: &mut [u8]) {
+    unsafe fn fill_span_unchecked<const C: usize>(
+        tex: &ImageRef,
+        mut u: i64,
+        mut v: i64,
+        du: i64,
+        dv: i64,
+        out: &mut [u8],
+    ) {
         for px in out.chunks_exact_mut(C) {
             px.copy_from_slice(&Self::sample_unchecked::<C>(tex, u, v));
             u += du;
@@ -85,7 +92,12 @@ fn bilinear_weights(u: i64, v: i64) -> (i64, i64, [u32; 4]) {
     // Fraction rounded to WEIGHT_BITS; it may round up to `one`, which the weights handle.
     let fx = (((u & (ONE - 1)) + (1 << (shift - 1))) >> shift) as u32;
     let fy = (((v & (ONE - 1)) + (1 << (shift - 1))) >> shift) as u32;
-    let w = [(one - fx) * (one - fy), fx * (one - fy), (one - fx) * fy, fx * fy];
+    let w = [
+        (one - fx) * (one - fy),
+        fx * (one - fy),
+        (one - fx) * fy,
+        fx * fy,
+    ];
     (u >> FRAC_BITS, v >> FRAC_BITS, w)
 }
 
@@ -94,7 +106,10 @@ fn bilinear_weights(u: i64, v: i64) -> (i64, i64, [u32; 4]) {
 fn blend<const C: usize>(p: [&[u8]; 4], w: [u32; 4]) -> [u8; C] {
     let mut px = [0u8; C];
     for c in 0..C {
-        let s = p[0][c] as u32 * w[0] + p[1][c] as u32 * w[1] + p[2][c] as u32 * w[2] + p[3][c] as u32 * w[3];
+        let s = p[0][c] as u32 * w[0]
+            + p[1][c] as u32 * w[1]
+            + p[2][c] as u32 * w[2]
+            + p[3][c] as u32 * w[3];
         px[c] = ((s + (1 << (2 * WEIGHT_BITS - 1))) >> (2 * WEIGHT_BITS)) as u8;
     }
     px
@@ -134,7 +149,14 @@ impl Sampler for Bilinear {
     }
 
     #[inline(always)]
-    unsafe fn fill_span_unchecked<const C: usize>(tex: &ImageRef, mut u: i64, mut v: i64, du: i64, dv: i64, out: &mut [u8]) {
+    unsafe fn fill_span_unchecked<const C: usize>(
+        tex: &ImageRef,
+        mut u: i64,
+        mut v: i64,
+        du: i64,
+        dv: i64,
+        out: &mut [u8],
+    ) {
         #[cfg(target_arch = "x86_64")]
         if super::simd::bilinear_span_avx2::<C>(tex, u, v, du, dv, out) > 0 {
             return;

@@ -14,14 +14,26 @@ use super::sampler::FRAC_BITS;
 /// The bilinear footprint of the first and the last pixel of `out` must lie inside the texture
 /// (`Bilinear::in_bounds`), and `out` must hold whole pixels of C bytes.
 #[inline(always)]
-pub unsafe fn bilinear_span_avx2<const C: usize>(tex: &ImageRef, u: i64, v: i64, du: i64, dv: i64, out: &mut [u8]) -> usize {
+pub unsafe fn bilinear_span_avx2<const C: usize>(
+    tex: &ImageRef,
+    u: i64,
+    v: i64,
+    du: i64,
+    dv: i64,
+    out: &mut [u8],
+) -> usize {
     let n = out.len() / C;
     // Each 4-byte gather may read one byte past a 3-byte texel: keep the footprint off the
     // texture's last row so that byte always exists. Coordinates must fit in i32 lanes.
     let last_row = |vv: i64| (vv >> FRAC_BITS) + 2 < tex.height as i64;
     let fits = |a: i64| a.abs() < (1 << 30);
     let (u1, v1) = (u + du * (n as i64 - 1), v + dv * (n as i64 - 1));
-    if !(C == 3 || C == 4) || n == 0 || !last_row(v) || !last_row(v1) || !(fits(u) && fits(v) && fits(u1) && fits(v1)) {
+    if !(C == 3 || C == 4)
+        || n == 0
+        || !last_row(v)
+        || !last_row(v1)
+        || !(fits(u) && fits(v) && fits(u1) && fits(v1))
+    {
         return 0;
     }
     if !std::arch::is_x86_feature_detected!("avx2") {
@@ -31,7 +43,15 @@ pub unsafe fn bilinear_span_avx2<const C: usize>(tex: &ImageRef, u: i64, v: i64,
 }
 
 #[target_feature(enable = "avx2")]
-unsafe fn span_avx2<const C: usize>(tex: &ImageRef, u: i32, v: i32, du: i32, dv: i32, out: &mut [u8], n: usize) -> usize {
+unsafe fn span_avx2<const C: usize>(
+    tex: &ImageRef,
+    u: i32,
+    v: i32,
+    du: i32,
+    dv: i32,
+    out: &mut [u8],
+    n: usize,
+) -> usize {
     const WB: i32 = 12; // weight bits, as the scalar sampler
     let lanes = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     let (du_v, dv_v) = (_mm256_set1_epi32(du), _mm256_set1_epi32(dv));
@@ -40,7 +60,10 @@ unsafe fn span_avx2<const C: usize>(tex: &ImageRef, u: i32, v: i32, du: i32, dv:
     let one = _mm256_set1_epi32(1 << WB);
     let round = _mm256_set1_epi32(1 << (2 * WB - 1));
     let byte = _mm256_set1_epi32(0xFF);
-    let (cc, stride) = (_mm256_set1_epi32(C as i32), _mm256_set1_epi32((tex.width * C) as i32));
+    let (cc, stride) = (
+        _mm256_set1_epi32(C as i32),
+        _mm256_set1_epi32((tex.width * C) as i32),
+    );
     let base = tex.data.as_ptr() as *const i32;
     let mut done = 0;
     let mut buf = [0u32; 8];
@@ -48,12 +71,29 @@ unsafe fn span_avx2<const C: usize>(tex: &ImageRef, u: i32, v: i32, du: i32, dv:
         // Lanes past the span's end repeat its last pixel, so every gather stays in bounds.
         let m = (n - done).min(8);
         let k = _mm256_min_epi32(lanes, _mm256_set1_epi32(m as i32 - 1));
-        let uu = _mm256_add_epi32(_mm256_set1_epi32(u.wrapping_add((done as i32).wrapping_mul(du))), _mm256_mullo_epi32(k, du_v));
-        let vv = _mm256_add_epi32(_mm256_set1_epi32(v.wrapping_add((done as i32).wrapping_mul(dv))), _mm256_mullo_epi32(k, dv_v));
-        let fx = _mm256_srli_epi32::<{ FRAC_BITS as i32 - WB }>(_mm256_add_epi32(_mm256_and_si256(uu, frac), half));
-        let fy = _mm256_srli_epi32::<{ FRAC_BITS as i32 - WB }>(_mm256_add_epi32(_mm256_and_si256(vv, frac), half));
+        let uu = _mm256_add_epi32(
+            _mm256_set1_epi32(u.wrapping_add((done as i32).wrapping_mul(du))),
+            _mm256_mullo_epi32(k, du_v),
+        );
+        let vv = _mm256_add_epi32(
+            _mm256_set1_epi32(v.wrapping_add((done as i32).wrapping_mul(dv))),
+            _mm256_mullo_epi32(k, dv_v),
+        );
+        let fx = _mm256_srli_epi32::<{ FRAC_BITS as i32 - WB }>(_mm256_add_epi32(
+            _mm256_and_si256(uu, frac),
+            half,
+        ));
+        let fy = _mm256_srli_epi32::<{ FRAC_BITS as i32 - WB }>(_mm256_add_epi32(
+            _mm256_and_si256(vv, frac),
+            half,
+        ));
         let (gx, gy) = (_mm256_sub_epi32(one, fx), _mm256_sub_epi32(one, fy));
-        let w = [_mm256_mullo_epi32(gx, gy), _mm256_mullo_epi32(fx, gy), _mm256_mullo_epi32(gx, fy), _mm256_mullo_epi32(fx, fy)];
+        let w = [
+            _mm256_mullo_epi32(gx, gy),
+            _mm256_mullo_epi32(fx, gy),
+            _mm256_mullo_epi32(gx, fy),
+            _mm256_mullo_epi32(fx, fy),
+        ];
         let x = _mm256_srai_epi32::<{ FRAC_BITS as i32 }>(uu);
         let y = _mm256_srai_epi32::<{ FRAC_BITS as i32 }>(vv);
         let o00 = _mm256_add_epi32(_mm256_mullo_epi32(y, stride), _mm256_mullo_epi32(x, cc));
@@ -73,7 +113,10 @@ unsafe fn span_avx2<const C: usize>(tex: &ImageRef, u: i32, v: i32, du: i32, dv:
                 let ch = _mm256_and_si256(_mm256_srl_epi32(t[k], shift), byte);
                 s = _mm256_add_epi32(s, _mm256_mullo_epi32(ch, w[k]));
             }
-            px = _mm256_or_si256(px, _mm256_sll_epi32(_mm256_srli_epi32::<{ 2 * WB }>(s), shift));
+            px = _mm256_or_si256(
+                px,
+                _mm256_sll_epi32(_mm256_srli_epi32::<{ 2 * WB }>(s), shift),
+            );
         }
         _mm256_storeu_si256(buf.as_mut_ptr() as *mut __m256i, px);
         let dst = out.as_mut_ptr().add(done * C);

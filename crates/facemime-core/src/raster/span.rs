@@ -32,7 +32,11 @@ impl Edge {
         if !owns {
             c -= 1; // E > 0 strictly, as E is an integer
         }
-        Self { a: SUB * dy, b: -SUB * dx, c }
+        Self {
+            a: SUB * dy,
+            b: -SUB * dx,
+            c,
+        }
     }
 }
 
@@ -49,7 +53,13 @@ struct CeilStepper {
 impl CeilStepper {
     fn new(n: i64, d: i64, dn: i64) -> Self {
         let x = -((-n).div_euclid(d));
-        Self { x, s: d * x - n, d, dq: dn.div_euclid(d), dr: dn.rem_euclid(d) }
+        Self {
+            x,
+            s: d * x - n,
+            d,
+            dq: dn.div_euclid(d),
+            dr: dn.rem_euclid(d),
+        }
     }
 
     #[inline(always)]
@@ -158,7 +168,13 @@ fn clip_to_box(tri: &[[f64; 2]; 3], x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<[
     let mut poly: Vec<[f64; 2]> = tri.to_vec();
     // (axis, bound, keep when coordinate >= bound if true, <= if false)
     for (axis, bound, keep_ge) in [(0, x0, true), (0, x1, false), (1, y0, true), (1, y1, false)] {
-        let inside = |p: &[f64; 2]| if keep_ge { p[axis] >= bound } else { p[axis] <= bound };
+        let inside = |p: &[f64; 2]| {
+            if keep_ge {
+                p[axis] >= bound
+            } else {
+                p[axis] <= bound
+            }
+        };
         let mut out = Vec::with_capacity(poly.len() + 2);
         for i in 0..poly.len() {
             let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
@@ -210,7 +226,9 @@ mod tests {
 
     #[test]
     fn degenerate_triangle_covers_nothing() {
-        assert!(count(&[[[0.0, 0.0], [4.0, 4.0], [8.0, 8.0]]], 10, 10).iter().all(|&c| c == 0));
+        assert!(count(&[[[0.0, 0.0], [4.0, 4.0], [8.0, 8.0]]], 10, 10)
+            .iter()
+            .all(|&c| c == 0));
     }
 
     #[test]
@@ -223,7 +241,16 @@ mod tests {
     fn fan_around_shared_vertex_covers_once() {
         // Eight triangles around a vertex exactly on a pixel centre.
         let c = [5.0, 5.0];
-        let ring = [[1.0, 1.0], [5.0, 0.0], [9.0, 1.0], [10.0, 5.0], [9.0, 9.0], [5.0, 10.0], [1.0, 9.0], [0.0, 5.0]];
+        let ring = [
+            [1.0, 1.0],
+            [5.0, 0.0],
+            [9.0, 1.0],
+            [10.0, 5.0],
+            [9.0, 9.0],
+            [5.0, 10.0],
+            [1.0, 9.0],
+            [0.0, 5.0],
+        ];
         let tris: Vec<_> = (0..8).map(|i| [c, ring[i], ring[(i + 1) % 8]]).collect();
         let cov = count(&tris, 12, 12);
         assert_eq!(cov[5 * 12 + 5], 1);

@@ -1,0 +1,17 @@
+//! STB-snakes (Nesi & Magnolfi 1996, §2; method.md §1): open curves given by m+1 knots, drawn as
+//! the linear B-spline through them with n points per segment, moved frame to frame by the
+//! paper's sign-descent solver.
+//!
+//! Several curves are solved jointly: they index one shared knot array (the mouth's upper and
+//! lower curves share their corner knots), and *pairs* of knots couple curves (a minimum gap that
+//! keeps lips from collapsing, a kept gap that holds the brow's thickness).
+//!
+//! Coordinates are image pixels (x right, y down, origin at the centre of the top-left pixel).
+
+mod energy;
+mod field;
+mod solver;
+
+pub use energy::{CurveParams, Operator, PairKind, PairSpec};
+pub use field::{Field, FIELD_CHANNELS};
+pub use solver::{FrameInput, Problem, Settings, Solution};

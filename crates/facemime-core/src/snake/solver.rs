@@ -1,0 +1,460 @@
+//! The paper's sign-descent solver (eq. 17): from the starting knots, every knot coordinate c
+//! takes Q steps `c ← c − δ_q·sign(∂E/∂c)`, δ_q = δ0·σ^q, stopping early when the total energy
+//! changes by less than `tol`. No coordinate moves more than δ0/(1−σ) pixels in a frame.
+
+use super::energy::{self, CurveParams, PairSpec};
+use super::field::Field;
+use crate::error::Result;
+use crate::invalid;
+
+type P2 = [f64; 2];
+
+/// Solver settings shared by all curves of a problem.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// Points per segment n (≥ 1).
+    pub points_per_segment: usize,
+    /// First step δ0 in pixels (> 0).
+    pub delta0: f64,
+    /// Step ratio σ in (0, 1).
+    pub sigma: f64,
+    /// At most Q iterations (1..=1000).
+    pub iterations: usize,
+    /// Early stop when |ΔE| < tol between iterations (energy units, ≥ 0).
+    pub tol: f64,
+}
+
+/// Curves over one shared knot array, their couplings and the solver settings; built once,
+/// solved every frame.
+#[derive(Clone, Debug)]
+pub struct Problem {
+    curves: Vec<(Vec<usize>, CurveParams)>,
+    pairs: Vec<PairSpec>,
+    n_knots: usize,
+    settings: Settings,
+}
+
+/// One frame's input. Slices are indexed like the shared knot array.
+pub struct FrameInput<'a> {
+    /// Image field of this frame (see [`Field`]).
+    pub field: Field<'a>,
+    /// Starting knots (the previous frame's, moved by the head motion); also the Et anchor.
+    pub start: &'a [P2],
+    /// Rest knots the internal energies measure shape against (all equal: the paper's E1, E2).
+    pub rest: &'a [P2],
+    /// Unit "down" vector of the head in the image, for pair gaps and zero-length normals.
+    pub down: P2,
+    /// Target gap of each pair, pixels.
+    pub pair_targets: &'a [f64],
+    /// Image (width, height): knots are kept within [0, width−1] × [0, height−1].
+    pub bounds: [f64; 2],
+}
+
+/// The solved knots with the iterations run, the final total energy and each curve's mean H.
+#[derive(Clone, Debug)]
+pub struct Solution {
+    pub knots: Vec<P2>,
+    pub iterations: usize,
+    pub energy: f64,
+    pub response: Vec<f64>,
+}
+
+impl Problem {
+    /// Validates and builds a problem over `n_knots` shared knots.
+    pub fn new(
+        curves: Vec<(Vec<usize>, CurveParams)>,
+        pairs: Vec<PairSpec>,
+        n_knots: usize,
+        settings: Settings,
+    ) -> Result<Self> {
+        if curves.is_empty() {
+            return invalid!("a snake problem needs at least one curve");
+        }
+        for (c, (idx, p)) in curves.iter().enumerate() {
+            if idx.len() < 2 {
+                return invalid!("curve {c} must have at least 2 knots, got {}", idx.len());
+            }
+            if let Some(&bad) = idx.iter().find(|&&i| i >= n_knots) {
+                return invalid!("curve {c} knot index {bad} is out of range for {n_knots} knots");
+            }
+            let w = [p.alpha, p.beta, p.tau, p.rho, p.gamma, p.luma, p.chroma];
+            if !w.iter().all(|v| v.is_finite())
+                || [p.alpha, p.beta, p.tau, p.rho, p.gamma]
+                    .iter()
+                    .any(|&v| v < 0.0)
+            {
+                return invalid!(
+                    "curve {c} weights must be finite and alpha, beta, tau, rho, gamma >= 0"
+                );
+            }
+        }
+        for (k, q) in pairs.iter().enumerate() {
+            if q.a >= n_knots || q.b >= n_knots || q.a == q.b {
+                return invalid!(
+                    "pair {k} must join two different knots below {n_knots}, got ({}, {})",
+                    q.a,
+                    q.b
+                );
+            }
+            if !(q.weight.is_finite() && q.weight >= 0.0) {
+                return invalid!("pair {k} weight must be finite and >= 0, got {}", q.weight);
+            }
+        }
+        let s = &settings;
+        if s.points_per_segment == 0 || s.points_per_segment > 64 {
+            return invalid!(
+                "points per segment must be in 1..=64, got {}",
+                s.points_per_segment
+            );
+        }
+        if !(s.delta0.is_finite() && s.delta0 > 0.0) {
+            return invalid!(
+                "delta0 must be a positive number of pixels, got {}",
+                s.delta0
+            );
+        }
+        if !(s.sigma > 0.0 && s.sigma < 1.0) {
+            return invalid!("sigma must be in (0, 1), got {}", s.sigma);
+        }
+        if s.iterations == 0 || s.iterations > 1000 {
+            return invalid!("iterations must be in 1..=1000, got {}", s.iterations);
+        }
+        if !(s.tol.is_finite() && s.tol >= 0.0) {
+            return invalid!("tol must be finite and >= 0, got {}", s.tol);
+        }
+        Ok(Problem {
+            curves,
+            pairs,
+            n_knots,
+            settings,
+        })
+    }
+
+    pub fn n_knots(&self) -> usize {
+        self.n_knots
+    }
+
+    pub fn n_curves(&self) -> usize {
+        self.curves.len()
+    }
+
+    pub fn n_pairs(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// Runs the solver on one frame.
+    pub fn solve(&self, input: &FrameInput<'_>) -> Result<Solution> {
+        self.check(input)?;
+        let chords: Vec<f64> = self
+            .curves
+            .iter()
+            .map(|(idx, _)| chord2(idx, input.rest, input.start))
+            .collect();
+        let mut knots = input.start.to_vec();
+        let mut grad = vec![[0.0; 2]; self.n_knots];
+        let mut response = vec![0.0; self.curves.len()];
+        let [xmax, ymax] = [input.bounds[0] - 1.0, input.bounds[1] - 1.0];
+        let mut energy = self.evaluate(&knots, input, &chords, &mut grad, &mut response);
+        let s = &self.settings;
+        let mut step = s.delta0;
+        let mut iterations = 0;
+        while iterations < s.iterations {
+            for (k, g) in knots.iter_mut().zip(&grad) {
+                k[0] = (k[0] - step * sign(g[0])).clamp(0.0, xmax);
+                k[1] = (k[1] - step * sign(g[1])).clamp(0.0, ymax);
+            }
+            step *= s.sigma;
+            iterations += 1;
+            let e = self.evaluate(&knots, input, &chords, &mut grad, &mut response);
+            let change = (e - energy).abs();
+            energy = e;
+            if change < s.tol {
+                break;
+            }
+        }
+        Ok(Solution {
+            knots,
+            iterations,
+            energy,
+            response,
+        })
+    }
+
+    /// Total energy and each curve's mean H at the starting knots, without moving them.
+    pub fn evaluate_start(&self, input: &FrameInput<'_>) -> Result<(f64, Vec<f64>)> {
+        self.check(input)?;
+        let chords: Vec<f64> = self
+            .curves
+            .iter()
+            .map(|(idx, _)| chord2(idx, input.rest, input.start))
+            .collect();
+        let mut grad = vec![[0.0; 2]; self.n_knots];
+        let mut response = vec![0.0; self.curves.len()];
+        let e = self.evaluate(input.start, input, &chords, &mut grad, &mut response);
+        Ok((e, response))
+    }
+
+    /// Total energy at `knots`; writes its gradient into `grad` and each curve's mean H.
+    fn evaluate(
+        &self,
+        knots: &[P2],
+        input: &FrameInput<'_>,
+        chords: &[f64],
+        grad: &mut [P2],
+        response: &mut [f64],
+    ) -> f64 {
+        grad.iter_mut().for_each(|g| *g = [0.0; 2]);
+        let n = self.settings.points_per_segment;
+        let mut e = 0.0;
+        for (c, (idx, p)) in self.curves.iter().enumerate() {
+            e += energy::internal(idx, knots, input.rest, input.start, p, n, chords[c], grad);
+            let (ei, h) = energy::image(idx, knots, &input.field, p, n, input.down, grad);
+            e += ei;
+            response[c] = h;
+        }
+        for (q, &target) in self.pairs.iter().zip(input.pair_targets) {
+            e += energy::pair(q, target, knots, input.down, grad);
+        }
+        e
+    }
+
+    fn check(&self, input: &FrameInput<'_>) -> Result<()> {
+        let k = self.n_knots;
+        if input.start.len() != k || input.rest.len() != k {
+            return invalid!(
+                "start and rest must have {k} knots, got {} and {}",
+                input.start.len(),
+                input.rest.len()
+            );
+        }
+        if input.pair_targets.len() != self.pairs.len() {
+            return invalid!(
+                "pair targets must have {} values, got {}",
+                self.pairs.len(),
+                input.pair_targets.len()
+            );
+        }
+        let finite = |pts: &[P2]| pts.iter().all(|p| p[0].is_finite() && p[1].is_finite());
+        if !finite(input.start)
+            || !finite(input.rest)
+            || !input.pair_targets.iter().all(|t| t.is_finite())
+        {
+            return invalid!("knots, rest knots and pair targets must be finite");
+        }
+        let [dx, dy] = input.down;
+        let unit_error = ((dx * dx + dy * dy).sqrt() - 1.0).abs();
+        if unit_error.is_nan() || unit_error >= 1e-6 {
+            return invalid!("down must be a unit vector, got ({dx}, {dy})");
+        }
+        let [w, h] = input.bounds;
+        if !(w >= 1.0 && h >= 1.0 && w.is_finite() && h.is_finite()) {
+            return invalid!("image bounds must be at least 1x1, got {w}x{h}");
+        }
+        Ok(())
+    }
+}
+
+fn sign(v: f64) -> f64 {
+    if v > 0.0 {
+        1.0
+    } else if v < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
+/// Δ² of a curve: its rest chord, or its starting chord when the rest knots coincide; at least 1.
+fn chord2(idx: &[usize], rest: &[P2], start: &[P2]) -> f64 {
+    let d2 = |q: &[P2]| {
+        let (a, b) = (q[idx[0]], q[idx[idx.len() - 1]]);
+        (b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)
+    };
+    let r = d2(rest);
+    (if r > 1.0 { r } else { d2(start) }).max(1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::energy::{Operator, PairKind};
+    use super::super::field::{FIELD_CHANNELS, L, LX, LY};
+    use super::*;
+    use proptest::prelude::*;
+
+    const W: usize = 64;
+    const H: usize = 48;
+
+    /// Field of a smoothed dark horizontal band (rows ≈ y0..y0+thick) on a bright background.
+    fn band_field(y0: f64, thick: f64) -> Vec<f32> {
+        let mut d = vec![0.0f32; W * H * FIELD_CHANNELS];
+        let lum = |y: f64| {
+            let s = |t: f64| 1.0 / (1.0 + (-t / 1.2).exp());
+            200.0 - 120.0 * (s(y - y0) - s(y - y0 - thick))
+        };
+        for y in 0..H {
+            for x in 0..W {
+                let i = (y * W + x) * FIELD_CHANNELS;
+                d[i + L] = lum(y as f64) as f32;
+                d[i + LX] = 0.0;
+                d[i + LY] = ((lum(y as f64 + 0.5) - lum(y as f64 - 0.5)) as f32).clamp(-1e3, 1e3);
+            }
+        }
+        d
+    }
+
+    fn curve_params(luma: f64) -> CurveParams {
+        CurveParams {
+            alpha: 1.0,
+            beta: 1.0,
+            tau: 0.1,
+            rho: 1.0,
+            gamma: 0.0,
+            luma,
+            chroma: 0.0,
+            operator: Operator::Directional,
+        }
+    }
+
+    fn settings() -> Settings {
+        Settings {
+            points_per_segment: 3,
+            delta0: 2.0,
+            sigma: 0.75,
+            iterations: 15,
+            tol: 0.0,
+        }
+    }
+
+    fn line(y: f64, x0: f64, count: usize) -> Vec<P2> {
+        (0..count).map(|k| [x0 + 5.0 * k as f64, y]).collect()
+    }
+
+    #[test]
+    fn a_curve_moves_onto_the_edge_of_its_polarity() {
+        // Upper edge of the band at y ≈ 20: bright above, dark below, so luma weight −1.
+        let data = band_field(20.0, 8.0);
+        let field = Field::new(&data, W, H, [0.0, 0.0]).unwrap();
+        let idx: Vec<usize> = (0..8).collect();
+        let upper = Problem::new(
+            vec![(idx.clone(), curve_params(-1.0))],
+            vec![],
+            8,
+            settings(),
+        )
+        .unwrap();
+        let lower = Problem::new(vec![(idx, curve_params(1.0))], vec![], 8, settings()).unwrap();
+        let start = line(23.5, 10.0, 8);
+        let input = FrameInput {
+            field,
+            start: &start,
+            rest: &start,
+            down: [0.0, 1.0],
+            pair_targets: &[],
+            bounds: [W as f64, H as f64],
+        };
+        let up = upper.solve(&input).unwrap();
+        assert!(
+            up.knots.iter().all(|k| (k[1] - 19.5).abs() < 0.6),
+            "{:?}",
+            up.knots
+        );
+        let low = lower.solve(&input).unwrap();
+        assert!(
+            low.knots.iter().all(|k| (k[1] - 27.5).abs() < 0.6),
+            "{:?}",
+            low.knots
+        );
+        assert!(up.response[0] > 10.0);
+    }
+
+    #[test]
+    fn min_gap_keeps_two_curves_from_merging() {
+        // Both curves are drawn to the same edge; the pair keeps the lower one 4 px below.
+        let data = band_field(20.0, 8.0);
+        let field = Field::new(&data, W, H, [0.0, 0.0]).unwrap();
+        let p = curve_params(-1.0);
+        let curves = vec![((0..5).collect(), p), ((5..10).collect(), p)];
+        let pairs: Vec<PairSpec> = (0..5)
+            .map(|k| PairSpec {
+                a: k,
+                b: k + 5,
+                kind: PairKind::MinGap,
+                weight: 50.0,
+            })
+            .collect();
+        let problem = Problem::new(curves, pairs, 10, settings()).unwrap();
+        let mut start = line(19.0, 10.0, 5);
+        start.extend(line(24.0, 10.0, 5));
+        let input = FrameInput {
+            field,
+            start: &start,
+            rest: &start,
+            down: [0.0, 1.0],
+            pair_targets: &[4.0; 5],
+            bounds: [W as f64, H as f64],
+        };
+        let sol = problem.solve(&input).unwrap();
+        for k in 0..5 {
+            assert!(
+                sol.knots[k + 5][1] - sol.knots[k][1] > 3.0,
+                "{:?}",
+                sol.knots
+            );
+        }
+    }
+
+    #[test]
+    fn bad_problems_and_inputs_are_refused() {
+        let p = curve_params(1.0);
+        assert!(Problem::new(vec![(vec![0], p)], vec![], 1, settings()).is_err());
+        assert!(Problem::new(vec![(vec![0, 3], p)], vec![], 3, settings()).is_err());
+        assert!(Problem::new(
+            vec![(vec![0, 1], p)],
+            vec![],
+            2,
+            Settings {
+                sigma: 1.0,
+                ..settings()
+            }
+        )
+        .is_err());
+        let problem = Problem::new(vec![(vec![0, 1], p)], vec![], 2, settings()).unwrap();
+        let data = band_field(20.0, 8.0);
+        let field = Field::new(&data, W, H, [0.0, 0.0]).unwrap();
+        let start = [[0.0, f64::NAN], [1.0, 1.0]];
+        let input = FrameInput {
+            field,
+            start: &start,
+            rest: &start,
+            down: [0.0, 1.0],
+            pair_targets: &[],
+            bounds: [64.0, 48.0],
+        };
+        assert!(problem.solve(&input).is_err());
+    }
+
+    proptest! {
+        /// Whatever the image, no coordinate moves more than δ0/(1−σ) in a frame and no knot
+        /// leaves the image.
+        #[test]
+        fn moves_are_bounded_and_knots_stay_in_the_image(
+            seed in proptest::collection::vec(-50.0f32..50.0, W * H * FIELD_CHANNELS / 64),
+            x0 in -10.0f64..70.0, y0 in -10.0f64..60.0,
+            delta0 in 0.1f64..6.0, sigma in 0.05f64..0.95, iterations in 1usize..40,
+        ) {
+            let data: Vec<f32> = (0..W * H * FIELD_CHANNELS).map(|i| seed[i % seed.len()] * ((i % 7) as f32 - 3.0)).collect();
+            let field = Field::new(&data, W, H, [3.0, -2.0]).unwrap();
+            let s = Settings { points_per_segment: 3, delta0, sigma, iterations, tol: 0.0 };
+            let p = curve_params(1.0);
+            let problem = Problem::new(vec![((0..6).collect(), p)], vec![], 6, s).unwrap();
+            let start: Vec<P2> = (0..6).map(|k| [(x0 + 4.0 * k as f64).clamp(0.0, 63.0), y0.clamp(0.0, 47.0)]).collect();
+            let input = FrameInput { field, start: &start, rest: &start, down: [0.0, 1.0], pair_targets: &[], bounds: [W as f64, H as f64] };
+            let sol = problem.solve(&input).unwrap();
+            let bound = delta0 / (1.0 - sigma) + 1e-9;
+            for (k, s0) in sol.knots.iter().zip(&start) {
+                prop_assert!((k[0] - s0[0]).abs() <= bound && (k[1] - s0[1]).abs() <= bound);
+                prop_assert!(k[0] >= 0.0 && k[0] <= 63.0 && k[1] >= 0.0 && k[1] <= 47.0);
+            }
+        }
+    }
+}

@@ -1,0 +1,258 @@
+//! Bindings of `facemime_core::snake`: a `SnakeSolver` built once per tracker, solved per frame.
+
+use facemime_core::snake::{
+    CurveParams, Field, FrameInput, Operator, PairKind, PairSpec, Problem, Settings,
+};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use crate::error::CoreErr;
+
+fn err(msg: String) -> PyErr {
+    PyValueError::new_err(msg)
+}
+
+fn points(name: &str, a: &PyReadonlyArray2<f64>) -> PyResult<Vec<[f64; 2]>> {
+    let v = a.as_array();
+    if v.shape()[1] != 2 {
+        return Err(err(format!(
+            "{name} must have shape (K, 2), got {:?}",
+            v.shape()
+        )));
+    }
+    Ok(v.rows().into_iter().map(|r| [r[0], r[1]]).collect())
+}
+
+/// Curves over one shared knot array solved jointly by sign descent. See
+/// `facemime.track.snake` for the documented API; arrays follow its conventions.
+#[pyclass(module = "facemime._core", frozen)]
+pub struct SnakeSolver {
+    problem: Problem,
+}
+
+#[pymethods]
+impl SnakeSolver {
+    /// curve_knots: concatenated knot indices of all curves; curve_lengths: knots per curve;
+    /// curve_params: (C, 8) alpha, beta, tau, rho, gamma, luma, chroma, operator (0 directional,
+    /// 1 magnitude); pairs: (P, 2) knot indices (a, b); pair_params: (P, 2) kind (0 min gap,
+    /// 1 keep), weight.
+    #[new]
+    #[pyo3(signature = (curve_knots, curve_lengths, curve_params, pairs, pair_params, points_per_segment, delta0, sigma, iterations, tol))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        curve_knots: PyReadonlyArray1<u32>,
+        curve_lengths: PyReadonlyArray1<u32>,
+        curve_params: PyReadonlyArray2<f64>,
+        pairs: PyReadonlyArray2<u32>,
+        pair_params: PyReadonlyArray2<f64>,
+        points_per_segment: usize,
+        delta0: f64,
+        sigma: f64,
+        iterations: usize,
+        tol: f64,
+    ) -> PyResult<Self> {
+        let (ck, cl, cp) = (
+            curve_knots.as_array(),
+            curve_lengths.as_array(),
+            curve_params.as_array(),
+        );
+        if cp.shape() != [cl.len(), 8] {
+            return Err(err(format!(
+                "curve_params must have shape ({}, 8), got {:?}",
+                cl.len(),
+                cp.shape()
+            )));
+        }
+        if cl.iter().map(|&l| l as usize).sum::<usize>() != ck.len() {
+            return Err(err(
+                "curve_lengths must sum to the length of curve_knots".into()
+            ));
+        }
+        let n_knots = ck.iter().map(|&i| i as usize + 1).max().unwrap_or(0);
+        let mut curves = Vec::with_capacity(cl.len());
+        let mut at = 0;
+        for (c, &len) in cl.iter().enumerate() {
+            let idx: Vec<usize> = ck
+                .slice(ndarray::s![at..at + len as usize])
+                .iter()
+                .map(|&i| i as usize)
+                .collect();
+            at += len as usize;
+            let r = cp.row(c);
+            let operator = match r[7] {
+                0.0 => Operator::Directional,
+                1.0 => Operator::Magnitude,
+                v => return Err(err(format!("curve {c} operator must be 0 or 1, got {v}"))),
+            };
+            let p = CurveParams {
+                alpha: r[0],
+                beta: r[1],
+                tau: r[2],
+                rho: r[3],
+                gamma: r[4],
+                luma: r[5],
+                chroma: r[6],
+                operator,
+            };
+            curves.push((idx, p));
+        }
+        let (pr, pp) = (pairs.as_array(), pair_params.as_array());
+        if pr.ncols() != 2 || pp.shape() != [pr.nrows(), 2] {
+            return Err(err(format!(
+                "pairs must be (P, 2) and pair_params (P, 2), got {:?} and {:?}",
+                pr.shape(),
+                pp.shape()
+            )));
+        }
+        let mut specs = Vec::with_capacity(pr.nrows());
+        for k in 0..pr.nrows() {
+            let kind = match pp[[k, 0]] {
+                0.0 => PairKind::MinGap,
+                1.0 => PairKind::Keep,
+                v => return Err(err(format!("pair {k} kind must be 0 or 1, got {v}"))),
+            };
+            specs.push(PairSpec {
+                a: pr[[k, 0]] as usize,
+                b: pr[[k, 1]] as usize,
+                kind,
+                weight: pp[[k, 1]],
+            });
+        }
+        let settings = Settings {
+            points_per_segment,
+            delta0,
+            sigma,
+            iterations,
+            tol,
+        };
+        Ok(SnakeSolver {
+            problem: Problem::new(curves, specs, n_knots, settings).map_err(CoreErr)?,
+        })
+    }
+
+    /// Number of knots in the shared knot array.
+    #[getter]
+    fn n_knots(&self) -> usize {
+        self.problem.n_knots()
+    }
+
+    /// Solves one frame; returns (knots (K, 2), iterations, energy, response (C,)).
+    #[pyo3(signature = (field, origin, bounds, start, rest, down, pair_targets))]
+    #[allow(clippy::too_many_arguments, clippy::type_complexity)]
+    fn solve<'py>(
+        &self,
+        py: Python<'py>,
+        field: PyReadonlyArray3<f32>,
+        origin: (f64, f64),
+        bounds: (f64, f64),
+        start: PyReadonlyArray2<f64>,
+        rest: PyReadonlyArray2<f64>,
+        down: (f64, f64),
+        pair_targets: PyReadonlyArray1<f64>,
+    ) -> PyResult<(
+        Bound<'py, PyArray2<f64>>,
+        usize,
+        f64,
+        Bound<'py, PyArray1<f64>>,
+    )> {
+        let frame = FrameArgs::new(&field, origin, bounds, &start, &rest, down, &pair_targets)?;
+        let sol = py.detach(|| frame.run(|input| self.problem.solve(input)))?;
+        let flat: Vec<f64> = sol.knots.iter().flatten().copied().collect();
+        let knots = ndarray::Array2::from_shape_vec((sol.knots.len(), 2), flat).expect("K x 2");
+        Ok((
+            knots.into_pyarray(py),
+            sol.iterations,
+            sol.energy,
+            sol.response.into_pyarray(py),
+        ))
+    }
+
+    /// Energy and each curve's mean H at `start`, without moving; returns (energy, response (C,)).
+    #[pyo3(signature = (field, origin, bounds, start, rest, down, pair_targets))]
+    #[allow(clippy::too_many_arguments)]
+    fn evaluate<'py>(
+        &self,
+        py: Python<'py>,
+        field: PyReadonlyArray3<f32>,
+        origin: (f64, f64),
+        bounds: (f64, f64),
+        start: PyReadonlyArray2<f64>,
+        rest: PyReadonlyArray2<f64>,
+        down: (f64, f64),
+        pair_targets: PyReadonlyArray1<f64>,
+    ) -> PyResult<(f64, Bound<'py, PyArray1<f64>>)> {
+        let frame = FrameArgs::new(&field, origin, bounds, &start, &rest, down, &pair_targets)?;
+        let (e, response) = py.detach(|| frame.run(|input| self.problem.evaluate_start(input)))?;
+        Ok((e, response.into_pyarray(py)))
+    }
+}
+
+/// One frame's arguments converted from numpy, ready to build a `FrameInput`.
+struct FrameArgs<'a> {
+    data: &'a [f32],
+    shape: Vec<usize>,
+    origin: [f64; 2],
+    bounds: [f64; 2],
+    start: Vec<[f64; 2]>,
+    rest: Vec<[f64; 2]>,
+    down: [f64; 2],
+    targets: Vec<f64>,
+}
+
+impl<'a> FrameArgs<'a> {
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        field: &'a PyReadonlyArray3<'_, f32>,
+        origin: (f64, f64),
+        bounds: (f64, f64),
+        start: &PyReadonlyArray2<f64>,
+        rest: &PyReadonlyArray2<f64>,
+        down: (f64, f64),
+        pair_targets: &PyReadonlyArray1<f64>,
+    ) -> PyResult<Self> {
+        let shape = field.as_array().shape().to_vec();
+        if shape[2] != facemime_core::snake::FIELD_CHANNELS {
+            return Err(err(format!(
+                "field must have shape (H, W, {}), got {shape:?}",
+                facemime_core::snake::FIELD_CHANNELS
+            )));
+        }
+        Ok(FrameArgs {
+            data: field
+                .as_slice()
+                .map_err(|_| err("field must be a C-contiguous float32 array".into()))?,
+            shape,
+            origin: [origin.0, origin.1],
+            bounds: [bounds.0, bounds.1],
+            start: points("start", start)?,
+            rest: points("rest", rest)?,
+            down: [down.0, down.1],
+            targets: pair_targets.as_array().to_vec(),
+        })
+    }
+
+    fn run<T>(
+        &self,
+        f: impl FnOnce(&FrameInput<'_>) -> facemime_core::error::Result<T>,
+    ) -> Result<T, CoreErr> {
+        let field = Field::new(self.data, self.shape[1], self.shape[0], self.origin)?;
+        let input = FrameInput {
+            field,
+            start: &self.start,
+            rest: &self.rest,
+            down: self.down,
+            pair_targets: &self.targets,
+            bounds: self.bounds,
+        };
+        Ok(f(&input)?)
+    }
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<SnakeSolver>()?;
+    m.add("FIELD_CHANNELS", facemime_core::snake::FIELD_CHANNELS)?;
+    Ok(())
+}

@@ -1,0 +1,134 @@
+"""The project's contour interchange files (see the shared data README):
+
+- ``facemime.init/1``: the eight contours of one frame that start a tracker;
+- ``facemime.track/1``: every frame's contours written by a tracker.
+
+Points are (x, y) pixels, origin at the centre of the top-left pixel, y down. ``facemime``
+extends ``facemime.track/1`` compatibly with per-frame ``confidence`` (feature -> 0..1) and
+``lost`` (features whose contours collapsed and were re-initialised in that frame).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from facemime.errors import FacemimeError, InputFileError
+from facemime.io.outputs import write_text
+from facemime.track.contours import CONTOUR_NAMES
+
+INIT_FORMAT = "facemime.init/1"
+TRACK_FORMAT = "facemime.track/1"
+
+Contours = dict[str, np.ndarray]
+
+
+class ContourFileError(FacemimeError, ValueError):
+    """An init or track JSON file is malformed."""
+
+
+def _load_json(path: str | Path, what: str) -> Any:
+    p = Path(path)
+    if not p.is_file():
+        raise InputFileError(f"{what} file {p} does not exist" if not p.exists() else f"{what} file {p} is not a file")
+    try:
+        return json.loads(p.read_text(encoding="utf-8"))
+    except UnicodeDecodeError:
+        raise ContourFileError(f"{p} is not a JSON text file") from None
+    except json.JSONDecodeError as e:
+        raise ContourFileError(f"{p} is not valid JSON: {e.msg} at line {e.lineno} column {e.colno}") from None
+
+
+def _contours(doc: Mapping[str, Any], where: str, size: tuple[int, int] | None, require_all: bool) -> Contours:
+    raw = doc.get("contours")
+    if not isinstance(raw, dict):
+        raise ContourFileError(f"{where}: 'contours' must be an object of named point lists")
+    missing = [n for n in CONTOUR_NAMES if n not in raw]
+    if require_all and missing:
+        raise ContourFileError(f"{where}: missing contour {', '.join(missing)}")
+    out: Contours = {}
+    for name, pts in raw.items():
+        try:
+            arr = np.asarray(pts, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ContourFileError(f"{where}: contour {name} must be a list of [x, y] numbers") from None
+        if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 2:
+            raise ContourFileError(f"{where}: contour {name} must have at least 2 [x, y] points, got shape {arr.shape}")
+        if not np.isfinite(arr).all():
+            raise ContourFileError(f"{where}: contour {name} has a non-finite coordinate")
+        if size is not None:
+            w, h = size
+            outside = (arr[:, 0] < -0.5) | (arr[:, 0] > w - 0.5) | (arr[:, 1] < -0.5) | (arr[:, 1] > h - 0.5)
+            if outside.any():
+                x, y = arr[np.argmax(outside)]
+                raise ContourFileError(f"{where}: contour {name} point ({x:g}, {y:g}) is outside the {w}x{h} image")
+        out[name] = arr
+    return out
+
+
+def read_init(path: str | Path, size: tuple[int, int] | None = None) -> tuple[int, Contours]:
+    """Read a ``facemime.init/1`` file; returns (frame index, contours). With ``size``
+    (width, height) every point must lie inside the image."""
+    doc = _load_json(path, "init")
+    where = str(path)
+    if not isinstance(doc, dict) or doc.get("format") != INIT_FORMAT:
+        found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
+        raise ContourFileError(f"{where}: expected format {INIT_FORMAT!r}, found {found!r}")
+    frame = doc.get("frame", 0)
+    if not isinstance(frame, int) or isinstance(frame, bool) or frame < 0:
+        raise ContourFileError(f"{where}: 'frame' must be a non-negative integer, got {frame!r}")
+    return frame, _contours(doc, where, size, require_all=True)
+
+
+def init_document(frame: int, contours: Mapping[str, np.ndarray]) -> dict[str, Any]:
+    """A ``facemime.init/1`` document."""
+    return {"format": INIT_FORMAT, "frame": int(frame),
+            "contours": {n: np.round(np.asarray(contours[n], float), 3).tolist() for n in CONTOUR_NAMES}}
+
+
+def track_document(video: Mapping[str, Any], frames: Sequence[Mapping[str, Any]],
+                   timing: Mapping[str, float] | None = None) -> dict[str, Any]:
+    """A ``facemime.track/1`` document. ``frames``: dicts with ``index``, ``contours`` (name ->
+    (N, 2) array) and optionally ``confidence`` (feature -> float) and ``lost`` (list of features)."""
+    out_frames = []
+    for f in frames:
+        entry: dict[str, Any] = {"index": int(f["index"]),
+                                 "contours": {n: np.round(np.asarray(c, float), 3).tolist() for n, c in f["contours"].items()}}
+        if "confidence" in f:
+            entry["confidence"] = {k: round(float(v), 4) for k, v in f["confidence"].items()}
+        if "lost" in f:
+            entry["lost"] = list(f["lost"])
+        out_frames.append(entry)
+    doc: dict[str, Any] = {"format": TRACK_FORMAT,
+                           "video": {k: video[k] for k in ("width", "height", "fps", "frames")},
+                           "frames": out_frames}
+    if timing is not None:
+        doc["timing"] = dict(timing)
+    return doc
+
+
+def write_json(path: str | Path, doc: Mapping[str, Any]) -> Path:
+    """Write a JSON document atomically (compact, one frame per line for track files)."""
+    return write_text(path, json.dumps(doc, separators=(",", ":")) + "\n")
+
+
+def read_track(path: str | Path) -> tuple[dict[str, Any], dict[int, Contours]]:
+    """Read a ``facemime.track/1`` file; returns (video info, frame index -> contours)."""
+    doc = _load_json(path, "track")
+    where = str(path)
+    if not isinstance(doc, dict) or doc.get("format") != TRACK_FORMAT:
+        found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
+        raise ContourFileError(f"{where}: expected format {TRACK_FORMAT!r}, found {found!r}")
+    frames = doc.get("frames")
+    if not isinstance(frames, list):
+        raise ContourFileError(f"{where}: 'frames' must be a list")
+    out: dict[int, Contours] = {}
+    for k, f in enumerate(frames):
+        if not isinstance(f, dict) or not isinstance(f.get("index"), int):
+            raise ContourFileError(f"{where}: frame entry {k} must be an object with an integer 'index'")
+        out[f["index"]] = _contours(f, f"{where} frame {f['index']}", None, require_all=False)
+    return doc.get("video", {}), out

@@ -1,0 +1,88 @@
+"""The contour error metric of the project (NME, as the shared data's README defines it).
+
+For one curve: resample prediction P and reference R at 100 points equally spaced in arc length,
+take the mean distance of each sample set to the other polyline, average the two directions and
+divide by the inter-ocular distance (IOD, pixels). Missing or non-finite curves score +inf.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+SAMPLES = 100
+#: NME above which a frame counts as a failure.
+FAILURE_NME = 0.10
+
+
+def resample(curve: np.ndarray, n: int = SAMPLES) -> np.ndarray:
+    """``n`` points equally spaced in arc length along a polyline, both ends included.
+
+    >>> resample(np.array([[0.0, 0.0], [4.0, 0.0]]), 5)[:, 0].tolist()
+    [0.0, 1.0, 2.0, 3.0, 4.0]
+    """
+    seg = np.linalg.norm(np.diff(curve, axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(seg)])
+    t = np.linspace(0.0, s[-1], n)
+    return np.stack([np.interp(t, s, curve[:, 0]), np.interp(t, s, curve[:, 1])], axis=1)
+
+
+def _distance_to_polyline(points: np.ndarray, line: np.ndarray) -> np.ndarray:
+    """Distance (pixels) from each of ``points`` (N, 2) to the nearest point of polyline ``line``."""
+    a, b = line[:-1], line[1:]
+    ab = b - a
+    denom = np.maximum((ab * ab).sum(axis=1), 1e-12)
+    t = np.clip(((points[:, None, :] - a[None]) * ab[None]).sum(axis=2) / denom, 0.0, 1.0)
+    nearest = a[None] + t[..., None] * ab[None]
+    return np.linalg.norm(points[:, None, :] - nearest, axis=2).min(axis=1)
+
+
+def curve_error(pred: object, ref: np.ndarray) -> float:
+    """Symmetric mean curve distance in pixels; +inf when ``pred`` is missing or malformed."""
+    if pred is None:
+        return float("inf")
+    p = np.asarray(pred, dtype=np.float64)
+    if p.ndim != 2 or p.shape[0] < 2 or p.shape[1] != 2 or not np.isfinite(p).all():
+        return float("inf")
+    r = np.asarray(ref, dtype=np.float64)
+    d_pr = _distance_to_polyline(resample(p), r).mean()
+    d_rp = _distance_to_polyline(resample(r), p).mean()
+    return float((d_pr + d_rp) / 2.0)
+
+
+def group_nme(pred: Mapping[str, object] | None, ref: Mapping[str, np.ndarray], names: Sequence[str], iod: float) -> float:
+    """Mean NME of the curves ``names`` of one frame (+inf if any is missing)."""
+    pred = pred or {}
+    return float(np.mean([curve_error(pred.get(n), ref[n]) for n in names])) / iod
+
+
+def summarize(per_frame: np.ndarray) -> dict[str, float]:
+    """mean, median, p90, failure rate and drift of one video's per-frame NMEs (frame order,
+    +inf for failures to produce a curve)."""
+    v = np.asarray(per_frame, dtype=np.float64)
+    finite = v[np.isfinite(v)]
+    third = len(v) // 3
+    first, last = v[:third], v[len(v) - third:]
+    mean_f = lambda x: float(np.mean(x[np.isfinite(x)])) if np.isfinite(x).any() else float("nan")  # noqa: E731
+    return {
+        "mean": float(finite.mean()) if finite.size else float("nan"),
+        "median": float(np.quantile(v, 0.5, method="inverted_cdf")) if v.size else float("nan"),
+        "p90": float(np.quantile(v, 0.9, method="inverted_cdf")) if v.size else float("nan"),
+        "failure_rate": float(np.mean(~(v <= FAILURE_NME))) if v.size else float("nan"),
+        "drift": mean_f(last) - mean_f(first) if third else float("nan"),
+    }
+
+
+def pooled_summary(per_video: Sequence[np.ndarray]) -> dict[str, float]:
+    """Summary over several videos, each weighing the same: mean, failure rate and drift are
+    means of the per-video values; median and p90 are weighted percentiles of all frames."""
+    summaries = [summarize(v) for v in per_video if len(v)]
+    out = {k: float(np.nanmean([s[k] for s in summaries])) for k in ("mean", "failure_rate", "drift")}
+    values = np.concatenate([np.asarray(v, np.float64) for v in per_video if len(v)])
+    weights = np.concatenate([np.full(len(v), 1.0 / len(v)) for v in per_video if len(v)])
+    order = np.argsort(values)
+    cum = np.cumsum(weights[order]) / weights.sum()
+    for key, q in (("median", 0.5), ("p90", 0.9)):
+        out[key] = float(values[order][np.searchsorted(cum, q)])
+    return out

@@ -1,0 +1,9 @@
+"""Tracking mouth and eyebrow contours through a video with STB-snakes (method.md §1).
+
+The public entry point is :class:`facemime.track.Tracker`, fed one frame at a time.
+"""
+
+from facemime.track.contours import CONTOUR_NAMES, FEATURES
+from facemime.track.tracker import FrameResult, Tracker, TrackerParams
+
+__all__ = ["CONTOUR_NAMES", "FEATURES", "FrameResult", "Tracker", "TrackerParams"]

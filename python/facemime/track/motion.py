@@ -1,0 +1,175 @@
+"""Head-motion compensation: the similarity transform (rotation, uniform scale, translation) of
+the face between consecutive frames, from pyramidal Lucas-Kanade optical flow of textured points
+in the rigid parts of the face (nose bridge and nose, forehead), forward-backward checked and
+fitted with RANSAC. Mouth and brows ride on this motion before the snakes refine them, so the
+snake search range δ0/(1−σ) can stay small (method.md §4).
+
+Transforms are 2×3 float64 matrices mapping (x, y) pixels of one frame to another.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import cv2
+import numpy as np
+
+#: Rigid zones in face coordinates (s, t): a point is ``c + s·W·u + t·D·v`` where ``c`` is the
+#: centre of the brows, ``v`` (length ``D``) runs from it to the centre of the mouth, ``u`` is
+#: ``v`` turned to image-right and ``W`` is the outer width of the brows.
+ZONES = (
+    ((-0.2, 0.2), (0.2, 0.72)),  # nose bridge, nose, nostrils
+    ((-0.45, 0.45), (-1.0, -0.4)),  # forehead above raised brows (hair, glasses)
+)
+WINDOW = (21, 21)
+LEVELS = 5
+FB_LIMIT = 1.0  # px: forward-backward error above this rejects a point
+MIN_POINTS = 6
+
+
+def face_frame(contours: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """(centre of the brows, u, v, W) of a set of contours; see :data:`ZONES`."""
+    brows = np.concatenate([contours[n] for n in contours if n.startswith("brow")])
+    mouth = np.concatenate([contours[n] for n in contours if n.startswith("mouth_outer")])
+    c = brows.mean(axis=0)
+    v = mouth.mean(axis=0) - c
+    u = np.array([v[1], -v[0]]) / max(np.linalg.norm(v), 1e-9)
+    width = float(np.linalg.norm(contours["brow_left_upper"][-1] - contours["brow_right_upper"][0]))
+    return c, u, v, width
+
+
+def zone_polygons(contours: Mapping[str, np.ndarray]) -> list[np.ndarray]:
+    """The rigid zones as (4, 2) pixel polygons."""
+    c, u, v, width = face_frame(contours)
+    polys = []
+    for (s0, s1), (t0, t1) in ZONES:
+        corners = [(s0, t0), (s1, t0), (s1, t1), (s0, t1)]
+        polys.append(np.array([c + s * width * u + t * v for s, t in corners]))
+    return polys
+
+
+def compose(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The 2×3 transform ``a ∘ b`` (apply ``b`` first)."""
+    return (np.vstack([a, [0, 0, 1]]) @ np.vstack([b, [0, 0, 1]]))[:2]
+
+
+def apply(m: np.ndarray, pts: np.ndarray) -> np.ndarray:
+    """Apply a 2×3 transform to (N, 2) points."""
+    return pts @ m[:, :2].T + m[:, 2]
+
+
+IDENTITY = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+
+
+class HeadMotion:
+    """Follows the head from frame to frame. Feed gray (H, W) uint8 frames to :meth:`update`
+    with the contours tracked in the previous frame: they place the rigid zones, so the points
+    stay on the face even when the accumulated motion drifts.
+
+    ``total`` is the accumulated transform from the first frame to the current one.
+    """
+
+    def __init__(self, gray: np.ndarray, contours: Mapping[str, np.ndarray], max_points: int = 60):
+        self._min_distance = max(3.0, face_frame(contours)[3] / 30.0)
+        self._max_points = max_points
+        self.total = IDENTITY.copy()
+        self._prev = gray
+        self._zones = zone_polygons(contours)
+        self._points = self._detect(gray)
+        self._wanted = max(MIN_POINTS, len(self._points) // 2)
+
+    def _detect(self, gray: np.ndarray) -> np.ndarray:
+        mask = np.zeros(gray.shape, np.uint8)
+        for poly in self._zones:
+            cv2.fillConvexPoly(mask, np.round(poly).astype(np.int32), 255)
+        pts = cv2.goodFeaturesToTrack(gray, self._max_points, 0.01, self._min_distance, mask=mask, blockSize=5)
+        return np.zeros((0, 2), np.float32) if pts is None else pts.reshape(-1, 2).astype(np.float32)
+
+    def _inside(self, pts: np.ndarray) -> np.ndarray:
+        inside = np.zeros(len(pts), bool)
+        for poly in self._zones:
+            c = poly.astype(np.float32).reshape(-1, 1, 2)
+            inside |= np.array([cv2.pointPolygonTest(c, (float(x), float(y)), False) >= 0 for x, y in pts], bool)
+        return inside
+
+    def _crop_box(self, shape: tuple[int, ...], extra: np.ndarray) -> tuple[int, int, int, int]:
+        pts = np.concatenate(self._zones + [self._points.astype(float), extra.astype(float)])
+        pad = 2 ** LEVELS * WINDOW[0] // 2 + 8
+        x0, y0 = np.floor(pts.min(axis=0)).astype(int) - pad
+        x1, y1 = np.ceil(pts.max(axis=0)).astype(int) + pad
+        return max(x0, 0), max(y0, 0), min(x1, shape[1]), min(y1, shape[0])
+
+    def _coarse_shift(self, gray: np.ndarray) -> tuple[np.ndarray, bool]:
+        """Fallback for motion too fast or blurred for the flow: the translation that best
+        matches the previous frame's face zones (normalised cross-correlation at 1/4 scale,
+        searched up to half the zone size away)."""
+        pts = np.concatenate(self._zones)
+        x0, y0 = np.maximum(np.floor(pts.min(axis=0)).astype(int), 0)
+        x1, y1 = np.minimum(np.ceil(pts.max(axis=0)).astype(int), [gray.shape[1], gray.shape[0]])
+        if x1 - x0 < 16 or y1 - y0 < 16:
+            return IDENTITY.copy(), False
+        rx, ry = (x1 - x0) // 2, (y1 - y0) // 2
+        sx0, sy0 = max(x0 - rx, 0), max(y0 - ry, 0)
+        sx1, sy1 = min(x1 + rx, gray.shape[1]), min(y1 + ry, gray.shape[0])
+        small = lambda img: cv2.resize(img, None, fx=0.25, fy=0.25, interpolation=cv2.INTER_AREA)  # noqa: E731
+        templ, search = small(self._prev[y0:y1, x0:x1]), small(gray[sy0:sy1, sx0:sx1])
+        if templ.shape[0] > search.shape[0] or templ.shape[1] > search.shape[1] or templ.std() < 1.0:
+            return IDENTITY.copy(), False
+        scores = cv2.matchTemplate(search, templ, cv2.TM_CCOEFF_NORMED)
+        _, best, _, (bx, by) = cv2.minMaxLoc(scores)
+        if best < 0.5:
+            return IDENTITY.copy(), False
+        shift = np.array([sx0 + 4.0 * bx - x0, sy0 + 4.0 * by - y0])
+        step = IDENTITY.copy()
+        step[:, 2] = shift
+        self._points = np.zeros((0, 2), np.float32)
+        return step, True
+
+    def update(self, gray: np.ndarray, contours: Mapping[str, np.ndarray],
+               extra: np.ndarray | None = None) -> tuple[np.ndarray, bool, np.ndarray | None]:
+        """Motion from the previous frame to ``gray``.
+
+        ``contours``: the previous frame's tracked contours (they place the rigid zones).
+        ``extra``: optional (N, 2) points of the previous frame to follow by the same flow.
+        Returns (step, measured, moved): the 2×3 similarity (identity when too few points agreed
+        and the coarse fallback failed), whether it was measured, and the extra points' new
+        positions (NaN where the flow failed its forward-backward check).
+        """
+        self._zones = zone_polygons(contours)
+        step, ok = IDENTITY.copy(), False
+        n_extra = 0 if extra is None else len(extra)
+        moved = None if extra is None else np.full((n_extra, 2), np.nan)
+        if len(self._points) >= MIN_POINTS:
+            extra_pts = np.zeros((0, 2), np.float32) if extra is None else np.asarray(extra, np.float32)
+            x0, y0, x1, y1 = self._crop_box(gray.shape, extra_pts)
+            off = np.array([x0, y0], np.float32)
+            a, b = self._prev[y0:y1, x0:x1], gray[y0:y1, x0:x1]
+            p0 = (np.concatenate([self._points, extra_pts]) - off).reshape(-1, 1, 2)
+            crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 20, 0.03)
+            p1, st1, _ = cv2.calcOpticalFlowPyrLK(a, b, p0, None, winSize=WINDOW, maxLevel=LEVELS, criteria=crit)
+            pb, st2, _ = cv2.calcOpticalFlowPyrLK(b, a, p1, None, winSize=WINDOW, maxLevel=LEVELS, criteria=crit)
+            good = (st1.ravel() == 1) & (st2.ravel() == 1) & (np.linalg.norm((pb - p0).reshape(-1, 2), axis=1) < FB_LIMIT)
+            p0, p1 = p0.reshape(-1, 2), p1.reshape(-1, 2)
+            n = len(self._points)
+            if moved is not None:
+                moved[good[n:]] = p1[n:][good[n:]] + off
+            good = good[:n]
+            src, dst = p0[:n][good], p1[:n][good]
+            if len(src) >= MIN_POINTS:
+                m, inliers = cv2.estimateAffinePartial2D(src, dst, method=cv2.RANSAC, ransacReprojThreshold=1.0)
+                if m is not None and inliers is not None and inliers.sum() >= MIN_POINTS:
+                    keep = inliers.ravel() == 1
+                    # back to full-frame coordinates: x' = R(x - off) + t + off
+                    m[:, 2] += off - m[:, :2] @ off
+                    step, ok = m, True
+                    self._points = dst[keep] + off
+        if not ok:
+            step, ok = self._coarse_shift(gray)
+        self.total = compose(step, self.total)
+        self._zones = [apply(step, z) for z in self._zones]
+        if len(self._points):
+            self._points = self._points[self._inside(self._points)]
+        if len(self._points) < self._wanted:
+            self._points = self._detect(gray)
+        self._prev = gray
+        return step, ok, moved

@@ -1,0 +1,309 @@
+"""The contour tracker: the eight mouth and brow curves of ``facemime.track.contours`` as
+STB-snakes over one shared knot array, solved jointly each frame after head-motion
+compensation (method.md §1).
+
+Per frame:
+
+1. the head's similarity motion from the previous frame (:mod:`facemime.track.motion`) moves the
+   previous knots (the snakes' start and their temporal anchor) and the rest shape (the first
+   frame's knots carried along by the accumulated head motion);
+2. the sign-descent solver (``facemime._core.SnakeSolver``) moves every knot at most δ0/(1−σ) px;
+3. each feature's confidence is its mean edge response relative to the first frame's; a feature
+   whose confidence collapses or whose shape degenerates is flagged ``lost``, so that it never
+   drifts silently. (Putting a lost feature back on its rest shape was measured and made the
+   tracks worse: the rest shape follows the head, not the mouth.)
+
+Coordinates are (x, y) pixels, origin at the centre of the top-left pixel, y down.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+
+import cv2
+import numpy as np
+
+from facemime import _core, validate
+from facemime.errors import InvalidInputError
+from facemime.metrics import resample
+from facemime.track import motion
+from facemime.track.contours import CONTOUR_NAMES, FEATURES, POLARITY
+from facemime.track.field import build_field, region
+
+OPERATORS = ("directional", "magnitude")
+
+
+@dataclass(frozen=True)
+class CurveWeights:
+    """Energy weights of a curve (method.md §1): tension α, rigidity β (both against the rest
+    shape), temporal smoothness τ, image contrast ρ, temporal brightness γ, and the weight of the
+    colour channel in H relative to luma (``chroma``)."""
+
+    alpha: float
+    beta: float
+    tau: float
+    rho: float = 1.0
+    gamma: float = 0.0
+    chroma: float = 0.0
+
+
+@dataclass(frozen=True)
+class TrackerParams:
+    """Tracker settings. Defaults were tuned on the six shared videos (benchmarks/accuracy.py).
+
+    Distances are pixels. ``lip_keep``: each lip keeps at least this fraction of its first-frame
+    thickness (repulsion between the outer and inner curves; the inner curves never cross).
+    ``gap_weight``: weight of those minimum gaps. ``brow_weight``: weight holding each brow's
+    upper-to-lower thickness at its first-frame value (scaled with the head). ``mouth_knots``,
+    ``brow_knots``: knots per curve (None: the init's own points). ``knot_flow``: start each knot where the optical flow carries it (when the flow passes its
+    forward-backward check) rather than where the head motion alone puts it. ``lost_response``: a feature
+    is lost when its edge response falls below this fraction of the first frame's.
+    ``calibration_passes``: solver runs on the first frame that measure how far the image edges
+    lie from the given contours (0: no correction).
+    """
+
+    mouth: CurveWeights = CurveWeights(alpha=30.0, beta=24.0, tau=2.0, rho=1.0, gamma=0.0, chroma=0.5)
+    brows: CurveWeights = CurveWeights(alpha=30.0, beta=24.0, tau=2.0, rho=1.0, gamma=0.0, chroma=0.0)
+    operator: str = "directional"
+    points_per_segment: int = 3
+    delta0: float = 1.5
+    sigma: float = 0.75
+    iterations: int = 15
+    tol: float = 1e-4
+    smoothing: float = 1.5
+    lip_keep: float = 0.5
+    gap_weight: float = 0.5
+    brow_weight: float = 0.05
+    mouth_knots: int | None = None
+    brow_knots: int | None = None
+    motion: bool = True
+    knot_flow: bool = True
+    lost_response: float = 0.1
+    calibration_passes: int = 3
+
+    def with_(self, **changes: object) -> "TrackerParams":
+        """A copy with some settings changed."""
+        return replace(self, **changes)
+
+
+@dataclass
+class FrameResult:
+    """One frame's output: ``contours`` name -> (N, 2) float64 pixels; ``confidence`` feature ->
+    0..1; ``lost`` features re-initialised in this frame; ``iterations`` the solver ran;
+    ``motion_ok`` whether the head motion was measured."""
+
+    index: int
+    contours: dict[str, np.ndarray]
+    confidence: dict[str, float]
+    lost: list[str] = field(default_factory=list)
+    iterations: int = 0
+    motion_ok: bool = True
+
+
+def _layout(contours: Mapping[str, np.ndarray], params: TrackerParams) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """Shared knot array and each contour's knot indices; mouth corners are shared."""
+    knots: list[np.ndarray] = []
+    index: dict[str, np.ndarray] = {}
+    for feature, (up, low) in FEATURES.items():
+        count = params.mouth_knots if feature.startswith("mouth") else params.brow_knots
+        u, lo = (np.asarray(contours[n], np.float64) for n in (up, low))
+        if count is None and len(u) != len(lo):
+            count = max(len(u), len(lo))
+        if count is not None:
+            u, lo = resample(u, count), resample(lo, count)
+        base = sum(len(k) for k in knots)
+        if feature.startswith("mouth"):
+            ends = (u[[0, -1]] + lo[[0, -1]]) / 2.0
+            u, lo = u.copy(), lo.copy()
+            u[[0, -1]] = ends
+            knots += [u, lo[1:-1]]
+            index[up] = np.arange(base, base + len(u))
+            index[low] = np.concatenate([[base], np.arange(base + len(u), base + 2 * len(u) - 2), [base + len(u) - 1]])
+        else:
+            knots += [u, lo]
+            index[up] = np.arange(base, base + len(u))
+            index[low] = np.arange(base + len(u), base + 2 * len(u))
+    return np.concatenate(knots), index
+
+
+def _check_contours(contours: Mapping[str, object], width: int, height: int) -> dict[str, np.ndarray]:
+    if not isinstance(contours, Mapping):
+        raise InvalidInputError(f"contours must be a mapping of contour name to (N, 2) points, got {type(contours).__name__}")
+    missing = [n for n in CONTOUR_NAMES if n not in contours]
+    if missing:
+        raise InvalidInputError(f"contours lack {', '.join(missing)}")
+    out = {}
+    for n in CONTOUR_NAMES:
+        pts = validate.float_array(f"contour {n}", contours[n], (None, 2))
+        if len(pts) < 2:
+            raise InvalidInputError(f"contour {n} needs at least 2 points, got {len(pts)}")
+        if (pts < -0.5).any() or (pts[:, 0] > width - 0.5).any() or (pts[:, 1] > height - 0.5).any():
+            raise InvalidInputError(f"contour {n} has points outside the {width}x{height} image")
+        out[n] = pts
+    return out
+
+
+def _rgb(name: str, frame: object) -> np.ndarray:
+    img = validate.image(name, frame)
+    if img.ndim != 3 or img.shape[2] != 3:
+        raise InvalidInputError(f"{name} must be an (H, W, 3) RGB image, got shape {img.shape}")
+    return img
+
+
+class Tracker:
+    """Tracks the mouth and brow contours frame by frame; usable on a live camera.
+
+    Parameters
+    ----------
+    frame : (H, W, 3) uint8 array
+        The RGB frame the contours were drawn on.
+    contours : mapping of str to (N, 2) float array
+        All eight contours of ``facemime.track.CONTOUR_NAMES``, (x, y) pixels, image-left to
+        image-right; the two curves of each mouth contour share their end points.
+    params : TrackerParams, optional
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from facemime.track.synthetic import band_face
+    >>> frame, contours = band_face(0.0)
+    >>> tracker = Tracker(frame, contours)
+    >>> result = tracker.update(band_face(1.0)[0])
+    >>> sorted(result.confidence)
+    ['brow_left', 'brow_right', 'mouth_inner', 'mouth_outer']
+    """
+
+    def __init__(self, frame: np.ndarray, contours: Mapping[str, np.ndarray], params: TrackerParams | None = None):
+        self.params = p = params or TrackerParams()
+        validate.choice("operator", p.operator, OPERATORS)
+        frame = _rgb("frame", frame)
+        self.height, self.width = frame.shape[:2]
+        contours = _check_contours(contours, self.width, self.height)
+        self._knots0, self._index = _layout(contours, p)
+        self._down0 = self._mouth_down(self._knots0)
+        self._solver, self._targets0 = self._build_solver()
+        gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
+        self._motion = motion.HeadMotion(gray, contours) if p.motion else None
+        self._prev = frame
+        self.frame_index = 0
+        # The snakes settle on the image edges, which may sit a little off the given contours
+        # (a landmark convention, not an error): settle them on the first frame, track the edges
+        # and report them shifted back by that offset (which turns and scales with the head).
+        edges = self._knots0
+        for _ in range(p.calibration_passes):
+            edges = self._solve(frame, edges, self._knots0, self._down0, self._targets0)[0]
+        self._offset = edges - self._knots0
+        self._knots0 = edges
+        self._knots = edges.copy()
+        self._linear = np.eye(2)
+        self._response0 = np.maximum(self._responses(frame, edges, edges, self._down0, self._targets0), 1e-6)
+
+    def _build_solver(self) -> tuple[_core.SnakeSolver, np.ndarray]:
+        p = self.params
+        order = list(CONTOUR_NAMES)
+        rows = []
+        for name in order:
+            w = p.mouth if name.startswith("mouth") else p.brows
+            sl, sc = POLARITY[name]
+            rows.append([w.alpha, w.beta, w.tau, w.rho, w.gamma, sl, sc * w.chroma, OPERATORS.index(p.operator)])
+        pairs, kinds, targets = [], [], []
+        k0, down = self._knots0, self._down0
+
+        def add(a_name: str, b_name: str, kind: int, weight: float, fraction: float) -> None:
+            ia, ib = self._index[a_name], self._index[b_name]
+            inner = slice(1, -1) if a_name.startswith("mouth") else slice(None)
+            for a, b in zip(ia[inner], ib[inner]):
+                pairs.append((a, b))
+                kinds.append((kind, weight))
+                targets.append(fraction * float(down @ (k0[b] - k0[a])))
+
+        add("mouth_outer_upper", "mouth_inner_upper", 0, p.gap_weight, p.lip_keep)
+        add("mouth_inner_lower", "mouth_outer_lower", 0, p.gap_weight, p.lip_keep)
+        add("mouth_inner_upper", "mouth_inner_lower", 0, p.gap_weight, 0.0)
+        for side in ("left", "right"):
+            add(f"brow_{side}_upper", f"brow_{side}_lower", 1, p.brow_weight, 1.0)
+        targets_arr = np.maximum(np.array(targets), 0.0)
+        solver = _core.SnakeSolver(
+            np.concatenate([self._index[n] for n in order]).astype(np.uint32),
+            np.array([len(self._index[n]) for n in order], np.uint32),
+            np.array(rows, np.float64),
+            np.array(pairs, np.uint32).reshape(-1, 2),
+            np.array(kinds, np.float64).reshape(-1, 2),
+            p.points_per_segment, p.delta0, p.sigma, p.iterations, p.tol,
+        )
+        return solver, targets_arr
+
+    def _mouth_down(self, knots: np.ndarray) -> np.ndarray:
+        """Unit vector perpendicular to the mouth's corner line, pointing down the face."""
+        corners = knots[self._index["mouth_outer_upper"][[0, -1]]]
+        along = (corners[1] - corners[0]) / max(np.linalg.norm(corners[1] - corners[0]), 1e-9)
+        return np.array([-along[1], along[0]])
+
+    def _field(self, frame: np.ndarray, knots: np.ndarray) -> tuple[np.ndarray, tuple[float, float]]:
+        p = self.params
+        margin = p.delta0 / (1.0 - p.sigma) + 4.0 * p.smoothing + 2.0
+        box = region(knots, margin, self.width, self.height)
+        prev = self._prev if max(p.mouth.gamma, p.brows.gamma) > 0 else None
+        return build_field(frame, prev, box, p.smoothing), (float(box[0]), float(box[1]))
+
+    def _responses(self, frame: np.ndarray, start: np.ndarray, rest: np.ndarray, down: np.ndarray, targets: np.ndarray) -> np.ndarray:
+        fld, origin = self._field(frame, start)
+        _, resp = self._solver.evaluate(fld, origin, (self.width, self.height), start, rest, tuple(down), targets)
+        return resp
+
+    def _solve(self, frame: np.ndarray, start: np.ndarray, rest: np.ndarray, down: np.ndarray,
+               targets: np.ndarray) -> tuple[np.ndarray, int, np.ndarray]:
+        fld, origin = self._field(frame, start)
+        knots, iters, _, resp = self._solver.solve(fld, origin, (self.width, self.height), start, rest, tuple(down), targets)
+        return knots, iters, resp
+
+    def update(self, frame: np.ndarray) -> FrameResult:
+        """Track one more frame, (H, W, 3) uint8 RGB of the first frame's size."""
+        frame = _rgb("frame", frame)
+        if frame.shape[:2] != (self.height, self.width):
+            raise InvalidInputError(f"frame size changed from {self.width}x{self.height} to {frame.shape[1]}x{frame.shape[0]}")
+        p = self.params
+        self.frame_index += 1
+        step, ok, flow = motion.IDENTITY, True, None
+        if self._motion is not None:
+            gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
+            step, ok, flow = self._motion.update(gray, self.contours, self._knots if p.knot_flow else None)
+        total = self._motion.total if self._motion is not None else motion.IDENTITY
+        scale = float(np.sqrt(abs(np.linalg.det(total[:, :2]))))
+        rot = total[:, :2] / max(scale, 1e-9)
+        down = rot @ self._down0
+        down /= np.linalg.norm(down)
+        bounds_hi = np.array([self.width - 1.0, self.height - 1.0])
+        start = motion.apply(step, self._knots)
+        if flow is not None:
+            followed = np.isfinite(flow[:, 0])
+            start[followed] = flow[followed]
+        start = np.clip(start, 0.0, bounds_hi)
+        rest = motion.apply(total, self._knots0)
+        targets = self._targets0 * scale
+        knots, iters, resp = self._solve(frame, start, rest, down, targets)
+        confidence, lost = {}, []
+        for feature, names in FEATURES.items():
+            rows = [CONTOUR_NAMES.index(n) for n in names]
+            conf = float(np.clip(resp[rows] / self._response0[rows], 0.0, 1.0).mean())
+            confidence[feature] = conf
+            if conf < p.lost_response or not self._shape_ok(knots, rest, names):
+                lost.append(feature)
+        self._knots = knots
+        self._linear = total[:, :2]
+        self._prev = frame
+        return FrameResult(self.frame_index, self.contours, confidence, lost, iters, ok)
+
+    def _shape_ok(self, knots: np.ndarray, rest: np.ndarray, names: tuple[str, str]) -> bool:
+        """The upper curve's chord stays within a factor 2 of its rest chord."""
+        ends = self._index[names[0]][[0, -1]]
+        chord = np.linalg.norm(knots[ends[1]] - knots[ends[0]])
+        rest_chord = np.linalg.norm(rest[ends[1]] - rest[ends[0]])
+        return bool(0.5 * rest_chord <= chord <= 2.0 * rest_chord)
+
+    @property
+    def contours(self) -> dict[str, np.ndarray]:
+        """The current contours, name -> (N, 2) float64 pixels."""
+        out = self._knots - self._offset @ self._linear.T
+        return {n: out[self._index[n]] for n in CONTOUR_NAMES}
