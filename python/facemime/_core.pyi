@@ -24,3 +24,44 @@ def coverage(
     width: int,
     height: int,
 ) -> npt.NDArray[np.uint32]: ...
+
+FIELD_CHANNELS: int
+
+class SnakeSolver:
+    """Curves over one shared knot array, solved jointly by sign descent (see facemime.track)."""
+
+    n_knots: int
+
+    def __init__(
+        self,
+        curve_knots: npt.NDArray[np.uint32],
+        curve_lengths: npt.NDArray[np.uint32],
+        curve_params: npt.NDArray[np.float64],
+        pairs: npt.NDArray[np.uint32],
+        pair_params: npt.NDArray[np.float64],
+        points_per_segment: int,
+        delta0: float,
+        sigma: float,
+        iterations: int,
+        tol: float,
+    ) -> None: ...
+    def solve(
+        self,
+        field: npt.NDArray[np.float32],
+        origin: tuple[float, float],
+        bounds: tuple[float, float],
+        start: npt.NDArray[np.float64],
+        rest: npt.NDArray[np.float64],
+        down: tuple[float, float],
+        pair_targets: npt.NDArray[np.float64],
+    ) -> tuple[npt.NDArray[np.float64], int, float, npt.NDArray[np.float64]]: ...
+    def evaluate(
+        self,
+        field: npt.NDArray[np.float32],
+        origin: tuple[float, float],
+        bounds: tuple[float, float],
+        start: npt.NDArray[np.float64],
+        rest: npt.NDArray[np.float64],
+        down: tuple[float, float],
+        pair_targets: npt.NDArray[np.float64],
+    ) -> tuple[float, npt.NDArray[np.float64]]: ...

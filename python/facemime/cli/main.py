@@ -10,7 +10,7 @@ from pathlib import Path
 import click
 
 from facemime import __version__
-from facemime.errors import FacemimeError
+from facemime.errors import FacemimeError, InvalidInputError
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -61,6 +61,29 @@ def model_preview(model: Path | None, out_file: Path, force: bool) -> None:
     texture = painted_texture(head) if head.uv is not None and head.groups else None
     write_image(out_file, views_sheet(head, texture))
     click.echo(str(out_file))
+
+
+@cli.command()
+@click.argument("video", type=click.Path(path_type=Path))
+@click.option("--init", "init", type=click.Path(path_type=Path),
+              help="facemime.init/1 JSON with the eight contours of the first tracked frame.")
+@click.option("--out", "out_file", type=click.Path(path_type=Path), required=True, help="facemime.track/1 JSON to write.")
+@click.option("--overlay", type=click.Path(path_type=Path), help="Also write the video with the contours drawn (.mp4 or .webm).")
+@click.option("--force", is_flag=True, help="Overwrite existing output files.")
+def track(video: Path, init: Path | None, out_file: Path, overlay: Path | None, force: bool) -> None:
+    """Track the mouth and eyebrow contours through VIDEO with STB-snakes."""
+    from facemime.track.video import track_video
+
+    if init is None:
+        raise InvalidInputError("--init INIT.json is needed: automatic initialisation of the contours "
+                                "is not available yet")
+    run = track_video(video, init, out_file, overlay, force)
+    click.echo(str(out_file))
+    if overlay is not None:
+        click.echo(str(overlay))
+    fps = run.frames / max(run.seconds, 1e-9)
+    lost = f", {run.frames_with_lost} with a lost feature" if run.frames_with_lost else ""
+    click.echo(f"tracked {run.frames} frames at {fps:.0f} frames/s (decoding excluded){lost}", err=True)
 
 
 def main(argv: list[str] | None = None) -> None:

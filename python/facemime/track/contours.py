@@ -7,6 +7,8 @@ The upper and lower curves of each mouth contour share their two corner points.
 
 from __future__ import annotations
 
+import numpy as np
+
 #: Contour name -> feature it belongs to, in the order of the interchange format.
 CONTOUR_NAMES = (
     "mouth_outer_upper",
@@ -46,3 +48,24 @@ POLARITY = {
     "brow_right_upper": (-1.0, 0.0),
     "brow_right_lower": (+1.0, 0.0),
 }
+
+#: MediaPipe Face Mesh (478-point) indices of each contour, image-left to image-right.
+FACE_MESH_INDICES = {
+    "mouth_outer_upper": (61, 185, 40, 39, 37, 0, 267, 269, 270, 409, 291),
+    "mouth_outer_lower": (61, 146, 91, 181, 84, 17, 314, 405, 321, 375, 291),
+    "mouth_inner_upper": (78, 191, 80, 81, 82, 13, 312, 311, 310, 415, 308),
+    "mouth_inner_lower": (78, 95, 88, 178, 87, 14, 317, 402, 318, 324, 308),
+    "brow_left_upper": (336, 296, 334, 293, 300),
+    "brow_left_lower": (285, 295, 282, 283, 276),
+    "brow_right_upper": (70, 63, 105, 66, 107),
+    "brow_right_lower": (46, 53, 52, 65, 55),
+}
+#: Face Mesh indices of the outer eye corners (subject's right, subject's left): the IOD points.
+FACE_MESH_IOD = (33, 263)
+
+
+def from_face_mesh(landmarks: np.ndarray) -> dict[str, np.ndarray]:
+    """The eight contours, name -> (N, 2) float64 (x, y) pixels, from one face's Face Mesh
+    landmarks, a (478, 2 or 3) array in pixels."""
+    pts = np.asarray(landmarks, dtype=np.float64)
+    return {name: pts[list(idx), :2] for name, idx in FACE_MESH_INDICES.items()}

@@ -14,9 +14,10 @@ from collections.abc import Mapping
 import cv2
 import numpy as np
 
-#: Rigid zones in face coordinates (s, t): a point is ``c + s·W·u + t·D·v`` where ``c`` is the
-#: centre of the brows, ``v`` (length ``D``) runs from it to the centre of the mouth, ``u`` is
-#: ``v`` turned to image-right and ``W`` is the outer width of the brows.
+#: Rigid zones in face coordinates (s, t) of the first frame: a point is ``c + s·W·u + t·v``
+#: where ``c`` is the centre of the brows, ``v`` runs from it to the centre of the mouth, ``u`` is
+#: ``v`` turned to image-right (unit) and ``W`` is the outer width of the brows. In later frames
+#: the zones follow the tracked brows.
 ZONES = (
     ((-0.2, 0.2), (0.2, 0.72)),  # nose bridge, nose, nostrils
     ((-0.45, 0.45), (-1.0, -0.4)),  # forehead above raised brows (hair, glasses)
@@ -48,6 +49,16 @@ def zone_polygons(contours: Mapping[str, np.ndarray]) -> list[np.ndarray]:
     return polys
 
 
+def brow_similarity(src: Mapping[str, np.ndarray], dst: Mapping[str, np.ndarray]) -> np.ndarray:
+    """The 2×3 similarity that best maps the brow contours of ``src`` onto those of ``dst``
+    (least squares over their points)."""
+    names = [n for n in src if n.startswith("brow")]
+    a = np.concatenate([src[n] for n in names]).astype(np.float32)
+    b = np.concatenate([dst[n] for n in names]).astype(np.float32)
+    m, _ = cv2.estimateAffinePartial2D(a, b, method=cv2.LMEDS)
+    return IDENTITY.copy() if m is None else m
+
+
 def compose(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The 2×3 transform ``a ∘ b`` (apply ``b`` first)."""
     return (np.vstack([a, [0, 0, 1]]) @ np.vstack([b, [0, 0, 1]]))[:2]
@@ -74,7 +85,9 @@ class HeadMotion:
         self._max_points = max_points
         self.total = IDENTITY.copy()
         self._prev = gray
-        self._zones = zone_polygons(contours)
+        self._contours0 = {n: np.asarray(c, float) for n, c in contours.items()}
+        self._zones0 = zone_polygons(contours)
+        self._zones = self._zones0
         self._points = self._detect(gray)
         self._wanted = max(MIN_POINTS, len(self._points) // 2)
 
@@ -129,13 +142,15 @@ class HeadMotion:
                extra: np.ndarray | None = None) -> tuple[np.ndarray, bool, np.ndarray | None]:
         """Motion from the previous frame to ``gray``.
 
-        ``contours``: the previous frame's tracked contours (they place the rigid zones).
+        ``contours``: the previous frame's tracked contours; their brows (the most reliably
+        tracked feature) place the rigid zones.
         ``extra``: optional (N, 2) points of the previous frame to follow by the same flow.
         Returns (step, measured, moved): the 2×3 similarity (identity when too few points agreed
         and the coarse fallback failed), whether it was measured, and the extra points' new
         positions (NaN where the flow failed its forward-backward check).
         """
-        self._zones = zone_polygons(contours)
+        place = brow_similarity(self._contours0, contours)
+        self._zones = [apply(place, z) for z in self._zones0]
         step, ok = IDENTITY.copy(), False
         n_extra = 0 if extra is None else len(extra)
         moved = None if extra is None else np.full((n_extra, 2), np.nan)

@@ -37,14 +37,16 @@ OPERATORS = ("directional", "magnitude")
 @dataclass(frozen=True)
 class CurveWeights:
     """Energy weights of a curve (method.md §1): tension α, rigidity β (both against the rest
-    shape), temporal smoothness τ, image contrast ρ, temporal brightness γ, and the weight of the
-    colour channel in H relative to luma (``chroma``)."""
+    shape), temporal smoothness τ, image contrast ρ, temporal brightness γ, and the weights of
+    the luma and colour (red − green) derivatives in H (their signs come from the edge's
+    polarity, :data:`facemime.track.contours.POLARITY`)."""
 
     alpha: float
     beta: float
     tau: float
     rho: float = 1.0
     gamma: float = 0.0
+    luma: float = 1.0
     chroma: float = 0.0
 
 
@@ -64,6 +66,7 @@ class TrackerParams:
     """
 
     mouth: CurveWeights = CurveWeights(alpha=30.0, beta=24.0, tau=2.0, rho=1.0, gamma=0.0, chroma=0.5)
+    mouth_inner: CurveWeights = CurveWeights(alpha=30.0, beta=24.0, tau=2.0, rho=1.0, gamma=0.0, luma=0.5, chroma=1.0)
     brows: CurveWeights = CurveWeights(alpha=30.0, beta=24.0, tau=2.0, rho=1.0, gamma=0.0, chroma=0.0)
     operator: str = "directional"
     points_per_segment: int = 3
@@ -167,9 +170,9 @@ class Tracker:
     --------
     >>> import numpy as np
     >>> from facemime.track.synthetic import band_face
-    >>> frame, contours = band_face(0.0)
+    >>> frame, contours = band_face()
     >>> tracker = Tracker(frame, contours)
-    >>> result = tracker.update(band_face(1.0)[0])
+    >>> result = tracker.update(band_face(shift=(1.0, 0.5))[0])
     >>> sorted(result.confidence)
     ['brow_left', 'brow_right', 'mouth_inner', 'mouth_outer']
     """
@@ -204,9 +207,9 @@ class Tracker:
         order = list(CONTOUR_NAMES)
         rows = []
         for name in order:
-            w = p.mouth if name.startswith("mouth") else p.brows
+            w = p.mouth_inner if name.startswith("mouth_inner") else p.mouth if name.startswith("mouth") else p.brows
             sl, sc = POLARITY[name]
-            rows.append([w.alpha, w.beta, w.tau, w.rho, w.gamma, sl, sc * w.chroma, OPERATORS.index(p.operator)])
+            rows.append([w.alpha, w.beta, w.tau, w.rho, w.gamma, sl * w.luma, sc * w.chroma, OPERATORS.index(p.operator)])
         pairs, kinds, targets = [], [], []
         k0, down = self._knots0, self._down0
 

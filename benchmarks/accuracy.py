@@ -1,0 +1,131 @@
+"""Tracking accuracy on the six shared videos (NME of the shared data README), initialised from
+the reference contours of the first frame, against two baselines measured in the same run:
+
+- static: the first frame's contours held;
+- LK: OpenCV's pyramidal Lucas-Kanade (calcOpticalFlowPyrLK, 21×21 window, 3 levels) tracking the
+  same points frame to frame, with a forward-backward check (a point whose back-tracked position
+  lands more than 1 px from where it started keeps its previous position).
+
+With ``--variants`` the tracker also runs with other image operators H (gradient magnitude,
+luma only, colour only) to show why the default is what it is.
+
+    python benchmarks/accuracy.py [--data ../shared/data] [--videos lp_d0,vr_1] [--variants]
+
+Prints one table per feature group and, last, one JSON line with every figure.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from facemime.io.video import VideoReader
+from facemime.metrics import group_nme, pooled_summary, summarize
+from facemime.track import Tracker, TrackerParams
+from facemime.track.contours import CONTOUR_NAMES, GROUPS, from_face_mesh
+
+VIDEOS = ("lp_d0", "lp_d3", "lp_d6", "lp_d12", "vr_1", "vr_2")
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def variants() -> dict[str, TrackerParams]:
+    p = TrackerParams()
+    luma_only = {k: replace(getattr(p, k), luma=1.0, chroma=0.0) for k in ("mouth", "mouth_inner", "brows")}
+    colour_only = {k: replace(getattr(p, k), luma=0.0, chroma=1.0) for k in ("mouth", "mouth_inner")}
+    return {
+        "facemime (directional, luma + colour)": p,
+        "facemime, H = gradient magnitude": p.with_(operator="magnitude"),
+        "facemime, H = directional luma only": p.with_(**luma_only),
+        "facemime, H = directional colour only (mouth)": p.with_(**colour_only),
+    }
+
+
+def run_tracker(frames: list[np.ndarray], init: dict, params: TrackerParams) -> tuple[list[dict], int]:
+    tracker = Tracker(frames[0], init, params)
+    out, lost = [], 0
+    for frame in frames[1:]:
+        r = tracker.update(frame)
+        out.append(r.contours)
+        lost += bool(r.lost)
+    return out, lost
+
+
+def run_lk(frames: list[np.ndarray], init: dict) -> list[dict]:
+    grays = [cv2.cvtColor(f, cv2.COLOR_RGB2GRAY) for f in frames]
+    sizes = [len(init[n]) for n in CONTOUR_NAMES]
+    pts = np.concatenate([init[n] for n in CONTOUR_NAMES]).astype(np.float32)
+    out = []
+    for prev, cur in zip(grays, grays[1:]):
+        lk = {"winSize": (21, 21), "maxLevel": 3}
+        p1, st1, _ = cv2.calcOpticalFlowPyrLK(prev, cur, pts.reshape(-1, 1, 2), None, **lk)
+        back, st2, _ = cv2.calcOpticalFlowPyrLK(cur, prev, p1, None, **lk)
+        ok = (st1.ravel() == 1) & (st2.ravel() == 1) & (np.linalg.norm(back.reshape(-1, 2) - pts, axis=1) <= 1.0)
+        pts = np.where(ok[:, None], p1.reshape(-1, 2), pts)
+        out.append(dict(zip(CONTOUR_NAMES, np.split(pts.astype(np.float64), np.cumsum(sizes)[:-1]))))
+    return out
+
+
+def score(tracks: list[dict], landmarks: np.ndarray, valid: np.ndarray, iod: np.ndarray) -> dict[str, np.ndarray]:
+    """Per-frame NME of each group over the scored frames (1..T-1 with a reference face)."""
+    per = {g: [] for g in GROUPS}
+    for i, contours in enumerate(tracks, start=1):
+        if not valid[i]:
+            continue
+        ref = from_face_mesh(landmarks[i])
+        for g, names in GROUPS.items():
+            per[g].append(group_nme(contours, ref, names, float(iod[i])))
+    return {g: np.array(v) for g, v in per.items()}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data")
+    ap.add_argument("--videos", default=",".join(VIDEOS))
+    ap.add_argument("--variants", action="store_true", help="also run other image operators H")
+    args = ap.parse_args()
+    cv2.setNumThreads(1)
+    methods = variants() if args.variants else {"facemime (directional, luma + colour)": TrackerParams()}
+    names = ["static", "LK + FB"] + list(methods)
+    series: dict[str, dict[str, list[np.ndarray]]] = {m: {g: [] for g in GROUPS} for m in names}
+    lost: dict[str, dict[str, int]] = {m: {} for m in methods}
+    per_video: dict[str, dict] = {}
+    for video in args.videos.split(","):
+        z = np.load(args.data / "video" / f"{video}.landmarks.npz")
+        with VideoReader(args.data / "video" / f"{video}.mp4") as reader:
+            frames = list(reader)
+        lm, valid, iod = z["landmarks"], z["valid"], z["iod"]
+        start = int(np.flatnonzero(valid)[0])
+        frames, lm, valid, iod = frames[start:], lm[start:], valid[start:], iod[start:]
+        init = from_face_mesh(lm[0])
+        runs = {"static": [init] * (len(frames) - 1), "LK + FB": run_lk(frames, init)}
+        for m, params in methods.items():
+            t0 = time.perf_counter()
+            runs[m], lost[m][video] = run_tracker(frames, init, params)
+            print(f"{video}: {m}: {len(frames) / (time.perf_counter() - t0):.0f} frames/s", flush=True)
+        per_video[video] = {}
+        for m, tracks in runs.items():
+            scores = score(tracks, lm, valid, iod)
+            per_video[video][m] = {g: summarize(v) for g, v in scores.items()}
+            for g in GROUPS:
+                series[m][g].append(scores[g])
+    pooled = {m: {g: pooled_summary(series[m][g]) for g in GROUPS} for m in names}
+    for g in GROUPS:
+        print(f"\n{g} (NME over {len(per_video)} videos, init frame excluded)")
+        print(f"  {'method':48s} {'mean':>7s} {'median':>7s} {'p90':>7s} {'fail%':>6s} {'drift':>7s}   per-video mean")
+        for m in names:
+            s = pooled[m][g]
+            pv = " ".join(f"{v}={per_video[v][m][g]['mean']:.3f}" for v in per_video)
+            print(f"  {m:48s} {s['mean']:7.4f} {s['median']:7.4f} {s['p90']:7.4f} {100 * s['failure_rate']:6.2f} {s['drift']:7.4f}   {pv}")
+    for m in methods:
+        print(f"frames with a lost feature, {m}: {lost[m]}")
+    print(json.dumps({"pooled": pooled, "per_video": per_video, "frames_with_lost": lost}, allow_nan=True))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,73 @@
+"""Tracking a whole video file: read the init contours, run the :class:`Tracker` over every
+frame from the init frame on, write the ``facemime.track/1`` JSON and optionally an overlay video
+(H.264 MP4 or VP9 WebM) with the contours drawn. Outputs appear only when complete."""
+
+from __future__ import annotations
+
+import time
+from contextlib import nullcontext
+from dataclasses import dataclass
+from pathlib import Path
+
+from facemime.errors import InputFileError, InvalidInputError
+from facemime.io.contours_json import read_init, track_document, write_json
+from facemime.io.outputs import check_outputs
+from facemime.io.video import CODECS, VideoReader, VideoWriter
+from facemime.progress import track as progress
+from facemime.track.contours import FEATURES
+from facemime.track.overlay import draw_contours
+from facemime.track.tracker import FrameResult, Tracker, TrackerParams
+
+
+@dataclass
+class TrackRun:
+    """Summary of a tracked video: frames tracked, seconds spent tracking (decoding and
+    encoding excluded), frames with a lost feature."""
+
+    frames: int
+    seconds: float
+    frames_with_lost: int
+
+
+def track_video(video: str | Path, init: str | Path, out: str | Path, overlay: str | Path | None = None,
+                force: bool = False, params: TrackerParams | None = None) -> TrackRun:
+    """Track ``video`` from the contours in ``init`` (``facemime.init/1``) and write ``out``
+    (``facemime.track/1``) and, if given, the ``overlay`` video. Existing outputs are refused
+    unless ``force``."""
+    out = Path(out)
+    outputs = [out] + ([Path(overlay)] if overlay is not None else [])
+    if overlay is not None and Path(overlay).suffix.lower() not in CODECS:
+        raise InvalidInputError(f"overlay video must end in .mp4 or .webm, got {Path(overlay).name!r}")
+    check_outputs(outputs, force)
+    with VideoReader(video) as reader:
+        start, contours = read_init(init, size=(reader.width, reader.height))
+        writer = VideoWriter(overlay, reader.fps) if overlay is not None else None
+        frames: list[dict] = []
+        tracker: Tracker | None = None
+        seconds, lost_frames, decoded = 0.0, 0, 0
+        with writer if writer is not None else nullcontext():
+            for index, frame in enumerate(progress(reader, reader.frames or None, "tracking")):
+                decoded += 1
+                if index < start:
+                    if writer is not None:
+                        writer.write(frame)
+                    continue
+                t0 = time.perf_counter()
+                if tracker is None:
+                    tracker = Tracker(frame, contours, params)
+                    result = FrameResult(index, tracker.contours, {f: 1.0 for f in FEATURES})
+                else:
+                    result = tracker.update(frame)
+                seconds += time.perf_counter() - t0
+                lost_frames += bool(result.lost)
+                frames.append({"index": index, "contours": result.contours, "confidence": result.confidence, "lost": result.lost})
+                if writer is not None:
+                    writer.write(draw_contours(frame, result.contours, result.lost))
+            if decoded == 0:
+                raise InputFileError(f"video {video} has no frames")
+            if tracker is None:
+                raise InvalidInputError(f"init frame {start} is beyond the last frame ({decoded - 1}) of {video}")
+        info = {"width": reader.width, "height": reader.height, "fps": reader.fps, "frames": decoded}
+        write_json(out, track_document(info, frames, {"processing_seconds": round(seconds, 4), "frames_processed": len(frames)}))
+    return TrackRun(len(frames), seconds, lost_frames)
+

@@ -1,0 +1,108 @@
+"""`facemime track`: real video in, track JSON and a playable overlay out, one-line errors."""
+
+import json
+
+import av
+import numpy as np
+import pytest
+
+from facemime.io.contours_json import init_document, write_json
+from facemime.io.video import VideoWriter
+from facemime.metrics import group_nme
+from facemime.track.contours import GROUPS, from_face_mesh
+from facemime.track.synthetic import band_face
+
+from .test_cli import run
+
+
+@pytest.fixture()
+def synthetic_video(tmp_path):
+    """A 12-frame synthetic face video (H.264) and its init file."""
+    video = tmp_path / "face.mp4"
+    with VideoWriter(video, fps=25) as w:
+        for t in range(12):
+            w.write(band_face(shift=(0.5 * t, 0.0), opening=0.3 * t)[0])
+    init = write_json(tmp_path / "init.json", init_document(0, band_face()[1]))
+    return video, init
+
+
+def test_track_writes_every_frame_and_an_overlay(tmp_path, capsys, synthetic_video):
+    video, init = synthetic_video
+    out, overlay = tmp_path / "t.json", tmp_path / "o.mp4"
+    code, stdout, err = run(capsys, "track", str(video), "--init", str(init), "--out", str(out), "--overlay", str(overlay))
+    assert code == 0, err
+    assert stdout.split() == [str(out), str(overlay)] and "tracked 12 frames" in err
+    doc = json.loads(out.read_text())
+    assert doc["format"] == "facemime.track/1" and doc["video"]["frames"] == 12
+    assert [f["index"] for f in doc["frames"]] == list(range(12))
+    assert all(len(f["contours"]) == 8 and set(f["confidence"]) == set(GROUPS) - {"brows"} | {"brow_left", "brow_right"}
+               for f in doc["frames"])
+    last = {n: np.array(c) for n, c in doc["frames"][-1]["contours"].items()}
+    truth = band_face(shift=(5.5, 0.0), opening=3.3)[1]
+    assert max(group_nme(last, truth, names, 100.0) for names in GROUPS.values()) < 0.01
+    with av.open(str(overlay)) as c:
+        assert c.streams.video[0].codec_context.name == "h264"
+        assert sum(1 for _ in c.decode(video=0)) == 12
+    # Running again refuses to overwrite both outputs.
+    code, _, err = run(capsys, "track", str(video), "--init", str(init), "--out", str(out), "--overlay", str(overlay))
+    assert code == 1 and "already exist" in err and "--force" in err
+
+
+def test_track_a_real_video_clip(tmp_path, capsys, shared):
+    # The first 30 frames of lp_d0, initialised from the reference, stay on the reference.
+    z = np.load(shared / "video" / "lp_d0.landmarks.npz")
+    clip = tmp_path / "clip.mp4"
+    with av.open(str(shared / "video" / "lp_d0.mp4")) as c, VideoWriter(clip, fps=25) as w:
+        for i, frame in zip(range(30), c.decode(video=0)):
+            w.write(frame.to_ndarray(format="rgb24"))
+    init = write_json(tmp_path / "init.json", init_document(0, from_face_mesh(z["landmarks"][0])))
+    code, _, err = run(capsys, "track", str(clip), "--init", str(init), "--out", str(tmp_path / "t.json"))
+    assert code == 0, err
+    frames = json.loads((tmp_path / "t.json").read_text())["frames"]
+    errors = [group_nme(f["contours"], from_face_mesh(z["landmarks"][f["index"]]), names, float(z["iod"][f["index"]]))
+              for f in frames[1:] for names in GROUPS.values()]
+    assert np.mean(errors) < 0.04 and max(errors) < 0.1
+
+
+@pytest.mark.parametrize(
+    ("setup", "message"),
+    [
+        ("no-init", "--init INIT.json is needed"),
+        ("missing-video", "video missing.mp4 does not exist"),
+        ("not-a-video", "cannot read video notvideo.mp4"),
+        ("bad-json", "init.json is not valid JSON"),
+        ("missing-feature", "missing contour mouth_inner_lower"),
+        ("outside", "is outside the 256x256 image"),
+        ("late-init", "init frame 50 is beyond the last frame (11)"),
+        ("bad-overlay", "overlay video must end in .mp4 or .webm"),
+    ],
+)
+def test_bad_input_gives_one_line_and_leaves_nothing(tmp_path, capsys, monkeypatch, synthetic_video, setup, message):
+    monkeypatch.chdir(tmp_path)
+    video, init = synthetic_video
+    doc = json.loads(init.read_text())
+    args = ["track", str(video.name), "--init", "init.json", "--out", "out.json", "--overlay", "o.mp4"]
+    if setup == "no-init":
+        args = ["track", str(video.name), "--out", "out.json"]
+    elif setup == "missing-video":
+        args[1] = "missing.mp4"
+    elif setup == "not-a-video":
+        (tmp_path / "notvideo.mp4").write_text("hello")
+        args[1] = "notvideo.mp4"
+    elif setup == "bad-json":
+        init.write_text('{"format": ')
+    elif setup == "missing-feature":
+        del doc["contours"]["mouth_inner_lower"]
+        init.write_text(json.dumps(doc))
+    elif setup == "outside":
+        doc["contours"]["brow_left_upper"][0] = [-40, 10]
+        init.write_text(json.dumps(doc))
+    elif setup == "late-init":
+        doc["frame"] = 50
+        init.write_text(json.dumps(doc))
+    elif setup == "bad-overlay":
+        args[-1] = "o.avi"
+    code, _, err = run(capsys, *args)
+    assert code == 1 and message in err and err.count("\n") == 1 and "Traceback" not in err
+    assert not (tmp_path / "out.json").exists() and not (tmp_path / "o.mp4").exists()
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]

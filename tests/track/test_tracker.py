@@ -1,0 +1,120 @@
+"""The contour tracker on synthetic faces with known truth and on a real shared video."""
+
+import numpy as np
+import pytest
+
+from facemime.errors import InvalidInputError
+from facemime.metrics import curve_error, group_nme
+from facemime.track import CONTOUR_NAMES, FEATURES, Tracker, TrackerParams
+from facemime.track.contours import GROUPS
+from facemime.track.synthetic import band_face
+
+
+def sequence(steps, **per_step):
+    """Frames t = 1..steps of a face moving by per_step * t, with noise."""
+    for t in range(1, steps + 1):
+        yield band_face(noise=2.0, seed=t, **{k: tuple(x * t for x in v) if isinstance(v, tuple) else v * t
+                                                for k, v in per_step.items()})
+
+
+def test_follows_a_translated_bent_and_opening_face_within_half_a_pixel():
+    frame0, truth0 = band_face(noise=2.0)
+    tracker = Tracker(frame0, truth0)
+    for frame, truth in sequence(20, shift=(0.7, 0.4), opening=0.4, bend=0.1, brow_raise=0.2):
+        result = tracker.update(frame)
+        assert not result.lost and result.motion_ok
+        for name in CONTOUR_NAMES:
+            assert curve_error(result.contours[name], truth[name]) < 0.5, (result.index, name)
+
+
+def lip_thickness(contours):
+    """Thickness of the upper and of the lower lip and the mouth opening at the middle (px)."""
+    y = {n: c[len(c) // 2, 1] for n, c in contours.items() if n.startswith("mouth")}
+    return (y["mouth_inner_upper"] - y["mouth_outer_upper"], y["mouth_outer_lower"] - y["mouth_inner_lower"],
+            y["mouth_inner_lower"] - y["mouth_inner_upper"])
+
+
+@pytest.mark.parametrize("repulsion", [True, False])
+def test_repulsion_keeps_thinning_lips_from_merging_onto_one_edge(repulsion):
+    # The lips thin to a fifth while the mouth is open: the outer and inner edges of each lip
+    # approach each other. With repulsion every lip keeps half its first-frame thickness and the
+    # inner curves do not cross (by more than half a pixel); without it the curves follow the edges together.
+    params = TrackerParams() if repulsion else TrackerParams(gap_weight=0.0)
+    frame0, truth0 = band_face(opening=6.0)
+    start_upper, start_lower, _ = lip_thickness(truth0)
+    tracker = Tracker(frame0, truth0, params)
+    for t in range(1, 17):
+        upper, lower, opening = lip_thickness(tracker.update(band_face(opening=6.0, lips=1.0 - 0.05 * t, noise=2.0, seed=t)[0]).contours)
+    if repulsion:
+        assert upper >= 0.5 * start_upper - 0.5 and lower >= 0.5 * start_lower - 0.5 and opening > -0.5
+    else:
+        assert upper < 0.35 * start_upper and lower < 0.35 * start_lower
+
+
+def test_no_coordinate_moves_more_than_the_solver_bound_in_a_frame():
+    params = TrackerParams(motion=False, delta0=1.0, sigma=0.6)
+    bound = params.delta0 / (1.0 - params.sigma)
+    frame0, truth0 = band_face()
+    tracker = Tracker(frame0, truth0, params)
+    before = tracker.contours
+    for frame, _ in sequence(6, shift=(5.0, -4.0)):
+        after = tracker.update(frame).contours
+        for name in CONTOUR_NAMES:
+            assert np.abs(after[name] - before[name]).max() <= bound + 1e-9
+        before = after
+
+
+def test_confidence_and_lost_flag_when_the_face_disappears():
+    frame0, truth0 = band_face()
+    tracker = Tracker(frame0, truth0)
+    ok = tracker.update(band_face(noise=1.0)[0])
+    assert ok.lost == [] and min(ok.confidence.values()) > 0.8
+    blank = np.full_like(frame0, 128)
+    gone = tracker.update(blank)
+    assert sorted(gone.lost) == sorted(FEATURES) and max(gone.confidence.values()) < 0.1
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (lambda c: c.pop("brow_left_lower"), "contours lack brow_left_lower"),
+        (lambda c: c.__setitem__("mouth_outer_upper", [[1.0, 2.0]]), "needs at least 2 points"),
+        (lambda c: c.__setitem__("brow_right_upper", [[1.0, 2.0], [np.nan, 3.0]]), "must be finite"),
+        (lambda c: c.__setitem__("brow_right_upper", [[1.0, 2.0], [900.0, 3.0]]), "outside the 256x256 image"),
+    ],
+)
+def test_bad_contours_are_refused(change, message):
+    frame0, truth0 = band_face()
+    contours = {k: v.tolist() for k, v in truth0.items()}
+    change(contours)
+    with pytest.raises(InvalidInputError, match=message):
+        Tracker(frame0, contours)
+
+
+def test_bad_frames_are_refused():
+    frame0, truth0 = band_face()
+    with pytest.raises(InvalidInputError, match="RGB"):
+        Tracker(frame0[..., 0], truth0)
+    tracker = Tracker(frame0, truth0)
+    with pytest.raises(InvalidInputError, match="frame size changed"):
+        tracker.update(frame0[:100])
+    with pytest.raises(InvalidInputError, match="operator must be one of"):
+        Tracker(frame0, truth0, TrackerParams(operator="laplace"))
+
+
+def test_tracks_a_real_talking_face(shared):
+    from facemime.io.video import VideoReader
+    from facemime.track.contours import from_face_mesh as reference_contours
+
+    name = "vr_2"
+    z = np.load(shared / "video" / f"{name}.landmarks.npz")
+    with VideoReader(shared / "video" / f"{name}.mp4") as reader:
+        frames = [f for _, f in zip(range(40), reader)]
+    tracker = Tracker(frames[0], reference_contours(z["landmarks"][0]))
+    errors = {g: [] for g in GROUPS}
+    for i in range(1, len(frames)):
+        result = tracker.update(frames[i])
+        for g, names in GROUPS.items():
+            errors[g].append(group_nme(result.contours, reference_contours(z["landmarks"][i]), names, float(z["iod"][i])))
+    for g, e in errors.items():
+        assert np.mean(e) < 0.03 and max(e) < 0.06, g
