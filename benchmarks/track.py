@@ -1,0 +1,121 @@
+"""Tracking speed on the 512×512 shared videos, one core, decoding excluded, with in the same
+run: the time to decode the same frames, OpenCV's pyramidal LK (21×21, 3 levels, forward-backward
+check) on the same points, and the snake solver alone (the recorded solver calls of the tracker
+replayed).
+
+The tracker is the default one: head-motion compensation plus all eight curves (4 × 11 + 4 × 5 =
+64 knots in one joint problem, the same number as the paper's 8 curves of 8 knots), 3 points per
+segment, at most 15 iterations.
+
+    python benchmarks/track.py [--data ../shared/data] [--frames 200]
+
+The last line of output is one JSON object with at least ``fps_tracker`` and ``fps_snakes``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import time
+from pathlib import Path
+
+import av
+import cv2
+import numpy as np
+
+from facemime.track import Tracker
+from facemime.track.contours import CONTOUR_NAMES, from_face_mesh
+
+VIDEOS = ("lp_d0", "lp_d3", "lp_d12")
+ROOT = Path(__file__).resolve().parents[1]
+
+
+class RecordingSolver:
+    """Forwards to the real solver and keeps every solve call's arguments."""
+
+    def __init__(self, solver):
+        self.solver, self.calls = solver, []
+
+    def solve(self, *args):
+        self.calls.append(args)
+        return self.solver.solve(*args)
+
+    def evaluate(self, *args):
+        return self.solver.evaluate(*args)
+
+
+def decode(path: Path, limit: int) -> tuple[list[np.ndarray], float]:
+    """Frames decoded on one thread, and the seconds it took."""
+    t0 = time.perf_counter()
+    frames = []
+    with av.open(str(path)) as c:
+        stream = c.streams.video[0]
+        stream.codec_context.thread_count = 1
+        for frame in c.decode(stream):
+            frames.append(frame.to_ndarray(format="rgb24"))
+            if len(frames) == limit:
+                break
+    return frames, time.perf_counter() - t0
+
+
+def lk_seconds(frames: list[np.ndarray], pts: np.ndarray) -> float:
+    grays = [cv2.cvtColor(f, cv2.COLOR_RGB2GRAY) for f in frames]
+    t0 = time.perf_counter()
+    p = pts.reshape(-1, 1, 2).astype(np.float32)
+    for prev, cur in zip(grays, grays[1:]):
+        p1, st1, _ = cv2.calcOpticalFlowPyrLK(prev, cur, p, None, winSize=(21, 21), maxLevel=3)
+        back, st2, _ = cv2.calcOpticalFlowPyrLK(cur, prev, p1, None, winSize=(21, 21), maxLevel=3)
+        ok = (st1.ravel() == 1) & (st2.ravel() == 1) & (np.linalg.norm((back - p).reshape(-1, 2), axis=1) <= 1.0)
+        p = np.where(ok[:, None, None], p1, p).astype(np.float32)
+    return time.perf_counter() - t0
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data")
+    ap.add_argument("--frames", type=int, default=200, help="frames per video at most")
+    args = ap.parse_args()
+    cv2.setNumThreads(1)
+    totals = {"frames": 0, "decode": 0.0, "tracker": 0.0, "snakes": 0.0, "lk": 0.0, "iterations": 0}
+    for video in VIDEOS:
+        frames, dec = decode(args.data / "video" / f"{video}.mp4", args.frames)
+        init = from_face_mesh(np.load(args.data / "video" / f"{video}.landmarks.npz")["landmarks"][0])
+        tracker = Tracker(frames[0], init)
+        recorder = RecordingSolver(tracker._solver)  # noqa: SLF001 - benchmark instrumentation
+        tracker._solver = recorder  # noqa: SLF001
+        t0 = time.perf_counter()
+        for frame in frames[1:]:
+            tracker.update(frame)
+        track_s = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        for call in recorder.calls:
+            totals["iterations"] += recorder.solver.solve(*call)[1]
+        snake_s = time.perf_counter() - t0
+        lk_s = lk_seconds(frames, np.concatenate([init[n] for n in CONTOUR_NAMES]))
+        n = len(frames) - 1
+        print(f"{video}: {n} frames  decode {len(frames) / dec:7.0f} fps  tracker {n / track_s:6.0f} fps  "
+              f"snakes alone {n / snake_s:7.0f} fps  LK+FB {n / lk_s:6.0f} fps")
+        for k, v in (("frames", n), ("decode", dec * n / len(frames)), ("tracker", track_s), ("snakes", snake_s), ("lk", lk_s)):
+            totals[k] += v
+    n = totals["frames"]
+    result = {
+        "machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, one used",
+        "frames": n,
+        "fps_tracker": n / totals["tracker"],
+        "fps_snakes": n / totals["snakes"],
+        "fps_decode": n / totals["decode"],
+        "fps_lk": n / totals["lk"],
+        "tracker_vs_decode": totals["decode"] / totals["tracker"],
+        "tracker_vs_lk": totals["lk"] / totals["tracker"],
+        "mean_iterations": totals["iterations"] / n,
+    }
+    print(f"all: tracker {result['fps_tracker']:.0f} fps ({result['tracker_vs_decode']:.2f}x decoding, "
+          f"{result['tracker_vs_lk']:.2f}x LK), snakes alone {result['fps_snakes']:.0f} fps, "
+          f"{result['mean_iterations']:.1f} iterations per frame")
+    print(json.dumps(result))
+
+
+if __name__ == "__main__":
+    main()
