@@ -34,9 +34,9 @@ def build_field(frame: np.ndarray, prev: np.ndarray | None, box: tuple[int, int,
     previous frame (or None: L_prev = L)."""
     x0, y0, x1, y1 = box
     crop = frame[y0:y1, x0:x1]
-    f = crop.astype(np.float32)
-    lum = cv2.GaussianBlur(cv2.transform(f, LUMA[None, :]), (0, 0), sigma)
-    chroma = cv2.GaussianBlur(np.ascontiguousarray(f[..., 0] - f[..., 1]), (0, 0), sigma)
+    lum = smoothed_luma(crop, sigma)
+    red_green = np.subtract(crop[..., 0], crop[..., 1], dtype=np.float32)
+    chroma = cv2.GaussianBlur(red_green, (0, 0), sigma)
     d = lambda img, dx, dy: cv2.Sobel(img, cv2.CV_32F, dx, dy, ksize=1, scale=0.5)  # noqa: E731  central difference
     lp = lum if prev is None else smoothed_luma(prev[y0:y1, x0:x1], sigma)
     return cv2.merge([d(lum, 1, 0), d(lum, 0, 1), d(chroma, 1, 0), d(chroma, 0, 1), lum, lp])

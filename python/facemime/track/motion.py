@@ -99,10 +99,13 @@ class HeadMotion:
         return np.zeros((0, 2), np.float32) if pts is None else pts.reshape(-1, 2).astype(np.float32)
 
     def _inside(self, pts: np.ndarray) -> np.ndarray:
+        """Which of ``pts`` (N, 2) lie in a zone (convex quadrilaterals, either winding)."""
         inside = np.zeros(len(pts), bool)
         for poly in self._zones:
-            c = poly.astype(np.float32).reshape(-1, 1, 2)
-            inside |= np.array([cv2.pointPolygonTest(c, (float(x), float(y)), False) >= 0 for x, y in pts], bool)
+            edges = np.roll(poly, -1, axis=0) - poly
+            rel = pts[:, None, :] - poly[None]
+            cross = edges[None, :, 0] * rel[..., 1] - edges[None, :, 1] * rel[..., 0]
+            inside |= (cross >= 0).all(axis=1) | (cross <= 0).all(axis=1)
         return inside
 
     def _crop_box(self, shape: tuple[int, ...], extra: np.ndarray) -> tuple[int, int, int, int]:

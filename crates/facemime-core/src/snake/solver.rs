@@ -144,28 +144,21 @@ impl Problem {
 
     /// Runs the solver on one frame.
     pub fn solve(&self, input: &FrameInput<'_>) -> Result<Solution> {
-        self.check(input)?;
-        let chords: Vec<f64> = self
-            .curves
-            .iter()
-            .map(|(idx, _)| chord2(idx, input.rest, input.start))
-            .collect();
+        let mut ws = self.workspace(input)?;
         let mut knots = input.start.to_vec();
-        let mut grad = vec![[0.0; 2]; self.n_knots];
-        let mut response = vec![0.0; self.curves.len()];
         let [xmax, ymax] = [input.bounds[0] - 1.0, input.bounds[1] - 1.0];
-        let mut energy = self.evaluate(&knots, input, &chords, &mut grad, &mut response);
+        let mut energy = self.evaluate(&knots, input, &mut ws);
         let s = &self.settings;
         let mut step = s.delta0;
         let mut iterations = 0;
         while iterations < s.iterations {
-            for (k, g) in knots.iter_mut().zip(&grad) {
+            for (k, g) in knots.iter_mut().zip(&ws.grad) {
                 k[0] = (k[0] - step * sign(g[0])).clamp(0.0, xmax);
                 k[1] = (k[1] - step * sign(g[1])).clamp(0.0, ymax);
             }
             step *= s.sigma;
             iterations += 1;
-            let e = self.evaluate(&knots, input, &chords, &mut grad, &mut response);
+            let e = self.evaluate(&knots, input, &mut ws);
             let change = (e - energy).abs();
             energy = e;
             if change < s.tol {
@@ -176,44 +169,53 @@ impl Problem {
             knots,
             iterations,
             energy,
-            response,
+            response: ws.response,
         })
     }
 
     /// Total energy and each curve's mean H at the starting knots, without moving them.
     pub fn evaluate_start(&self, input: &FrameInput<'_>) -> Result<(f64, Vec<f64>)> {
-        self.check(input)?;
-        let chords: Vec<f64> = self
-            .curves
-            .iter()
-            .map(|(idx, _)| chord2(idx, input.rest, input.start))
-            .collect();
-        let mut grad = vec![[0.0; 2]; self.n_knots];
-        let mut response = vec![0.0; self.curves.len()];
-        let e = self.evaluate(input.start, input, &chords, &mut grad, &mut response);
-        Ok((e, response))
+        let mut ws = self.workspace(input)?;
+        let e = self.evaluate(input.start, input, &mut ws);
+        Ok((e, ws.response))
     }
 
-    /// Total energy at `knots`; writes its gradient into `grad` and each curve's mean H.
-    fn evaluate(
-        &self,
-        knots: &[P2],
-        input: &FrameInput<'_>,
-        chords: &[f64],
-        grad: &mut [P2],
-        response: &mut [f64],
-    ) -> f64 {
-        grad.iter_mut().for_each(|g| *g = [0.0; 2]);
+    /// Checks a frame's input and allocates the buffers one solve needs (once per frame).
+    fn workspace(&self, input: &FrameInput<'_>) -> Result<Workspace> {
+        self.check(input)?;
+        Ok(Workspace {
+            chords: self
+                .curves
+                .iter()
+                .map(|(idx, _)| chord2(idx, input.rest, input.start))
+                .collect(),
+            grad: vec![[0.0; 2]; self.n_knots],
+            response: vec![0.0; self.curves.len()],
+        })
+    }
+
+    /// Total energy at `knots`; writes its gradient and each curve's mean H into `ws`.
+    fn evaluate(&self, knots: &[P2], input: &FrameInput<'_>, ws: &mut Workspace) -> f64 {
+        ws.grad.iter_mut().for_each(|g| *g = [0.0; 2]);
         let n = self.settings.points_per_segment;
         let mut e = 0.0;
         for (c, (idx, p)) in self.curves.iter().enumerate() {
-            e += energy::internal(idx, knots, input.rest, input.start, p, n, chords[c], grad);
-            let (ei, h) = energy::image(idx, knots, &input.field, p, n, input.down, grad);
+            e += energy::internal(
+                idx,
+                knots,
+                input.rest,
+                input.start,
+                p,
+                n,
+                ws.chords[c],
+                &mut ws.grad,
+            );
+            let (ei, h) = energy::image(idx, knots, &input.field, p, n, input.down, &mut ws.grad);
             e += ei;
-            response[c] = h;
+            ws.response[c] = h;
         }
         for (q, &target) in self.pairs.iter().zip(input.pair_targets) {
-            e += energy::pair(q, target, knots, input.down, grad);
+            e += energy::pair(q, target, knots, input.down, &mut ws.grad);
         }
         e
     }
@@ -252,6 +254,13 @@ impl Problem {
         }
         Ok(())
     }
+}
+
+/// Per-solve buffers: each curve's Δ², the energy gradient per knot, each curve's mean H.
+struct Workspace {
+    chords: Vec<f64>,
+    grad: Vec<P2>,
+    response: Vec<f64>,
 }
 
 fn sign(v: f64) -> f64 {
