@@ -25,6 +25,19 @@ def coverage(
     height: int,
 ) -> npt.NDArray[np.uint32]: ...
 
+def elastic_adjust(
+    points: npt.NDArray[np.float64],
+    chains: npt.NDArray[np.uint32],
+    chain_lengths: npt.NDArray[np.uint32],
+    targets: npt.NDArray[np.float64],
+    target_lengths: npt.NDArray[np.uint32],
+    psi: float,
+    shrink: float,
+    epsilon: float,
+    iterations: int,
+    tolerance: float,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+
 FIELD_CHANNELS: int
 
 class SnakeSolver:

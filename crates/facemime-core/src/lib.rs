@@ -6,6 +6,7 @@
 //!   pixel, so pixel centres sit on integer coordinates.
 //! - Depth is a float along the view direction, **larger = nearer the camera**.
 
+pub mod adjust;
 pub mod error;
 pub mod raster;
 pub mod snake;

@@ -3,6 +3,7 @@
 
 use pyo3::prelude::*;
 
+mod adjust;
 mod error;
 mod raster;
 mod snake;
@@ -10,6 +11,7 @@ mod snake;
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    adjust::register(m)?;
     raster::register(m)?;
     snake::register(m)?;
     Ok(())

@@ -147,6 +147,33 @@ def _parse_head(text: str, where: str) -> HeadModel:
         doc = json.loads(text)
     except json.JSONDecodeError as e:
         raise ModelFormatError(f"{where}: not valid JSON ({e.msg} at line {e.lineno})") from None
+    return head_from_document(doc, where)
+
+
+def head_document(model: HeadModel) -> dict:
+    """``model`` as a ``facemime.head/1`` document (JSON-ready; floats kept exactly)."""
+    units = {
+        name: {
+            "description": model.descriptions.get(name, ""),
+            "displacements": [[int(i), *d[i].tolist()] for i in np.flatnonzero(np.abs(d).max(axis=1) > 0)],
+        }
+        for name, d in model.units.items()
+    }
+    return {
+        "format": HEAD_FORMAT,
+        "name": model.name,
+        "unit": model.unit,
+        "vertices": model.vertices.tolist(),
+        "triangles": model.triangles.tolist(),
+        "uv": None if model.uv is None else model.uv.tolist(),
+        "groups": {k: g.tolist() for k, g in model.groups.items()},
+        "deformation_units": units,
+    }
+
+
+def head_from_document(doc: object, where: str) -> HeadModel:
+    """Validate a parsed ``facemime.head/1`` document and build the model; a
+    :class:`ModelFormatError` naming ``where`` and the problem otherwise."""
     if not isinstance(doc, dict) or doc.get("format") != HEAD_FORMAT:
         found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
         raise ModelFormatError(f"{where}: expected format {HEAD_FORMAT!r}, got {found!r}")

@@ -306,6 +306,12 @@ class Tracker:
         return bool(0.5 * rest_chord <= chord <= 2.0 * rest_chord)
 
     @property
+    def edges(self) -> dict[str, np.ndarray]:
+        """The first frame's contours as settled on the image edges (no calibration offset
+        taken out), name -> (N, 2) float64 pixels."""
+        return {n: self._knots0[self._index[n]].copy() for n in CONTOUR_NAMES}
+
+    @property
     def contours(self) -> dict[str, np.ndarray]:
         """The current contours, name -> (N, 2) float64 pixels."""
         out = self._knots - self._offset @ self._linear.T

@@ -1,0 +1,12 @@
+"""Fitting the generic head to one person (method.md §2): reference points (from a file or found
+automatically), placement and elastic adjustment, texture smearing, and the resulting actor."""
+
+from facemime.fit.auto import AutoPoints, auto_points
+from facemime.fit.detect import FaceDetection, NoFaceError, detect_face
+from facemime.fit.placement import Fit, fit_model, frontal_pose
+from facemime.fit.points import GROUPS, NAMES, REQUIRED, ReferencePoints, check_points, model_chain
+
+__all__ = [
+    "AutoPoints", "auto_points", "FaceDetection", "NoFaceError", "detect_face", "Fit", "fit_model",
+    "frontal_pose", "GROUPS", "NAMES", "REQUIRED", "ReferencePoints", "check_points", "model_chain",
+]

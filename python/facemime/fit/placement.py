@@ -1,0 +1,105 @@
+"""Placing and elastically adjusting a head model on reference points (method.md §2).
+
+The model is seen frontally (yaw = pitch = 0) under the orthographic projection of
+:mod:`facemime.render.projection`: a :class:`~facemime.render.projection.Pose` with a roll, a
+scale (pixels per model unit) and a translation maps it onto the photo.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from facemime import _core
+from facemime.fit.points import POINTS, ReferencePoints, model_chain
+from facemime.model.head import HeadModel
+from facemime.render.projection import Pose, project, rotation_matrix
+
+#: Elastic adjustment settings: initial rigidity ψ as a fraction of the inter-ocular distance,
+#: its shrink factor per iteration, ε, most iterations, and the stop threshold (fraction of the
+#: inter-ocular distance) on the mean contour disagreement.
+PSI = 0.6
+SHRINK = 0.55
+EPSILON = 2.0
+ITERATIONS = 8
+TOLERANCE = 0.004
+
+
+def model_iod(model: HeadModel) -> float:
+    """Distance between the model's outer eye corners, model units."""
+    g = model.groups
+    return float(np.linalg.norm(model.vertices[g["eye_right"][0], :2] - model.vertices[g["eye_left"][4], :2]))
+
+
+def frontal_pose(model_points: np.ndarray, image_points: np.ndarray) -> Pose:
+    """The frontal pose (roll, scale, translation) that best maps (K, 3) model points onto
+    (K, 2) image points, least squares; K >= 2.
+
+    >>> frontal_pose(np.array([[-45.0, 0, 0], [45, 0, 0]]), np.array([[100.0, 50], [190, 50]]))
+    Pose(yaw=0.0, pitch=0.0, roll=-0.0, scale=1.0, tx=145.0, ty=50.0)
+    """
+    q = model_points[:, 0] - 1j * model_points[:, 1]  # image orientation: y down
+    p = image_points[:, 0] + 1j * image_points[:, 1]
+    qc, pc = q - q.mean(), p - p.mean()
+    z = (np.conj(qc) @ pc) / max(float(np.vdot(qc, qc).real), 1e-12)
+    t = p.mean() - z * q.mean()
+    return Pose(roll=float(-np.degrees(np.angle(z))), scale=float(abs(z)), tx=float(t.real), ty=float(t.imag))
+
+
+@dataclass(frozen=True)
+class Fit:
+    """A head model fitted to a photo.
+
+    Attributes
+    ----------
+    vertices : (N, 3) float64 array
+        The adjusted vertices, model units, in the model's own frame (frontal, upright).
+    pose : Pose
+        Maps ``vertices`` onto the photo (frontal: only roll, scale, translation).
+    residuals : (I + 1,) float64 array
+        Mean contour disagreement before and after each elastic iteration, pixels.
+    """
+
+    vertices: np.ndarray
+    pose: Pose
+    residuals: np.ndarray
+
+
+def fit_model(model: HeadModel, points: ReferencePoints) -> Fit:
+    """Scale and place ``model`` on validated reference ``points`` (see
+    :func:`facemime.fit.points.check_points`), then adjust it elastically until its contours
+    lie on theirs.
+
+    The placement is the least-squares similarity of the single points and the curve ends; the
+    adjusted image positions are taken back into model space through it, so proportions that
+    differ from the generic head (a longer face, a wider mouth) stay in the vertices.
+    """
+    anchors_m, anchors_i = [], []
+    for name, pts in points.items():
+        chain = model_chain(model, name)
+        if name in POINTS:
+            anchors_m.append(model.vertices[chain])
+            anchors_i.append(pts)
+        elif name != "face_outline":
+            anchors_m.append(model.vertices[chain[[0, -1]]])
+            anchors_i.append(pts[[0, -1]])
+    pose = frontal_pose(np.concatenate(anchors_m), np.concatenate(anchors_i))
+    start = project(model.vertices, pose)[0]
+    names = list(points)
+    chains = [model_chain(model, n) for n in names]
+    iod = pose.scale * model_iod(model)
+    adjusted, residuals = _core.elastic_adjust(
+        np.ascontiguousarray(start),
+        np.concatenate(chains).astype(np.uint32),
+        np.array([len(c) for c in chains], np.uint32),
+        np.ascontiguousarray(np.concatenate([points[n] for n in names])),
+        np.array([len(points[n]) for n in names], np.uint32),
+        PSI * iod, SHRINK, EPSILON, ITERATIONS, TOLERANCE * iod,
+    )
+    # Back to model space: undo translation, scale and roll; depth stays the generic one.
+    rot = rotation_matrix(roll=pose.roll)[:2, :2]
+    local = np.column_stack([adjusted[:, 0] - pose.tx, pose.ty - adjusted[:, 1]]) / pose.scale
+    vertices = model.vertices.copy()
+    vertices[:, :2] = local @ rot  # rot is orthonormal: rot.T undoes it (row vectors)
+    return Fit(vertices, pose, residuals)

@@ -1,0 +1,84 @@
+"""Reference points of a frontal face: the named points and curves the model is fitted to.
+
+Points are (x, y) pixels of the photo, x right, y down, (0, 0) at the centre of the top-left
+pixel. Each name maps to a chain of generic-head vertices (``model_chain``): a single point is a
+chain of one vertex, a curve is ordered like the model group of the same name (image-left to
+image-right for the mouth and brow curves of :data:`facemime.track.CONTOUR_NAMES`, clockwise
+from the forehead top for ``face_outline``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from facemime.errors import InvalidInputError
+from facemime.model.head import HeadModel
+from facemime.track.contours import CONTOUR_NAMES
+
+#: Single points -> (model group, position in the group).
+POINTS = {
+    "eye_right_outer": ("eye_right", 0),  # subject's right eye: image left
+    "eye_right_inner": ("eye_right", 4),
+    "eye_left_inner": ("eye_left", 0),
+    "eye_left_outer": ("eye_left", 4),
+    "nose_tip": ("nose", 6),
+    "chin": ("face_outline", 9),
+}
+#: Curves, named like the model groups they follow.
+CURVES = CONTOUR_NAMES + ("face_outline",)
+#: Every name a reference-point set may hold.
+NAMES = tuple(POINTS) + CURVES
+#: Names a set must hold: enough to place and scale the model.
+REQUIRED = ("eye_right_outer", "eye_right_inner", "eye_left_inner", "eye_left_outer",
+            "mouth_outer_upper", "mouth_outer_lower")
+#: The point groups accuracy is reported for (README of the shared data): name -> members.
+GROUPS = {
+    "eye_corners": ("eye_right_outer", "eye_right_inner", "eye_left_inner", "eye_left_outer"),
+    "brows": ("brow_left_upper", "brow_left_lower", "brow_right_upper", "brow_right_lower"),
+    "mouth": CONTOUR_NAMES[:4],
+}
+
+ReferencePoints = dict[str, np.ndarray]
+
+
+def model_chain(model: HeadModel, name: str) -> np.ndarray:
+    """The model vertex indices that reference point or curve ``name`` marks: (K,) int64."""
+    if name in POINTS:
+        group, at = POINTS[name]
+        return model.groups[group][[at]]
+    if name in CURVES:
+        return model.groups[name]
+    raise InvalidInputError(f"unknown reference point {name!r}; known: {', '.join(NAMES)}")
+
+
+def check_points(points: Mapping[str, object], width: int, height: int, where: str = "points") -> ReferencePoints:
+    """Validate a reference-point set for a ``width`` x ``height`` image: known names, the
+    required ones present, single points as (2,) or (1, 2), curves as (K >= 2, 2), all inside
+    the image. Returns name -> (K, 2) float64 arrays."""
+    if not isinstance(points, Mapping):
+        raise InvalidInputError(f"{where} must map point names to [x, y] positions, got {type(points).__name__}")
+    unknown = [n for n in points if n not in NAMES]
+    if unknown:
+        raise InvalidInputError(f"{where}: unknown point {', '.join(map(str, unknown))}; known: {', '.join(NAMES)}")
+    missing = [n for n in REQUIRED if n not in points]
+    if missing:
+        raise InvalidInputError(f"{where}: missing {', '.join(missing)}")
+    out: ReferencePoints = {}
+    for name, raw in points.items():
+        try:
+            arr = np.atleast_2d(np.asarray(raw, dtype=np.float64))
+        except (TypeError, ValueError):
+            arr = np.empty((0, 0))
+        if arr.ndim != 2 or arr.shape[1] != 2 or len(arr) == 0 or not np.isfinite(arr).all():
+            raise InvalidInputError(f"{where}: {name} must be [x, y] numbers or a list of them")
+        if name in POINTS and len(arr) != 1:
+            raise InvalidInputError(f"{where}: {name} is a single point [x, y], got {len(arr)} points")
+        if name in CURVES and len(arr) < 2:
+            raise InvalidInputError(f"{where}: {name} is a curve and needs at least 2 points, got {len(arr)}")
+        if (arr < -0.5).any() or (arr[:, 0] > width - 0.5).any() or (arr[:, 1] > height - 0.5).any():
+            raise InvalidInputError(f"{where}: {name} has points outside the {width}x{height} image")
+        out[name] = arr
+    return out
+
