@@ -67,7 +67,7 @@ def test_track_a_real_video_clip(tmp_path, capsys, shared):
 @pytest.mark.parametrize(
     ("setup", "message"),
     [
-        ("no-init", "--init INIT.json is needed"),
+        ("no-face", "no face found in the first frame of face.mp4; pass the contours with --init INIT.json"),
         ("missing-video", "video missing.mp4 does not exist"),
         ("not-a-video", "cannot read video notvideo.mp4"),
         ("bad-json", "init.json is not valid JSON"),
@@ -82,7 +82,7 @@ def test_bad_input_gives_one_line_and_leaves_nothing(tmp_path, capsys, monkeypat
     video, init = synthetic_video
     doc = json.loads(init.read_text())
     args = ["track", str(video.name), "--init", "init.json", "--out", "out.json", "--overlay", "o.mp4"]
-    if setup == "no-init":
+    if setup == "no-face":
         args = ["track", str(video.name), "--out", "out.json"]
     elif setup == "missing-video":
         args[1] = "missing.mp4"

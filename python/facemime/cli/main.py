@@ -10,7 +10,7 @@ from pathlib import Path
 import click
 
 from facemime import __version__
-from facemime.errors import FacemimeError, InvalidInputError
+from facemime.errors import FacemimeError
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -66,7 +66,8 @@ def model_preview(model: Path | None, out_file: Path, force: bool) -> None:
 @cli.command()
 @click.argument("video", type=click.Path(path_type=Path))
 @click.option("--init", "init", type=click.Path(path_type=Path),
-              help="facemime.init/1 JSON with the eight contours of the first tracked frame.")
+              help="facemime.init/1 JSON with the eight contours of the first tracked frame "
+                   "(default: found automatically on the first frame).")
 @click.option("--out", "out_file", type=click.Path(path_type=Path), required=True, help="facemime.track/1 JSON to write.")
 @click.option("--overlay", type=click.Path(path_type=Path), help="Also write the video with the contours drawn (.mp4 or .webm).")
 @click.option("--force", is_flag=True, help="Overwrite existing output files.")
@@ -74,9 +75,6 @@ def track(video: Path, init: Path | None, out_file: Path, overlay: Path | None, 
     """Track the mouth and eyebrow contours through VIDEO with STB-snakes."""
     from facemime.track.video import track_video
 
-    if init is None:
-        raise InvalidInputError("--init INIT.json is needed: automatic initialisation of the contours "
-                                "is not available yet")
     run = track_video(video, init, out_file, overlay, force)
     click.echo(str(out_file))
     if overlay is not None:
@@ -84,6 +82,27 @@ def track(video: Path, init: Path | None, out_file: Path, overlay: Path | None, 
     fps = run.frames / max(run.seconds, 1e-9)
     lost = f", {run.frames_with_lost} with a lost feature" if run.frames_with_lost else ""
     click.echo(f"tracked {run.frames} frames at {fps:.0f} frames/s (decoding excluded){lost}", err=True)
+
+
+@cli.command()
+@click.argument("source", metavar="IMAGE_OR_VIDEO", type=click.Path(path_type=Path))
+@click.option("--frame", default=0, show_default=True, help="Frame of a video to fit on (0-based).")
+@click.option("--points", "points_file", type=click.Path(path_type=Path),
+              help="facemime.points/1 JSON with reference points marked by hand (default: found automatically).")
+@click.option("--out", "out_file", type=click.Path(path_type=Path), required=True,
+              help="NAME.actor to write; the preview goes to NAME.png.")
+@click.option("--force", is_flag=True, help="Overwrite existing output files.")
+def fit(source: Path, frame: int, points_file: Path | None, out_file: Path, force: bool) -> None:
+    """Fit the generic head to the frontal face in IMAGE_OR_VIDEO: reference points, elastic
+    adjustment, texture; write the actor file and a preview PNG."""
+    from facemime.fit.run import fit_file
+
+    run = fit_file(source, out_file, frame, points_file, force)
+    for w in run.warnings:
+        click.echo(f"facemime: warning: {w}", err=True)
+    for f in run.files:
+        click.echo(str(f))
+    click.echo(f"fitted in {run.seconds:.2f} s; the model's contours end {run.residual:.2f} px from the points", err=True)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -14,6 +14,9 @@ import numpy as np
 
 from facemime.errors import FacemimeError
 
+#: Another face counts (for the several-faces warning) when at least this fraction of the
+#: chosen face's width.
+MIN_OTHER_FACE = 0.4
 #: Where the eye centres sit in a frontal-face box of the default cascade, as fractions of the
 #: box width (measured on the first frames of the six shared videos: 0.32-0.36, 0.65-0.71 across,
 #: 0.33-0.43 down).
@@ -25,7 +28,7 @@ EYE_ANGLES = (0.0, -8.0, 8.0, -14.0, 14.0)
 #: Hits closer than this (fraction of the box width) count as the same eye.
 EYE_CLUSTER = 0.05
 #: Plausible distance between the eye centres, fractions of the box width.
-EYE_GAP = (0.27, 0.40)
+EYE_GAP = (0.26, 0.52)
 
 
 class NoFaceError(FacemimeError, ValueError):
@@ -41,7 +44,8 @@ class FaceDetection:
     box : (4,) int array
         (x, y, w, h) of the largest frontal face, pixels.
     faces : int
-        How many faces were found (the largest is used).
+        How many faces were found (the largest is used; hits under MIN_OTHER_FACE of its
+        width are not counted).
     eyes : (2, 2) float64 array
         Eye centres, (x, y) pixels, image-left eye first.
     eyes_found : bool
@@ -79,7 +83,8 @@ def detect_face(rgb: np.ndarray) -> FaceDetection:
         raise NoFaceError("no face found")
     box = faces[np.argmax(faces[:, 2] * faces[:, 3])]
     eyes, found = _eyes(gray, box)
-    return FaceDetection(box, len(faces), eyes, found)
+    count = int((faces[:, 2] >= MIN_OTHER_FACE * box[2]).sum())  # smaller hits are mostly false alarms
+    return FaceDetection(box, count, eyes, found)
 
 
 def _distinct(boxes: np.ndarray) -> np.ndarray:

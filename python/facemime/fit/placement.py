@@ -19,8 +19,8 @@ from facemime.render.projection import Pose, project, rotation_matrix
 #: Elastic adjustment settings: initial rigidity ψ as a fraction of the inter-ocular distance,
 #: its shrink factor per iteration, ε, most iterations, and the stop threshold (fraction of the
 #: inter-ocular distance) on the mean contour disagreement.
-PSI = 0.6
-SHRINK = 0.55
+PSI = 0.3
+SHRINK = 0.4
 EPSILON = 2.0
 ITERATIONS = 8
 TOLERANCE = 0.004

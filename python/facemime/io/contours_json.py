@@ -31,7 +31,7 @@ class ContourFileError(FacemimeError, ValueError):
     """An init or track JSON file is malformed."""
 
 
-def _load_json(path: str | Path, what: str) -> Any:
+def load_json(path: str | Path, what: str) -> Any:
     p = Path(path)
     if not p.is_file():
         raise InputFileError(f"{what} file {p} does not exist" if not p.exists() else f"{what} file {p} is not a file")
@@ -73,7 +73,7 @@ def _contours(doc: Mapping[str, Any], where: str, size: tuple[int, int] | None, 
 def read_init(path: str | Path, size: tuple[int, int] | None = None) -> tuple[int, Contours]:
     """Read a ``facemime.init/1`` file; returns (frame index, contours). With ``size``
     (width, height) every point must lie inside the image."""
-    doc = _load_json(path, "init")
+    doc = load_json(path, "init")
     where = str(path)
     if not isinstance(doc, dict) or doc.get("format") != INIT_FORMAT:
         found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
@@ -118,7 +118,7 @@ def write_json(path: str | Path, doc: Mapping[str, Any]) -> Path:
 
 def read_track(path: str | Path) -> tuple[dict[str, Any], dict[int, Contours]]:
     """Read a ``facemime.track/1`` file; returns (video info, frame index -> contours)."""
-    doc = _load_json(path, "track")
+    doc = load_json(path, "track")
     where = str(path)
     if not isinstance(doc, dict) or doc.get("format") != TRACK_FORMAT:
         found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__

@@ -10,6 +10,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from facemime.errors import InputFileError, InvalidInputError
+from facemime.fit.detect import NoFaceError
+from facemime.fit.run import fit_actor, init_contours
 from facemime.io.contours_json import read_init, track_document, write_json
 from facemime.io.outputs import check_outputs
 from facemime.io.video import CODECS, VideoReader, VideoWriter
@@ -29,18 +31,19 @@ class TrackRun:
     frames_with_lost: int
 
 
-def track_video(video: str | Path, init: str | Path, out: str | Path, overlay: str | Path | None = None,
+def track_video(video: str | Path, init: str | Path | None, out: str | Path, overlay: str | Path | None = None,
                 force: bool = False, params: TrackerParams | None = None) -> TrackRun:
     """Track ``video`` from the contours in ``init`` (``facemime.init/1``) and write ``out``
     (``facemime.track/1``) and, if given, the ``overlay`` video. Existing outputs are refused
-    unless ``force``."""
+    unless ``force``. Without ``init`` an actor is fitted automatically on the first frame and
+    its projected mouth and brow vertices start the tracker."""
     out = Path(out)
     outputs = [out] + ([Path(overlay)] if overlay is not None else [])
     if overlay is not None and Path(overlay).suffix.lower() not in CODECS:
         raise InvalidInputError(f"overlay video must end in .mp4 or .webm, got {Path(overlay).name!r}")
     check_outputs(outputs, force)
     with VideoReader(video) as reader:
-        start, contours = read_init(init, size=(reader.width, reader.height))
+        start, contours = read_init(init, size=(reader.width, reader.height)) if init is not None else (0, None)
         writer = VideoWriter(overlay, reader.fps) if overlay is not None else None
         frames: list[dict] = []
         tracker: Tracker | None = None
@@ -54,6 +57,11 @@ def track_video(video: str | Path, init: str | Path, out: str | Path, overlay: s
                     continue
                 t0 = time.perf_counter()
                 if tracker is None:
+                    if contours is None:
+                        try:
+                            contours = init_contours(fit_actor(frame, f"the first frame of {video}")[0])
+                        except NoFaceError as e:
+                            raise NoFaceError(f"{e}; pass the contours with --init INIT.json") from None
                     tracker = Tracker(frame, contours, params)
                     result = FrameResult(index, tracker.contours, {f: 1.0 for f in FEATURES})
                 else:

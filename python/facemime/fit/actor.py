@@ -1,0 +1,77 @@
+"""The actor: a head model fitted to one person, with that person's face smeared on it as texture.
+
+Model coordinates are the generic head's (right-handed, x to the subject's left, y up, z towards
+the camera, millimetres for the built-in head). Texture coordinates are in [0, 1] from the
+texture's top-left corner; texel (i, j) has its centre at ((i + 0.5) / W, (j + 0.5) / H).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import cv2
+import numpy as np
+
+from facemime.errors import InvalidInputError
+from facemime.fit.placement import Fit
+from facemime.fit.points import ReferencePoints
+from facemime.model.head import HeadModel
+from facemime.render.projection import Pose, project
+
+#: The texture is the photo cropped around the face with this margin (fraction of the face size)
+#: and shrunk, if needed, to at most this many pixels on its longer side.
+TEXTURE_MARGIN = 0.08
+TEXTURE_MAX_SIDE = 1024
+
+
+@dataclass(frozen=True, eq=False)
+class Actor:
+    """A fitted, textured head.
+
+    Attributes
+    ----------
+    model : HeadModel
+        The adjusted model; its ``uv`` address ``texture``.
+    texture : (H, W, 3) uint8 array
+        RGB, the source photo cropped around the face.
+    pose : Pose
+        The frontal pose that maps ``model.vertices`` onto the source photo.
+    source : dict
+        Where the face came from: ``file`` (name only), ``frame``, ``width``, ``height``.
+    points : dict of str -> (K, 2) float64 array
+        The reference points the model was fitted to, pixels of the source photo.
+    """
+
+    model: HeadModel
+    texture: np.ndarray
+    pose: Pose
+    source: dict = field(default_factory=dict)
+    points: ReferencePoints = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        t = self.texture
+        if not (isinstance(t, np.ndarray) and t.dtype == np.uint8 and t.ndim == 3 and t.shape[2] == 3 and min(t.shape[:2]) >= 1):
+            raise InvalidInputError(f"actor texture must be an (H, W, 3) uint8 image, got {getattr(t, 'shape', type(t).__name__)}")
+        if self.model.uv is None:
+            raise InvalidInputError("actor model needs texture coordinates (uv)")
+
+
+def smear_texture(model: HeadModel, photo: np.ndarray, fit: Fit, points: ReferencePoints, source: dict) -> Actor:
+    """Build the actor: ``model`` with ``fit``'s vertices, textured by ``photo`` ((H, W, 3) uint8
+    RGB) — each vertex's texture coordinate is where it projects in the photo (method.md §2.4)."""
+    h, w = photo.shape[:2]
+    px = project(fit.vertices, fit.pose)[0]
+    lo, hi = px.min(axis=0), px.max(axis=0)
+    pad = TEXTURE_MARGIN * (hi - lo).max()
+    x0, y0 = (int(np.clip(np.floor(v), 0, n - 1)) for v, n in zip(lo - pad, (w, h)))
+    x1, y1 = (int(np.clip(np.ceil(v), 1, n)) for v, n in zip(hi + pad, (w, h)))
+    if x1 - x0 < 8 or y1 - y0 < 8:
+        raise InvalidInputError(f"the fitted face covers only {x1 - x0}x{y1 - y0} pixels of the image")
+    crop = photo[y0:y1, x0:x1]
+    shrink = min(1.0, TEXTURE_MAX_SIDE / max(crop.shape[:2]))
+    if shrink < 1.0:
+        crop = cv2.resize(crop, (max(1, round(crop.shape[1] * shrink)), max(1, round(crop.shape[0] * shrink))),
+                          interpolation=cv2.INTER_AREA)
+    uv = np.clip((px - [x0, y0] + 0.5) / [x1 - x0, y1 - y0], 0.0, 1.0)
+    adjusted = replace(model, vertices=fit.vertices, uv=uv, name=f"{source.get('file', 'photo')} actor")
+    return Actor(adjusted, np.ascontiguousarray(crop), fit.pose, dict(source), {k: np.asarray(v, float) for k, v in points.items()})

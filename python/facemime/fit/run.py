@@ -1,0 +1,90 @@
+"""Fitting an actor from a file: ``facemime fit`` and the tracker's automatic initialisation."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from facemime.errors import InvalidInputError
+from facemime.fit.actor import Actor, smear_texture
+from facemime.fit.auto import auto_points
+from facemime.fit.detect import NoFaceError
+from facemime.fit.placement import fit_model
+from facemime.fit.preview import preview_sheet
+from facemime.model.head import HeadModel, generic_head
+from facemime.render.projection import project
+from facemime.track.contours import CONTOUR_NAMES
+
+
+@dataclass
+class FitRun:
+    """What :func:`fit_file` made: the actor, the files written, warnings for the user, the
+    seconds spent finding points and fitting (reading and writing excluded), and how far the
+    adjusted model's contours still are from the points (pixels)."""
+
+    actor: Actor
+    files: list[Path]
+    warnings: list[str] = field(default_factory=list)
+    seconds: float = 0.0
+    residual: float = 0.0
+
+
+def fit_actor(photo: np.ndarray, name: str, points: dict | None = None, frame: int = 0,
+              model: HeadModel | None = None) -> tuple[Actor, list[str], float]:
+    """Fit ``model`` (default: the generic head) to ``photo`` ((H, W, 3) uint8 RGB) on the given
+    validated reference ``points`` or, without them, on points found automatically. ``name`` is
+    the photo's file name, for messages and the actor's metadata. Returns the actor, warnings
+    (several faces, eyes not confirmed) and the final contour residual (pixels)."""
+    model = model or generic_head()
+    warnings: list[str] = []
+    if points is None:
+        try:
+            found = auto_points(photo, model)
+        except NoFaceError:
+            raise NoFaceError(f"no face found in {name}") from None
+        points = found.points
+        if found.detection.faces > 1:
+            warnings.append(f"{found.detection.faces} faces found in {name}; fitting the largest")
+        if not found.detection.eyes_found:
+            warnings.append(f"the eyes in {name} were placed from the face box alone; check the preview")
+    fit = fit_model(model, points)
+    source = {"file": Path(name).name, "frame": int(frame), "width": int(photo.shape[1]), "height": int(photo.shape[0])}
+    return smear_texture(model, photo, fit, points, source), warnings, float(fit.residuals[-1])
+
+
+def fit_file(source: str | Path, out: str | Path, frame: int = 0, points_file: str | Path | None = None,
+             force: bool = False) -> FitRun:
+    """Fit an actor to ``source`` (an image, or frame ``frame`` of a video) and write ``out``
+    (``NAME.actor``) and its preview ``NAME.png``; existing files are refused unless ``force``."""
+    from facemime.io.actor_file import save_actor
+    from facemime.io.outputs import check_outputs, write_image
+    from facemime.io.photo import read_photo
+    from facemime.io.points_json import read_points
+
+    out = Path(out)
+    if out.suffix.lower() != ".actor":
+        raise InvalidInputError(f"the actor file name must end in .actor, got {out.name!r}")
+    preview = out.with_suffix(".png")
+    check_outputs([out, preview], force)
+    photo = read_photo(source, frame)
+    points = read_points(points_file, (photo.shape[1], photo.shape[0])) if points_file is not None else None
+    t0 = time.perf_counter()
+    try:
+        actor, warnings, residual = fit_actor(photo, str(source), points, frame)
+    except NoFaceError as e:
+        raise NoFaceError(f"{e}; mark the face by hand and pass the points with --points POINTS.json "
+                          "(format facemime.points/1)") from None
+    seconds = time.perf_counter() - t0
+    save_actor(out, actor, force)
+    write_image(preview, preview_sheet(actor, photo))
+    return FitRun(actor, [out, preview], warnings, seconds, residual)
+
+
+def init_contours(actor: Actor) -> dict[str, np.ndarray]:
+    """The eight tracker contours of ``actor``: its mouth and brow vertices projected onto its
+    source photo, name -> (K, 2) float64 pixels."""
+    points = project(actor.model.vertices, actor.pose)[0]
+    return {n: points[actor.model.groups[n]] for n in CONTOUR_NAMES}

@@ -1,0 +1,28 @@
+"""``facemime.points/1`` files: reference points of a frontal face, marked by hand or by a tool.
+
+``{"format": "facemime.points/1", "points": {"eye_right_outer": [x, y], ...,
+"mouth_outer_upper": [[x, y], ...], ...}}`` — names and required ones in
+:mod:`facemime.fit.points`; (x, y) pixels, origin at the centre of the top-left pixel, y down.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from facemime.errors import InvalidInputError
+from facemime.fit.points import ReferencePoints, check_points
+from facemime.io.contours_json import ContourFileError, load_json
+
+POINTS_FORMAT = "facemime.points/1"
+
+
+def read_points(path: str | Path, size: tuple[int, int]) -> ReferencePoints:
+    """Read and validate a points file for an image of ``size`` = (width, height)."""
+    doc = load_json(path, "points")
+    if not isinstance(doc, dict) or doc.get("format") != POINTS_FORMAT:
+        found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
+        raise ContourFileError(f"{path}: expected format {POINTS_FORMAT!r}, got {found!r}")
+    try:
+        return check_points(doc.get("points"), *size, where=str(path))
+    except InvalidInputError as e:
+        raise ContourFileError(str(e)) from None
