@@ -2,7 +2,14 @@
 
 from pathlib import Path
 
+import numpy as np
 import pytest
+
+from facemime.fit import fit_model
+from facemime.fit.actor import smear_texture
+from facemime.io.video import VideoReader
+from facemime.model import generic_head
+from facemime.track.contours import from_face_mesh
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT.parent / "shared"
@@ -18,3 +25,34 @@ def shared() -> Path:
 @pytest.fixture(scope="session")
 def candide_path(shared: Path) -> Path:
     return shared / "models" / "candide3.wfm"
+
+EYE_CORNERS = {"eye_right_outer": 33, "eye_right_inner": 133, "eye_left_inner": 362, "eye_left_outer": 263}
+
+
+def reference_points(landmarks: np.ndarray) -> dict[str, np.ndarray]:
+    """Reference points from one frame's Face Mesh landmarks (478, 2+), pixels."""
+    pts = {n: landmarks[[i], :2].astype(float) for n, i in EYE_CORNERS.items()}
+    pts |= {"nose_tip": landmarks[[1], :2].astype(float), "chin": landmarks[[152], :2].astype(float)}
+    return pts | from_face_mesh(landmarks)
+
+
+@pytest.fixture(scope="session")
+def points_of():
+    """The function that turns Face Mesh landmarks into reference points."""
+    return reference_points
+
+
+@pytest.fixture(scope="session")
+def lp_d0(shared):
+    """First frame of lp_d0, its reference points and IOD."""
+    frame = next(iter(VideoReader(shared / "video" / "lp_d0.mp4")))
+    z = np.load(shared / "video" / "lp_d0.landmarks.npz")
+    return frame, reference_points(z["landmarks"][0]), float(z["iod"][0])
+
+
+@pytest.fixture(scope="session")
+def actor(lp_d0):
+    """The generic head fitted to lp_d0's first frame on its reference points."""
+    frame, points, _ = lp_d0
+    model = generic_head()
+    return smear_texture(model, frame, fit_model(model, points), points, {"file": "lp_d0.mp4", "frame": 0, "width": 512, "height": 512})

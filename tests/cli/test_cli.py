@@ -8,6 +8,16 @@ import pytest
 from facemime.cli.main import main
 
 
+def first_frames(source, count, path):
+    """A clip of the first ``count`` frames of video ``source``, written (H.264) to ``path``."""
+    from facemime.io.video import VideoWriter
+
+    with av.open(str(source)) as c, VideoWriter(path, fps=25) as w:
+        for _, frame in zip(range(count), c.decode(video=0)):
+            w.write(frame.to_ndarray(format="rgb24"))
+    return path
+
+
 def run(capsys, *args):
     with pytest.raises(SystemExit) as exc:
         main(list(args))

@@ -12,7 +12,7 @@ from facemime.metrics import group_nme
 from facemime.track.contours import GROUPS, from_face_mesh
 from facemime.track.synthetic import band_face
 
-from .test_cli import run
+from .test_cli import first_frames, run
 
 
 @pytest.fixture()
@@ -51,10 +51,7 @@ def test_track_writes_every_frame_and_an_overlay(tmp_path, capsys, synthetic_vid
 def test_track_a_real_video_clip(tmp_path, capsys, shared):
     # The first 30 frames of lp_d0, initialised from the reference, stay on the reference.
     z = np.load(shared / "video" / "lp_d0.landmarks.npz")
-    clip = tmp_path / "clip.mp4"
-    with av.open(str(shared / "video" / "lp_d0.mp4")) as c, VideoWriter(clip, fps=25) as w:
-        for i, frame in zip(range(30), c.decode(video=0)):
-            w.write(frame.to_ndarray(format="rgb24"))
+    clip = first_frames(shared / "video" / "lp_d0.mp4", 30, tmp_path / "clip.mp4")
     init = write_json(tmp_path / "init.json", init_document(0, from_face_mesh(z["landmarks"][0])))
     code, _, err = run(capsys, "track", str(clip), "--init", str(init), "--out", str(tmp_path / "t.json"))
     assert code == 0, err

@@ -104,7 +104,7 @@ fn check(points: &[[f64; 2]], contours: &[Contour], s: &Settings) -> Result<()> 
     if !(s.epsilon > 0.0 && s.epsilon.is_finite()) {
         return invalid!("epsilon must be positive, got {}", s.epsilon);
     }
-    if !(s.tolerance >= 0.0) {
+    if s.tolerance.is_nan() || s.tolerance < 0.0 {
         return invalid!("tolerance must be >= 0, got {}", s.tolerance);
     }
     if points

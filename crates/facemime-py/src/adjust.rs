@@ -36,6 +36,9 @@ fn runs<T: Clone>(name: &str, all: &[T], lengths: &[u32]) -> PyResult<Vec<Vec<T>
     Ok(out)
 }
 
+/// Adjusted points (N, 2) and the residual after each iteration.
+type Adjusted<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
+
 /// points: (N, 2) projected model vertices (pixels); chains + chain_lengths: the model vertex
 /// indices of each contour, concatenated; targets + target_lengths: each contour's target
 /// polyline, concatenated. Returns (adjusted points (N, 2), residuals (iterations + 1,)).
@@ -54,7 +57,7 @@ fn elastic_adjust<'py>(
     epsilon: f64,
     iterations: usize,
     tolerance: f64,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>)> {
+) -> PyResult<Adjusted<'py>> {
     let mut pts = pairs("points", &points)?;
     let chain_list: Vec<usize> = chains.as_array().iter().map(|&i| i as usize).collect();
     let chain_runs = runs("chains", &chain_list, chain_lengths.as_slice()?)?;
