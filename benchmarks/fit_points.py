@@ -22,7 +22,8 @@ import numpy as np
 
 from facemime.fit import auto_points, detect_face, frontal_pose
 from facemime.fit.detect import EYE_PRIOR
-from facemime.fit.points import GROUPS
+from facemime.fit.placement import model_eye_centres
+from facemime.fit.points import GROUPS, model_chain
 from facemime.io.video import VideoReader
 from facemime.metrics import curve_error
 from facemime.model import generic_head
@@ -51,15 +52,9 @@ def group_errors(points: dict[str, np.ndarray], landmarks: np.ndarray, iod: floa
 def box_baseline(frame: np.ndarray) -> dict[str, np.ndarray]:
     """The generic head placed on the eye prior of the face box only."""
     model = generic_head()
-    g = model.groups
     box = detect_face(frame).box
-    eyes = box[:2] + EYE_PRIOR * box[2]
-    centres = np.array([model.vertices[g[e][[0, 4]]].mean(axis=0) for e in ("eye_right", "eye_left")])
-    p = project(model.vertices, frontal_pose(centres, eyes))[0]
-    pts = {n: p[g[n]] for names in GROUPS.values() for n in names if n not in EYE_CORNERS}
-    pts |= {"eye_right_outer": p[g["eye_right"][[0]]], "eye_right_inner": p[g["eye_right"][[4]]],
-            "eye_left_inner": p[g["eye_left"][[0]]], "eye_left_outer": p[g["eye_left"][[4]]]}
-    return pts
+    p = project(model.vertices, frontal_pose(model_eye_centres(model), box[:2] + EYE_PRIOR * box[2]))[0]
+    return {n: p[model_chain(model, n)] for names in GROUPS.values() for n in names}
 
 
 def main() -> None:

@@ -19,8 +19,8 @@ import numpy as np
 
 from facemime.fit.detect import FaceDetection, detect_face
 from facemime.fit.features import locate
-from facemime.fit.placement import frontal_pose, model_iod
-from facemime.fit.points import ReferencePoints
+from facemime.fit.placement import frontal_pose, model_eye_centres, model_iod
+from facemime.fit.points import GROUPS, ReferencePoints, model_chain
 from facemime.model.head import HeadModel, generic_head
 from facemime.render.projection import project
 from facemime.track.contours import CONTOUR_NAMES
@@ -62,8 +62,7 @@ def auto_points(rgb: np.ndarray, model: HeadModel | None = None) -> AutoPoints:
     model = model or generic_head()
     det = detect_face(rgb)
     g = model.groups
-    eye_centres = np.array([model.vertices[g[e][[0, 4]]].mean(axis=0) for e in ("eye_right", "eye_left")])
-    pose = frontal_pose(eye_centres, det.eyes)
+    pose = frontal_pose(model_eye_centres(model), det.eyes)
     p = project(model.vertices, pose)[0]
     iod = pose.scale * model_iod(model)
 
@@ -76,11 +75,7 @@ def auto_points(rgb: np.ndarray, model: HeadModel | None = None) -> AutoPoints:
         found = locate(channel, poly, (rx * iod, ry * iod), max(2.0, band * iod), scales)
         return [found.apply(q, poly.mean(axis=0)) for q in (poly, *others)]
 
-    corners_arr = p[np.concatenate([g["eye_right"][[0, 4]], g["eye_left"][[0, 4]]])]
-    points: ReferencePoints = {
-        "eye_right_outer": corners_arr[[0]], "eye_right_inner": corners_arr[[1]],
-        "eye_left_inner": corners_arr[[2]], "eye_left_outer": corners_arr[[3]],
-    }
+    points: ReferencePoints = {n: p[model_chain(model, n)] for n in GROUPS["eye_corners"]}
     for side in ("left", "right"):
         up, low = f"brow_{side}_upper", f"brow_{side}_lower"
         _, points[up], points[low] = place(dark, _polygon(p, model, up, low), BROW_SEARCH, p[g[up]], p[g[low]])

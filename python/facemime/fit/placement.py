@@ -32,6 +32,11 @@ def model_iod(model: HeadModel) -> float:
     return float(np.linalg.norm(model.vertices[g["eye_right"][0], :2] - model.vertices[g["eye_left"][4], :2]))
 
 
+def model_eye_centres(model: HeadModel) -> np.ndarray:
+    """Midpoints of each eye's corners, image-left eye (the subject's right) first: (2, 3)."""
+    return np.array([model.vertices[model.groups[e][[0, 4]]].mean(axis=0) for e in ("eye_right", "eye_left")])
+
+
 def frontal_pose(model_points: np.ndarray, image_points: np.ndarray) -> Pose:
     """The frontal pose (roll, scale, translation) that best maps (K, 3) model points onto
     (K, 2) image points, least squares; K >= 2.

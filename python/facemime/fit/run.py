@@ -14,6 +14,10 @@ from facemime.fit.auto import auto_points
 from facemime.fit.detect import NoFaceError
 from facemime.fit.placement import fit_model
 from facemime.fit.preview import preview_sheet
+from facemime.io.actor_file import save_actor
+from facemime.io.outputs import check_outputs, write_image
+from facemime.io.photo import read_photo
+from facemime.io.points_json import read_points
 from facemime.model.head import HeadModel, generic_head
 from facemime.render.projection import project
 from facemime.track.contours import CONTOUR_NAMES
@@ -59,11 +63,6 @@ def fit_file(source: str | Path, out: str | Path, frame: int = 0, points_file: s
              force: bool = False) -> FitRun:
     """Fit an actor to ``source`` (an image, or frame ``frame`` of a video) and write ``out``
     (``NAME.actor``) and its preview ``NAME.png``; existing files are refused unless ``force``."""
-    from facemime.io.actor_file import save_actor
-    from facemime.io.outputs import check_outputs, write_image
-    from facemime.io.photo import read_photo
-    from facemime.io.points_json import read_points
-
     out = Path(out)
     if out.suffix.lower() != ".actor":
         raise InvalidInputError(f"the actor file name must end in .actor, got {out.name!r}")

@@ -15,9 +15,7 @@ hostile file gives an :class:`ActorFileError` naming the file and the problem.
 
 from __future__ import annotations
 
-import io
 import json
-import os
 import zipfile
 from pathlib import Path
 
@@ -26,7 +24,7 @@ import numpy as np
 
 from facemime.errors import FacemimeError, InputFileError, InvalidInputError, ModelFormatError
 from facemime.fit.actor import Actor
-from facemime.io.outputs import OutputFileError, check_outputs, temporary_sibling
+from facemime.io.outputs import OutputFileError, atomic_file, check_outputs
 from facemime.model.head import head_document, head_from_document
 from facemime.render.projection import Pose
 
@@ -56,16 +54,9 @@ def save_actor(path: str | Path, actor: Actor, force: bool = False) -> Path:
         "points": {k: np.asarray(v).tolist() for k, v in actor.points.items()},
         "texture": {"width": int(actor.texture.shape[1]), "height": int(actor.texture.shape[0])},
     }
-    tmp = temporary_sibling(path)
-    try:
-        with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
-            z.writestr("actor.json", json.dumps(doc))
-            z.writestr(zipfile.ZipInfo("texture.png"), png.tobytes(), zipfile.ZIP_STORED)
-        os.replace(tmp, path)
-    except OSError as e:
-        raise OutputFileError(f"cannot write {path}: {e.strerror or e}") from None
-    finally:
-        tmp.unlink(missing_ok=True)
+    with atomic_file(path) as tmp, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("actor.json", json.dumps(doc))
+        z.writestr(zipfile.ZipInfo("texture.png"), png.tobytes(), zipfile.ZIP_STORED)
     return path
 
 
@@ -120,10 +111,9 @@ def load_actor(path: str | Path) -> Actor:
 
 
 def _texture(png: bytes, meta: object, where: str) -> np.ndarray:
-    head = np.frombuffer(png[:24], np.uint8)
     if len(png) < 24 or png[:8] != b"\x89PNG\r\n\x1a\n":
         raise ActorFileError(f"{where}: texture.png is not a PNG image")
-    w, h = int.from_bytes(bytes(head[16:20]), "big"), int.from_bytes(bytes(head[20:24]), "big")
+    w, h = int.from_bytes(png[16:20], "big"), int.from_bytes(png[20:24], "big")  # the IHDR size
     if not (1 <= w <= MAX_TEXTURE_SIDE and 1 <= h <= MAX_TEXTURE_SIDE):
         raise ActorFileError(f"{where}: texture is {w}x{h}; at most {MAX_TEXTURE_SIDE} pixels a side are allowed")
     img = cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_COLOR)

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import os
 import tempfile
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import cv2
@@ -64,17 +65,25 @@ def temporary_sibling(path: Path) -> Path:
     return Path(tmp)
 
 
-def write_text(path: str | Path, text: str) -> Path:
-    """Write a UTF-8 text file atomically."""
-    path = Path(path)
+@contextmanager
+def atomic_file(path: Path) -> Iterator[Path]:
+    """Yield a temporary file next to ``path`` to write; when the block ends without an error it
+    replaces ``path`` in one step, otherwise it is removed. OS errors become one line."""
     tmp = temporary_sibling(path)
     try:
-        tmp.write_text(text, encoding="utf-8")
+        yield tmp
         os.replace(tmp, path)
     except OSError as e:
         raise OutputFileError(f"cannot write {path}: {e.strerror or e}") from None
     finally:
         tmp.unlink(missing_ok=True)
+
+
+def write_text(path: str | Path, text: str) -> Path:
+    """Write a UTF-8 text file atomically."""
+    path = Path(path)
+    with atomic_file(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
     return path
 
 
@@ -82,12 +91,8 @@ def write_image(path: str | Path, image: np.ndarray) -> Path:
     """Write an RGB or gray uint8 image (PNG, JPEG, ... by suffix) atomically."""
     path = Path(path)
     check_image_suffix(path)
-    tmp = temporary_sibling(path)
-    try:
+    with atomic_file(path) as tmp:
         bgr = image[..., ::-1] if image.ndim == 3 else image
         if not cv2.imwrite(str(tmp), np.ascontiguousarray(bgr)):
             raise OutputFileError(f"cannot write image {path}")
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
     return path
