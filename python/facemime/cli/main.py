@@ -105,6 +105,49 @@ def fit(source: Path, frame: int, points_file: Path | None, out_file: Path, forc
     click.echo(f"fitted in {run.seconds:.2f} s; the model's contours end {run.residual:.2f} px from the points", err=True)
 
 
+def user_motion_options(f):
+    """The options that add motion on top of the measured one (``run`` and ``view``)."""
+    for opt in reversed((
+        click.option("--yaw", default=0.0, show_default=True, help="Extra head turn, degrees (+: towards the image's right)."),
+        click.option("--pitch", default=0.0, show_default=True, help="Extra head tilt, degrees (+: nose down)."),
+        click.option("--roll", default=0.0, show_default=True, help="Extra in-plane rotation, degrees (+: counter-clockwise)."),
+        click.option("--zoom", default=1.0, show_default=True, help="Factor on the face's size."),
+        click.option("--exaggerate", "gain", default=1.0, show_default=True,
+                     help="Factor on the mouth and brow motion (0: a still face, 2: twice the motion)."),
+    )):
+        f = opt(f)
+    return f
+
+
+@cli.command()
+@click.argument("video", type=click.Path(path_type=Path))
+@click.option("--actor", "actor_file", type=click.Path(path_type=Path),
+              help="NAME.actor to drive (from facemime fit; default: the face fitted on the first frame).")
+@click.option("--out", "out_file", type=click.Path(path_type=Path), required=True,
+              help="Side-by-side video to write (.mp4 or .webm): the original with contours | the synthesised face.")
+@click.option("--track", "track_file", type=click.Path(path_type=Path),
+              help="facemime.track/1 JSON to write: contours, head pose and motion per frame (default: OUT with .json).")
+@user_motion_options
+@click.option("--force", is_flag=True, help="Overwrite existing output files.")
+def run(video: Path, actor_file: Path | None, out_file: Path, track_file: Path | None, yaw: float, pitch: float,
+        roll: float, zoom: float, gain: float, force: bool) -> None:
+    """Analyse the face in VIDEO (fit, track, head pose) and re-synthesise every frame on an actor."""
+    from facemime.animate.run import run_video
+    from facemime.animate.synth import UserMotion
+
+    user = UserMotion(yaw=yaw, pitch=pitch, roll=roll, zoom=zoom, gain=gain)
+    result = run_video(video, out_file, actor_file, track_file, user, force)
+    for w in result.warnings:
+        click.echo(f"facemime: warning: {w}", err=True)
+    for f in result.files:
+        click.echo(str(f))
+    s = result.seconds
+    busy = sum(v for k, v in s.items() if k not in ("encode", "fit"))
+    shares = ", ".join(f"{k} {100 * s[k] / max(busy, 1e-9):.0f}%" for k in ("decode", "track", "pose", "synth", "compose"))
+    missing = f"; no face in {result.frames_without_face} frames" if result.frames_without_face else ""
+    click.echo(f"ran {result.frames} frames at {result.fps:.0f} frames/s (encoding excluded: {shares}){missing}", err=True)
+
+
 def main(argv: list[str] | None = None) -> None:
     """Entry point: run the CLI, turning expected errors into one line on stderr."""
     argv = sys.argv[1:] if argv is None else argv

@@ -4,8 +4,21 @@
 - ``facemime.track/1``: every frame's contours written by a tracker.
 
 Points are (x, y) pixels, origin at the centre of the top-left pixel, y down. ``facemime``
-extends ``facemime.track/1`` compatibly with per-frame ``confidence`` (feature -> 0..1) and
-``lost`` (features whose contours collapsed and were re-initialised in that frame).
+extends ``facemime.track/1`` compatibly with per-frame keys:
+
+- ``confidence``: feature -> 0..1; ``lost``: features whose contours collapsed in that frame;
+- ``face`` (``facemime run``): false in frames where the face was not found (it left the frame
+  or turned away); their contours repeat the last good ones;
+- ``pose``: the head pose, ``yaw``, ``pitch``, ``roll`` in degrees (rotations of the model about
+  its own y, x, z axes, applied yaw first), ``scale`` in pixels per model unit and ``tx``, ``ty``
+  the pixel position of the model origin (orthographic, see
+  :mod:`facemime.render.projection`);
+- ``offsets``: (K, 2) displacements of the model's contour vertices (the knots) in the head's own
+  frame, model units, relative to the first frame: the local motion that drives synthesis;
+
+and a top-level ``model``: ``unit`` (of the offsets and of the model), ``knots`` (the K model
+vertex indices the offsets belong to) and ``feature_sizes`` (K widths of each knot's feature,
+model units, for carrying the motion to another face).
 """
 
 from __future__ import annotations
@@ -22,6 +35,7 @@ from facemime.io.outputs import write_text
 from facemime.track.contours import CONTOUR_NAMES
 
 INIT_FORMAT = "facemime.init/1"
+POSE_KEYS = ("yaw", "pitch", "roll", "scale", "tx", "ty")
 TRACK_FORMAT = "facemime.track/1"
 
 Contours = dict[str, np.ndarray]
@@ -91,9 +105,11 @@ def init_document(frame: int, contours: Mapping[str, np.ndarray]) -> dict[str, A
 
 
 def track_document(video: Mapping[str, Any], frames: Sequence[Mapping[str, Any]],
-                   timing: Mapping[str, float] | None = None) -> dict[str, Any]:
+                   timing: Mapping[str, float] | None = None, model: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """A ``facemime.track/1`` document. ``frames``: dicts with ``index``, ``contours`` (name ->
-    (N, 2) array) and optionally ``confidence`` (feature -> float) and ``lost`` (list of features)."""
+    (N, 2) array) and optionally ``confidence`` (feature -> float), ``lost`` (list of
+    features), ``face`` (bool), ``pose`` (mapping) and ``offsets`` ((K, 2) array); ``model``
+    describes the knots the offsets belong to (see the module docstring)."""
     out_frames = []
     for f in frames:
         entry: dict[str, Any] = {"index": int(f["index"]),
@@ -102,10 +118,18 @@ def track_document(video: Mapping[str, Any], frames: Sequence[Mapping[str, Any]]
             entry["confidence"] = {k: round(float(v), 4) for k, v in f["confidence"].items()}
         if "lost" in f:
             entry["lost"] = list(f["lost"])
+        if "face" in f:
+            entry["face"] = bool(f["face"])
+        if "pose" in f:
+            entry["pose"] = {k: round(float(v), 4) for k, v in f["pose"].items()}
+        if "offsets" in f:
+            entry["offsets"] = np.round(np.asarray(f["offsets"], float), 3).tolist()
         out_frames.append(entry)
     doc: dict[str, Any] = {"format": TRACK_FORMAT,
                            "video": {k: video[k] for k in ("width", "height", "fps", "frames")},
                            "frames": out_frames}
+    if model is not None:
+        doc["model"] = dict(model)
     if timing is not None:
         doc["timing"] = dict(timing)
     return doc
@@ -132,3 +156,34 @@ def read_track(path: str | Path) -> tuple[dict[str, Any], dict[int, Contours]]:
             raise ContourFileError(f"{where}: frame entry {k} must be an object with an integer 'index'")
         out[f["index"]] = _contours(f, f"{where} frame {f['index']}", None, require_all=False)
     return doc.get("video", {}), out
+
+
+def read_motion(path: str | Path) -> tuple[dict[str, Any], dict[str, Any], list[dict[str, Any]]]:
+    """Read the motion of a ``facemime.track/1`` file written by ``facemime run``: (video info,
+    the ``model`` block, frames in order as dicts with ``index``, ``face`` (bool), ``pose``
+    (mapping of the six pose values) and ``offsets`` ((K, 2) float64 array))."""
+    doc = load_json(path, "track")
+    where = str(path)
+    if not isinstance(doc, dict) or doc.get("format") != TRACK_FORMAT:
+        found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
+        raise ContourFileError(f"{where}: expected format {TRACK_FORMAT!r}, found {found!r}")
+    model = doc.get("model")
+    if not isinstance(model, dict) or not isinstance(model.get("knots"), list) or not isinstance(model.get("feature_sizes"), list):
+        raise ContourFileError(f"{where}: has no head motion ('model' with 'knots' and 'feature_sizes'); "
+                               "write it with facemime run")
+    k = len(model["knots"])
+    frames = doc.get("frames")
+    if not isinstance(frames, list) or not frames:
+        raise ContourFileError(f"{where}: 'frames' must be a non-empty list")
+    out = []
+    for n, f in enumerate(frames):
+        pose, offsets = (f.get("pose"), f.get("offsets")) if isinstance(f, dict) else (None, None)
+        try:
+            values = {key: float(pose[key]) for key in POSE_KEYS}
+            arr = np.asarray(offsets, dtype=np.float64)
+        except (TypeError, KeyError, ValueError):
+            raise ContourFileError(f"{where}: frame entry {n} needs a 'pose' with {', '.join(POSE_KEYS)} and 'offsets'") from None
+        if arr.shape != (k, 2) or not np.isfinite(arr).all() or not all(np.isfinite(list(values.values()))) or values["scale"] <= 0:
+            raise ContourFileError(f"{where}: frame entry {n} has malformed 'offsets' or 'pose'")
+        out.append({"index": f.get("index", n), "face": bool(f.get("face", True)), "pose": values, "offsets": arr})
+    return doc.get("video", {}), model, out

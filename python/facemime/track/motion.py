@@ -77,7 +77,11 @@ class HeadMotion:
     with the contours tracked in the previous frame: they place the rigid zones, so the points
     stay on the face even when the accumulated motion drifts.
 
-    ``total`` is the accumulated transform from the first frame to the current one.
+    ``total`` is the accumulated transform from the first frame to the current one. ``points``
+    (M, 2) float32 are the rigid points followed into the current frame and ``ids`` (M,) int64
+    their identities: a point keeps its id for as long as it is followed, new detections get
+    new ids (the head-pose estimator keeps each point's 3D position by id). ``followed`` is the
+    (points, ids) pair of the points followed from the previous frame, before any re-detection.
     """
 
     def __init__(self, gray: np.ndarray, contours: Mapping[str, np.ndarray], max_points: int = 60):
@@ -88,15 +92,23 @@ class HeadMotion:
         self._contours0 = {n: np.asarray(c, float) for n, c in contours.items()}
         self._zones0 = zone_polygons(contours)
         self._zones = self._zones0
-        self._points = self._detect(gray)
-        self._wanted = max(MIN_POINTS, len(self._points) // 2)
+        self._next_id = 0
+        self.points, self.ids = self._detect(gray)
+        self.followed = (self.points, self.ids)
+        self._wanted = max(MIN_POINTS, len(self.points) // 2)
 
     def _detect(self, gray: np.ndarray) -> np.ndarray:
         mask = np.zeros(gray.shape, np.uint8)
         for poly in self._zones:
             cv2.fillConvexPoly(mask, np.round(poly).astype(np.int32), 255)
         pts = cv2.goodFeaturesToTrack(gray, self._max_points, 0.01, self._min_distance, mask=mask, blockSize=5)
-        return np.zeros((0, 2), np.float32) if pts is None else pts.reshape(-1, 2).astype(np.float32)
+        pts = np.zeros((0, 2), np.float32) if pts is None else pts.reshape(-1, 2).astype(np.float32)
+        ids = np.arange(self._next_id, self._next_id + len(pts), dtype=np.int64)
+        self._next_id += len(pts)
+        return pts, ids
+
+    def _keep(self, mask: np.ndarray) -> None:
+        self.points, self.ids = self.points[mask], self.ids[mask]
 
     def _inside(self, pts: np.ndarray) -> np.ndarray:
         """Which of ``pts`` (N, 2) lie in a zone (convex quadrilaterals, either winding)."""
@@ -109,7 +121,7 @@ class HeadMotion:
         return inside
 
     def _crop_box(self, shape: tuple[int, ...], extra: np.ndarray) -> tuple[int, int, int, int]:
-        pts = np.concatenate(self._zones + [self._points.astype(float), extra.astype(float)])
+        pts = np.concatenate(self._zones + [self.points.astype(float), extra.astype(float)])
         pad = 2 ** LEVELS * WINDOW[0] // 2 + 8
         x0, y0 = np.floor(pts.min(axis=0)).astype(int) - pad
         x1, y1 = np.ceil(pts.max(axis=0)).astype(int) + pad
@@ -138,7 +150,7 @@ class HeadMotion:
         shift = np.array([sx0 + 4.0 * bx - x0, sy0 + 4.0 * by - y0])
         step = IDENTITY.copy()
         step[:, 2] = shift
-        self._points = np.zeros((0, 2), np.float32)
+        self._keep(np.zeros(len(self.points), bool))
         return step, True
 
     def update(self, gray: np.ndarray, contours: Mapping[str, np.ndarray],
@@ -157,18 +169,18 @@ class HeadMotion:
         step, ok = IDENTITY.copy(), False
         n_extra = 0 if extra is None else len(extra)
         moved = None if extra is None else np.full((n_extra, 2), np.nan)
-        if len(self._points) >= MIN_POINTS:
+        if len(self.points) >= MIN_POINTS:
             extra_pts = np.zeros((0, 2), np.float32) if extra is None else np.asarray(extra, np.float32)
             x0, y0, x1, y1 = self._crop_box(gray.shape, extra_pts)
             off = np.array([x0, y0], np.float32)
             a, b = self._prev[y0:y1, x0:x1], gray[y0:y1, x0:x1]
-            p0 = (np.concatenate([self._points, extra_pts]) - off).reshape(-1, 1, 2)
+            p0 = (np.concatenate([self.points, extra_pts]) - off).reshape(-1, 1, 2)
             crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 20, 0.03)
             p1, st1, _ = cv2.calcOpticalFlowPyrLK(a, b, p0, None, winSize=WINDOW, maxLevel=LEVELS, criteria=crit)
             pb, st2, _ = cv2.calcOpticalFlowPyrLK(b, a, p1, None, winSize=WINDOW, maxLevel=LEVELS, criteria=crit)
             good = (st1.ravel() == 1) & (st2.ravel() == 1) & (np.linalg.norm((pb - p0).reshape(-1, 2), axis=1) < FB_LIMIT)
             p0, p1 = p0.reshape(-1, 2), p1.reshape(-1, 2)
-            n = len(self._points)
+            n = len(self.points)
             if moved is not None:
                 moved[good[n:]] = p1[n:][good[n:]] + off
             good = good[:n]
@@ -180,14 +192,16 @@ class HeadMotion:
                     # back to full-frame coordinates: x' = R(x - off) + t + off
                     m[:, 2] += off - m[:, :2] @ off
                     step, ok = m, True
-                    self._points = dst[keep] + off
+                    self._keep(np.flatnonzero(good)[keep])
+                    self.points = dst[keep] + off
         if not ok:
             step, ok = self._coarse_shift(gray)
         self.total = compose(step, self.total)
         self._zones = [apply(step, z) for z in self._zones]
-        if len(self._points):
-            self._points = self._points[self._inside(self._points)]
-        if len(self._points) < self._wanted:
-            self._points = self._detect(gray)
+        if len(self.points):
+            self._keep(self._inside(self.points))
+        self.followed = (self.points, self.ids)
+        if len(self.points) < self._wanted:
+            self.points, self.ids = self._detect(gray)
         self._prev = gray
         return step, ok, moved

@@ -306,6 +306,12 @@ class Tracker:
         return bool(0.5 * rest_chord <= chord <= 2.0 * rest_chord)
 
     @property
+    def motion(self) -> motion.HeadMotion | None:
+        """The head-motion follower (its rigid points feed the head pose); None when head-motion
+        compensation is off."""
+        return self._motion
+
+    @property
     def edges(self) -> dict[str, np.ndarray]:
         """The first frame's contours as settled on the image edges (no calibration offset
         taken out), name -> (N, 2) float64 pixels."""

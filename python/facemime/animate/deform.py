@@ -1,0 +1,127 @@
+"""Local deformation: the tracked mouth and brow contours, taken into the head's own frame, move
+their model vertices (the knots), and every other vertex follows smoothly (method.md §3).
+
+Knot offsets are (x, y) displacements in model units (millimetres for the built-in head) in the
+head's own frame — with the head's rotation, scale and translation taken out — relative to the
+first frame. Depth (z) is left as it is.
+
+The spread is Shepard interpolation with weights 1 / (d² + ε²) over model-space distances d:
+vertices above the eyes follow the brow knots, vertices between the eyes and the mouth line the
+upper-lip knots, vertices below the mouth line the lower-lip knots (so an opening mouth pulls the
+chin down and the cheeks little). The eyes, the nose and the face outline above the mouth line
+are anchors that do not move, and a constant far-field anchor (weight 1 / :data:`REACH`²) keeps
+distant vertices still.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from facemime.errors import InvalidInputError
+from facemime.fit.placement import model_iod
+from facemime.metrics import resample
+from facemime.model.head import CONTOUR_GROUPS, HeadModel
+from facemime.render.projection import Pose, rotation_matrix
+
+#: Softening of the Shepard weights and reach of the far-field anchor, fractions of the
+#: distance between the outer eye corners.
+SOFTEN = 0.02
+REACH = 0.45
+
+UPPER = ("mouth_outer_upper", "mouth_inner_upper")
+LOWER = ("mouth_outer_lower", "mouth_inner_lower")
+BROWS = tuple(n for n in CONTOUR_GROUPS if n.startswith("brow"))
+
+
+def head_plane(points: np.ndarray, depth: np.ndarray, pose: Pose) -> np.ndarray:
+    """Model-space (x, y) of image ``points`` (K, 2) px seen in ``pose``, each at its model
+    depth ``depth`` (K,): the inverse of the orthographic projection for points of known z."""
+    r = rotation_matrix(pose.yaw, pose.pitch, pose.roll)
+    a = np.array([[r[0, 0], r[0, 1]], [-r[1, 0], -r[1, 1]]]) * pose.scale
+    rhs = np.column_stack([points[:, 0] - pose.tx - pose.scale * r[0, 2] * depth,
+                           points[:, 1] - pose.ty + pose.scale * r[1, 2] * depth])
+    return np.linalg.solve(a, rhs.T).T
+
+
+class Deformer:
+    """Drives one head model by the eight tracked contours.
+
+    ``knots`` are the model's contour vertices (the mouth corners shared by the upper and lower
+    curves counted once), in a fixed order; ``weights`` (N, K) spreads their offsets to all N
+    vertices.
+    """
+
+    def __init__(self, model: HeadModel):
+        missing = [g for g in CONTOUR_GROUPS + ("eye_left", "eye_right") if g not in model.groups]
+        if missing:
+            raise InvalidInputError(f"head model {model.name!r} lacks the contour groups {', '.join(missing)}")
+        self.model = model
+        g = model.groups
+        self.knots = np.unique(np.concatenate([g[n] for n in CONTOUR_GROUPS]))
+        self._slot = {int(v): k for k, v in enumerate(self.knots)}
+        self.weights = self._spread()
+
+    def _spread(self) -> np.ndarray:
+        model, g = self.model, self.model.groups
+        v = model.vertices
+        iod = model_iod(model)
+        eye_y = v[np.concatenate([g["eye_left"], g["eye_right"]]), 1].mean()
+        mouth_y = v[g["mouth_outer_upper"][[0, -1]], 1].mean()
+        sets = {name: np.array([self._slot[int(i)] for i in np.unique(np.concatenate([g[n] for n in names]))])
+                for name, names in (("upper", UPPER), ("lower", LOWER), ("brows", BROWS))}
+        anchors = [g[n] for n in ("eye_left", "eye_right", "nose") if n in g]
+        if "face_outline" in g:
+            anchors.append(g["face_outline"][v[g["face_outline"], 1] > mouth_y])
+        anchor_idx = np.setdiff1d(np.concatenate(anchors), self.knots)
+        soft2, far = (SOFTEN * iod) ** 2, 1.0 / (REACH * iod) ** 2
+        weights = np.zeros((len(v), len(self.knots)))
+        for j in range(len(v)):
+            if j in self._slot:
+                weights[j, self._slot[j]] = 1.0
+                continue
+            y = v[j, 1]
+            chosen = sets["brows"] if y > eye_y else sets["upper"] if y >= mouth_y else sets["lower"]
+            w = 1.0 / (np.sum((v[self.knots[chosen]] - v[j]) ** 2, axis=1) + soft2)
+            a = anchor_idx[anchor_idx != j]
+            rest = np.sum(1.0 / (np.sum((v[a] - v[j]) ** 2, axis=1) + soft2)) + far
+            weights[j, chosen] = w / (w.sum() + rest)
+        return weights
+
+    def knot_positions(self, contours: Mapping[str, np.ndarray], pose: Pose) -> np.ndarray:
+        """The knots' model-space (x, y) (K, 2) where the image ``contours`` (name -> (M, 2) px,
+        resampled to the model's group lengths) put them, seen in ``pose``."""
+        g, v = self.model.groups, self.model.vertices
+        pts = np.zeros((len(self.knots), 2))
+        seen = np.zeros(len(self.knots))
+        for name in CONTOUR_GROUPS:
+            idx = g[name]
+            c = np.asarray(contours[name], np.float64)
+            c = c if len(c) == len(idx) else resample(c, len(idx))
+            if np.linalg.norm(c[0] - c[-1]) > 0 and (c[-1, 0] - c[0, 0]) * (v[idx[-1], 0] - v[idx[0], 0]) < 0:
+                c = c[::-1]  # the model's groups run image-left to image-right in a frontal view
+            slots = [self._slot[int(i)] for i in idx]
+            np.add.at(pts, slots, head_plane(c, v[idx, 2], pose))
+            np.add.at(seen, slots, 1.0)
+        return pts / seen[:, None]
+
+    def vertices(self, offsets: np.ndarray, gain: float = 1.0) -> np.ndarray:
+        """The model's vertices moved by knot ``offsets`` (K, 2) model units times ``gain`` (the
+        exaggeration): (N, 3) float64."""
+        out = self.model.vertices.copy()
+        out[:, :2] += gain * (self.weights @ offsets)
+        return out
+
+    def feature_sizes(self) -> np.ndarray:
+        """Per knot, the width of its feature (the mouth's corner-to-corner distance for mouth
+        knots, the brow's length for brow knots), model units: the scale motion is measured in
+        when it is carried from one actor to another."""
+        g, v = self.model.groups, self.model.vertices
+        sizes = np.zeros(len(self.knots))
+        for name in CONTOUR_GROUPS:
+            idx = g[name]
+            ends = g["mouth_outer_upper"][[0, -1]] if name.startswith("mouth") else idx[[0, -1]]
+            sizes[[self._slot[int(i)] for i in idx]] = np.linalg.norm(v[ends[1], :2] - v[ends[0], :2])
+        return sizes
+

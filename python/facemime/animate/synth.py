@@ -1,0 +1,158 @@
+"""Synthesising a frame: the actor's textured model, deformed and posed, over a background, with
+a mouth interior (a dark cavity with upper and lower teeth) behind the lips so that an open mouth
+never shows the background (the paper's Figure 9h shortcoming).
+
+Images are (H, W, 3) uint8 RGB; points are (x, y) pixels, y down.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import cv2
+import numpy as np
+
+from facemime.animate.deform import Deformer
+from facemime.errors import InvalidInputError
+from facemime.fit.actor import Actor
+from facemime.fit.placement import model_iod
+from facemime.render.projection import Pose, project
+from facemime.render.texture_map import render_mesh_into
+
+BACKGROUND = (38, 40, 46)
+CAVITY = (52, 18, 22)
+TEETH = (214, 208, 192)
+GAPS = (150, 140, 128)
+#: Visible height of the upper and lower teeth, fractions of the mouth's width, and the part of
+#: the mouth's width they span (centred).
+UPPER_TEETH = 0.11
+LOWER_TEETH = 0.07
+TEETH_SPAN = 0.72
+SHIFT = 4  # sub-pixel bits for cv2 drawing
+
+
+def draw_mouth_interior(out: np.ndarray, upper: np.ndarray, lower: np.ndarray) -> None:
+    """Paint the mouth opening bounded by the inner-lip curves ``upper`` and ``lower`` (each
+    (K, 2) px, corner to corner, sharing the corners) into ``out`` in place: the cavity, and the
+    teeth hanging from the upper lip and rising from the lower one."""
+    poly = np.concatenate([upper, lower[::-1]])
+    lo = np.floor(poly.min(axis=0)).astype(int) - 1
+    hi = np.ceil(poly.max(axis=0)).astype(int) + 2
+    x0, y0 = np.maximum(lo, 0)
+    x1, y1 = np.minimum(hi, [out.shape[1], out.shape[0]])
+    if x1 - x0 < 2 or y1 - y0 < 2:
+        return
+    fix = lambda p: np.round((p - [x0, y0]) * (1 << SHIFT)).astype(np.int32).reshape(-1, 1, 2)  # noqa: E731
+    mask = np.zeros((y1 - y0, x1 - x0), np.uint8)
+    cv2.fillPoly(mask, [fix(poly)], 255, cv2.LINE_AA, SHIFT)
+    if not mask.any():
+        return
+    paint = np.empty((y1 - y0, x1 - x0, 3), np.uint8)
+    paint[:] = CAVITY
+    along = upper[-1] - upper[0]
+    width = float(np.linalg.norm(along))
+    down = np.array([-along[1], along[0]]) / max(width, 1e-9)
+    keep = np.abs(np.linspace(-1.0, 1.0, len(upper))) <= TEETH_SPAN
+    if len(upper) != len(lower) or keep.sum() < 2:
+        keep[:] = True
+    opening = np.maximum((lower - upper) @ down, 0.0)[keep] if len(upper) == len(lower) else np.full(keep.sum(), width)
+    for curve, height, share, sign in ((upper, UPPER_TEETH, 0.55, 1.0), (lower, LOWER_TEETH, 0.3, -1.0)):
+        edge = curve[keep]
+        reach = np.minimum(height * width, share * opening)[:, None]
+        band = np.concatenate([edge, (edge + sign * reach * down)[::-1]])
+        cv2.fillPoly(paint, [fix(band)], TEETH, cv2.LINE_AA, SHIFT)
+        for a, b in zip(edge[1:-1], (edge + sign * reach * down)[1:-1]):  # gaps between the teeth
+            cv2.line(paint, tuple(int(v) for v in fix(a).ravel()), tuple(int(v) for v in fix(b).ravel()),
+                     GAPS, 1, cv2.LINE_AA, SHIFT)
+    # shade the far corners of the cavity and the teeth towards dark
+    cx = (np.arange(x0, x1) - (upper[0, 0] + upper[-1, 0]) / 2.0) / max(width / 2.0, 1.0)
+    shade = np.clip(1.15 - 0.6 * cx ** 2, 0.35, 1.0)[None, :, None]
+    paint = (paint * shade).astype(np.uint8)
+    alpha = (mask.astype(np.float32) / 255.0)[:, :, None]
+    roi = out[y0:y1, x0:x1]
+    roi[:] = (roi * (1.0 - alpha) + paint * alpha).astype(np.uint8)
+
+
+def synthesize(actor: Actor, vertices: np.ndarray, pose: Pose, size: tuple[int, int],
+               background: np.ndarray | tuple[int, int, int] = BACKGROUND, out: np.ndarray | None = None) -> np.ndarray:
+    """The actor with ``vertices`` (its model's, deformed) seen in ``pose``: an (H, W, 3) image
+    of ``size`` = (width, height) over ``background`` (a colour or an image of that size), or
+    drawn into ``out`` when given (the background is then what ``out`` holds)."""
+    w, h = size
+    if out is None:
+        out = np.empty((h, w, 3), np.uint8)
+        out[...] = background
+    points, depth = project(vertices, pose)
+    g = actor.model.groups
+    draw_mouth_interior(out, points[g["mouth_inner_upper"]], points[g["mouth_inner_lower"]])
+    render_mesh_into(out, actor.texture, actor.model.uv, points, depth, actor.model.triangles)
+    return out
+
+
+@dataclass(frozen=True)
+class UserMotion:
+    """Motion the user adds on top of the measured one: extra ``yaw``, ``pitch``, ``roll``
+    (degrees), ``zoom`` (factor on the face's size, about the model origin between the eyes) and
+    ``gain`` (exaggeration: factor on the local deformation; 0 freezes the face)."""
+
+    yaw: float = 0.0
+    pitch: float = 0.0
+    roll: float = 0.0
+    zoom: float = 1.0
+    gain: float = 1.0
+
+    def __post_init__(self) -> None:
+        for name in ("yaw", "pitch", "roll"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and -180.0 <= v <= 180.0):
+                raise InvalidInputError(f"{name} must be degrees in [-180, 180], got {v}")
+        if not (np.isfinite(self.zoom) and 0.1 <= self.zoom <= 10.0):
+            raise InvalidInputError(f"zoom must be in [0.1, 10], got {self.zoom}")
+        if not (np.isfinite(self.gain) and 0.0 <= self.gain <= 10.0):
+            raise InvalidInputError(f"exaggeration must be in [0, 10], got {self.gain}")
+
+    def changed(self, **deltas: float) -> "UserMotion":
+        """A copy with ``deltas`` added (``zoom`` and ``gain`` multiply), kept in range."""
+        v = {k: getattr(self, k) for k in ("yaw", "pitch", "roll", "zoom", "gain")}
+        for k, d in deltas.items():
+            v[k] = v[k] * d if k in ("zoom", "gain") else v[k] + d
+        v.update(yaw=float(np.clip(v["yaw"], -180, 180)), pitch=float(np.clip(v["pitch"], -180, 180)),
+                 roll=float(np.clip(v["roll"], -180, 180)), zoom=float(np.clip(v["zoom"], 0.1, 10)),
+                 gain=float(np.clip(v["gain"], 0.0, 10.0)))
+        return replace(self, **v)
+
+
+class Puppet:
+    """An actor driven by motion measured on a face (its own or another person's).
+
+    ``source_sizes``: the feature size of each knot on the measured face (see
+    :meth:`Deformer.feature_sizes`) and ``source_iod`` its eye-corner distance, model units;
+    offsets are scaled per feature by the ratio of the two faces' sizes, and the measured
+    pose's scale by the ratio of the eye distances, so the driven face keeps the measured face's
+    size on screen.
+    """
+
+    def __init__(self, actor: Actor, source_sizes: np.ndarray, source_iod: float):
+        self.actor = actor
+        self.deformer = Deformer(actor.model)
+        sizes = np.asarray(source_sizes, np.float64)
+        if sizes.shape != (len(self.deformer.knots),) or not np.isfinite(sizes).all() or (sizes <= 0).any():
+            raise InvalidInputError(f"the motion has {len(sizes)} knots but actor {actor.model.name!r} has "
+                                    f"{len(self.deformer.knots)}")
+        self._ratio = (self.deformer.feature_sizes() / sizes)[:, None]
+        self._scale = float(source_iod) / model_iod(actor.model)
+
+    def pose(self, measured: Pose, user: UserMotion = UserMotion()) -> Pose:
+        """The pose to show the actor in for a ``measured`` pose of the source face."""
+        return Pose(yaw=measured.yaw + user.yaw, pitch=measured.pitch + user.pitch, roll=measured.roll + user.roll,
+                    scale=measured.scale * self._scale * user.zoom, tx=measured.tx, ty=measured.ty)
+
+    def vertices(self, offsets: np.ndarray, user: UserMotion = UserMotion()) -> np.ndarray:
+        """The actor's vertices moved by the source's knot ``offsets`` (K, 2)."""
+        return self.deformer.vertices(offsets * self._ratio, user.gain)
+
+    def render(self, measured: Pose, offsets: np.ndarray, size: tuple[int, int], user: UserMotion = UserMotion(),
+               out: np.ndarray | None = None) -> np.ndarray:
+        """The synthesised frame, (H, W, 3) of ``size`` = (width, height), drawn into ``out``
+        when given."""
+        return synthesize(self.actor, self.vertices(offsets, user), self.pose(measured, user), size, out=out)
