@@ -56,3 +56,14 @@ def actor(lp_d0):
     frame, points, _ = lp_d0
     model = generic_head()
     return smear_texture(model, frame, fit_model(model, points), points, {"file": "lp_d0.mp4", "frame": 0, "width": 512, "height": 512})
+
+
+@pytest.fixture(scope="session")
+def astronaut(tmp_path_factory) -> Path:
+    """scikit-image's astronaut photo (Eileen Collins, frontal), as a PNG file."""
+    import cv2
+    from skimage import data
+
+    path = tmp_path_factory.mktemp("photo") / "astronaut.png"
+    cv2.imwrite(str(path), cv2.cvtColor(data.astronaut(), cv2.COLOR_RGB2BGR))
+    return path

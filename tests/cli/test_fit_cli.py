@@ -14,15 +14,6 @@ from facemime.track.contours import GROUPS, from_face_mesh
 from .test_cli import first_frames, run
 
 
-@pytest.fixture(scope="module")
-def astronaut(tmp_path_factory):
-    from skimage import data
-
-    path = tmp_path_factory.mktemp("photo") / "astronaut.png"
-    cv2.imwrite(str(path), cv2.cvtColor(data.astronaut(), cv2.COLOR_RGB2BGR))
-    return path
-
-
 def test_fit_a_photo_writes_an_actor_and_a_preview(tmp_path, capsys, astronaut):
     out = tmp_path / "eileen.actor"
     code, stdout, err = run(capsys, "fit", str(astronaut), "--out", str(out))

@@ -1,0 +1,71 @@
+import numpy as np
+import pytest
+
+from facemime.animate.synth import Puppet, UserMotion, synthesize
+from facemime.errors import InvalidInputError
+from facemime.fit.placement import model_iod
+from facemime.render.projection import project
+
+GREEN = (0, 255, 0)
+
+
+def mouth_polygon_mask(points, actor, shape):
+    import cv2
+
+    g = actor.model.groups
+    poly = np.concatenate([points[g["mouth_inner_upper"]], points[g["mouth_inner_lower"]][::-1]])
+    mask = np.zeros(shape, np.uint8)
+    cv2.fillPoly(mask, [np.round(poly).astype(np.int32)], 1)
+    return cv2.erode(mask, np.ones((3, 3), np.uint8)).astype(bool)
+
+
+def test_an_open_mouth_shows_a_dark_cavity_and_teeth_not_the_background(actor):
+    vertices = actor.model.deform({"jaw_drop": 1.0})
+    img = synthesize(actor, vertices, actor.pose, (512, 512), background=GREEN)
+    inside = mouth_polygon_mask(project(vertices, actor.pose)[0], actor, img.shape[:2])
+    assert inside.sum() > 300
+    pixels = img[inside].astype(int)
+    assert not (np.abs(pixels - GREEN).sum(axis=1) < 60).any()
+    brightness = pixels.mean(axis=1)
+    assert (brightness < 60).mean() > 0.2  # the cavity
+    assert (brightness > 150).mean() > 0.1  # the teeth
+
+
+def test_a_closed_mouth_only_fills_the_sliver_between_the_lips(actor):
+    from facemime.render.head_view import render_head
+
+    plain = render_head(actor.model, actor.texture, actor.pose, (512, 512), background=GREEN)
+    synth = synthesize(actor, actor.model.vertices, actor.pose, (512, 512), background=GREEN)
+    changed = np.abs(synth.astype(int) - plain).max(axis=2) > 1
+    # Only pixels where the background leaked between the lips change.
+    assert changed.sum() < 30 and (plain[changed] == GREEN).all()
+
+
+def test_motion_carries_to_a_face_of_other_proportions(actor):
+    from dataclasses import replace
+
+    wide = actor.model.vertices.copy()
+    wide[:, 0] *= 1.3  # a wider face: wider mouth and brows, wider-set eyes
+    other = replace(actor, model=replace(actor.model, vertices=wide))
+    source = Puppet(actor, Puppet(actor, np.ones(60), 1.0).deformer.feature_sizes(), model_iod(actor.model))
+    puppet = Puppet(other, source.deformer.feature_sizes(), model_iod(actor.model))
+    offsets = np.zeros((60, 2))
+    offsets[:40, 1] = -4.0
+    moved = puppet.vertices(offsets) - other.model.vertices
+    assert np.allclose(moved[:40, 1], -4.0 * 1.3, atol=0.01)
+    # The driven face keeps the measured face's size on screen.
+    assert puppet.pose(actor.pose).scale * model_iod(other.model) == pytest.approx(actor.pose.scale * model_iod(actor.model))
+    with pytest.raises(InvalidInputError, match="knots"):
+        Puppet(other, np.ones(12), 90.0)
+
+
+def test_user_motion_adds_turns_zoom_and_exaggeration(actor):
+    puppet = Puppet(actor, Puppet(actor, np.ones(60), 1.0).deformer.feature_sizes(), model_iod(actor.model))
+    user = UserMotion(yaw=20, roll=-5, zoom=1.5)
+    pose = puppet.pose(actor.pose, user)
+    assert pose.yaw == actor.pose.yaw + 20 and pose.roll == pytest.approx(actor.pose.roll - 5)
+    assert pose.scale == pytest.approx(1.5 * actor.pose.scale)
+    assert UserMotion().changed(gain=2.0, yaw=-200).gain == 2.0 and UserMotion().changed(yaw=-200).yaw == -180
+    for bad in ({"zoom": 0.0}, {"gain": -1}, {"yaw": float("nan")}):
+        with pytest.raises(InvalidInputError):
+            UserMotion(**bad)
