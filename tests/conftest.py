@@ -60,10 +60,11 @@ def actor(lp_d0):
 
 @pytest.fixture(scope="session")
 def astronaut(tmp_path_factory) -> Path:
-    """scikit-image's astronaut photo (Eileen Collins, frontal), as a PNG file."""
+    """The astronaut photo the package ships (NASA, public domain), as a PNG file."""
     import cv2
-    from skimage import data
+    from importlib import resources
 
     path = tmp_path_factory.mktemp("photo") / "astronaut.png"
-    cv2.imwrite(str(path), cv2.cvtColor(data.astronaut(), cv2.COLOR_RGB2BGR))
+    jpg = np.frombuffer(resources.files("facemime.data").joinpath("astronaut.jpg").read_bytes(), np.uint8)
+    cv2.imwrite(str(path), cv2.imdecode(jpg, cv2.IMREAD_COLOR))
     return path

@@ -3,6 +3,7 @@ import sys
 
 import av
 import cv2
+import numpy as np
 import pytest
 
 from facemime.cli.main import main
@@ -26,22 +27,34 @@ def run(capsys, *args):
     return exc.value.code or 0, out, err
 
 
-def test_demo_writes_views_stills_and_a_playable_video(tmp_path, capsys):
+def test_demo_fits_animates_tracks_back_and_resynthesises(tmp_path, capsys):
+    from facemime.demo import FILES
+
     code, out, err = run(capsys, "demo", "--out", str(tmp_path / "d"))
-    assert code == 0
-    names = {p.name for p in (tmp_path / "d").iterdir()}
-    assert names == {"head_views.png", "deformation_units.png", "head.mp4"}
-    assert out.split() == [str(tmp_path / "d" / n) for n in ("head_views.png", "deformation_units.png", "head.mp4")]
-    views = cv2.imread(str(tmp_path / "d" / "head_views.png"))
-    assert views.shape == (640, 1600, 3) and views.std() > 20
-    with av.open(str(tmp_path / "d" / "head.mp4")) as c:
-        assert c.streams.video[0].codec_context.name == "h264"
+    assert code == 0, err
+    assert out.split() == [str(tmp_path / "d" / n) for n in FILES]
+    assert {p.name for p in (tmp_path / "d").iterdir()} == set(FILES)
+    with av.open(str(tmp_path / "d" / "resynthesis.mp4")) as c:
+        s = c.streams.video[0].codec_context
+        assert (s.name, s.width, s.height) == ("h264", 1536, 512)
         assert sum(1 for _ in c.decode(video=0)) == 150
+    # Tracked back from an automatic start, the contours stay on the known truth.
+    report = (tmp_path / "d" / "report.html").read_text()
+    import re
+
+    means = [float(m) for m in re.findall(r"<tr><td>(?:mouth outer|mouth inner|brows)</td><td>([0-9.]+)</td>", report)]
+    assert len(means) == 3 and max(means) < 0.03
+    assert 'src="resynthesis.mp4"' in report and 'src="stills.png"' in report
+    stills = cv2.imread(str(tmp_path / "d" / "stills.png"))
+    assert stills.shape == (1024, 768, 3)
+    for col in range(3):  # each panel of each still shows a face, not the empty backdrop
+        panel = stills[:256, 256 * col:256 * (col + 1)].astype(int)
+        assert (np.abs(panel - panel[5, 5]).sum(axis=2) > 60).mean() > 0.1
     # A second run refuses to overwrite, in one line, and changes nothing.
-    before = (tmp_path / "d" / "head.mp4").stat().st_mtime_ns
+    before = (tmp_path / "d" / "resynthesis.mp4").stat().st_mtime_ns
     code, out, err = run(capsys, "demo", "--out", str(tmp_path / "d"))
     assert code == 1 and err.count("\n") == 1 and err.startswith("facemime: error:") and "--force" in err
-    assert (tmp_path / "d" / "head.mp4").stat().st_mtime_ns == before
+    assert (tmp_path / "d" / "resynthesis.mp4").stat().st_mtime_ns == before
 
 
 def test_model_preview_of_a_candide_file(tmp_path, capsys, candide_path):
