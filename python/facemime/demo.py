@@ -25,7 +25,7 @@ import numpy as np
 from facemime.animate.analysis import Analysis
 from facemime.animate.run import pose_dict
 from facemime.animate.synth import Puppet, synthesize
-from facemime.fit.actor import Actor
+from facemime.fit.actor import generic_actor
 from facemime.fit.placement import model_iod
 from facemime.fit.preview import preview_sheet
 from facemime.fit.run import fit_actor
@@ -34,7 +34,6 @@ from facemime.io.actor_file import save_actor
 from facemime.io.contours_json import track_document, write_json
 from facemime.io.outputs import write_text
 from facemime.metrics import group_nme, summarize
-from facemime.model import generic_head, painted_texture
 from facemime.progress import track
 from facemime.render import Pose
 from facemime.render.projection import project
@@ -85,12 +84,6 @@ def _backdrop(size: tuple[int, int]) -> np.ndarray:
     img = (1 - ramp) * np.array([118, 128, 142]) + ramp * np.array([64, 70, 84])
     grain = np.random.default_rng(7).normal(0, 2.0, (h, w, 1))
     return np.clip(np.broadcast_to(img, (h, w, 3)) + grain, 0, 255).astype(np.uint8)
-
-
-def second_face() -> Actor:
-    """The generic head with its painted texture, as an actor."""
-    head = generic_head()
-    return Actor(head, painted_texture(head, 512), Pose.framing(head.vertices, SIZE, 0.8))
 
 
 def _still_sheet(rows: list[np.ndarray]) -> np.ndarray:
@@ -147,7 +140,7 @@ def run_demo(out_dir: Path, force: bool = False, seconds: float = 6.0) -> DemoRe
 
     # 4. Re-synthesise on the astronaut and on the second face.
     sizes, iod = analysis.deformer.feature_sizes(), model_iod(analysis.actor.model)
-    puppets = [Puppet(actor, sizes, iod), Puppet(second_face(), sizes, iod)]
+    puppets = [Puppet(actor, sizes, iod), Puppet(generic_actor(SIZE), sizes, iod)]
     stills, shown = [], {int(count * f) for f in (0.2, 0.43, 0.6, 0.87)}
     t0 = time.perf_counter()
     synth_seconds = 0.0

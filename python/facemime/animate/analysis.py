@@ -17,6 +17,7 @@ import numpy as np
 from facemime.animate.deform import Deformer
 from facemime.animate.pose import PoseTracker
 from facemime.fit.detect import NoFaceError
+from facemime.fit.placement import model_iod
 from facemime.fit.run import fit_actor, init_contours
 from facemime.render.projection import Pose
 from facemime.track.contours import FEATURES
@@ -114,7 +115,9 @@ class Analysis:
 
     @property
     def model_block(self) -> dict:
-        """The track file's ``model`` entry: unit, knot vertices and their feature sizes."""
+        """The track file's ``model`` entry: unit, knot vertices, their feature sizes and the
+        distance between the outer eye corners (model units)."""
         return {"unit": self.actor.model.unit, "knots": self.deformer.knots.tolist(),
-                "feature_sizes": np.round(self.deformer.feature_sizes(), 3).tolist()}
+                "feature_sizes": np.round(self.deformer.feature_sizes(), 3).tolist(),
+                "iod": round(model_iod(self.actor.model), 3)}
 

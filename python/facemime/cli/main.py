@@ -149,6 +149,34 @@ def run(video: Path, actor_file: Path | None, out_file: Path, track_file: Path |
     click.echo(f"ran {result.frames} frames at {result.fps:.0f} frames/s (encoding excluded: {shares}){missing}", err=True)
 
 
+@cli.command()
+@click.argument("source", metavar="VIDEO_OR_TRACK", type=click.Path(path_type=Path))
+@click.option("--actor", "actor_file", type=click.Path(path_type=Path),
+              help="NAME.actor to drive (default: the video's own face, or the generic head for a track file).")
+@click.option("--port", default=8765, show_default=True, help="Local port of the viewer's web page (0: any free port).")
+@click.option("--no-browser", is_flag=True, help="Do not open a browser; print the address only.")
+def view(source: Path, actor_file: Path | None, port: int, no_browser: bool) -> None:
+    """Play VIDEO (analysed live) or a TRACK.json from facemime run in the interactive viewer, a
+    page in your web browser: keys turn, tilt, roll, zoom and exaggerate the synthesised face.
+    Stop with Ctrl-C."""
+    import webbrowser
+
+    from facemime.io.actor_file import load_actor
+    from facemime.viewer import HELP, Viewer, make_server
+
+    actor = load_actor(actor_file) if actor_file is not None else None
+    server = make_server(Viewer(source, actor), port)
+    url = f"http://127.0.0.1:{server.server_address[1]}/"
+    click.echo(url)
+    click.echo(f"keys: {HELP}; Ctrl-C stops", err=True)
+    if not no_browser:
+        webbrowser.open(url)
+    try:
+        server.serve_forever()
+    finally:
+        server.server_close()
+
+
 def main(argv: list[str] | None = None) -> None:
     """Entry point: run the CLI, turning expected errors into one line on stderr."""
     argv = sys.argv[1:] if argv is None else argv

@@ -15,7 +15,8 @@ import numpy as np
 from facemime.errors import InvalidInputError
 from facemime.fit.placement import Fit
 from facemime.fit.points import ReferencePoints
-from facemime.model.head import HeadModel
+from facemime.model.head import HeadModel, generic_head
+from facemime.model.texture import painted_texture
 from facemime.render.projection import Pose, project
 
 #: The texture is the photo cropped around the face with this margin (fraction of the face size)
@@ -75,3 +76,10 @@ def smear_texture(model: HeadModel, photo: np.ndarray, fit: Fit, points: Referen
     uv = np.clip((px - [x0, y0] + 0.5) / [x1 - x0, y1 - y0], 0.0, 1.0)
     adjusted = replace(model, vertices=fit.vertices, uv=uv, name=f"{source.get('file', 'photo')} actor")
     return Actor(adjusted, np.ascontiguousarray(crop), fit.pose, dict(source), {k: np.asarray(v, float) for k, v in points.items()})
+
+
+def generic_actor(size: tuple[int, int] = (512, 512)) -> Actor:
+    """The generic head with its painted texture, as an actor framed in a view of ``size`` =
+    (width, height) pixels."""
+    head = generic_head()
+    return Actor(head, painted_texture(head, 512), Pose.framing(head.vertices, size, 0.8))

@@ -17,8 +17,9 @@ extends ``facemime.track/1`` compatibly with per-frame keys:
   frame, model units, relative to the first frame: the local motion that drives synthesis;
 
 and a top-level ``model``: ``unit`` (of the offsets and of the model), ``knots`` (the K model
-vertex indices the offsets belong to) and ``feature_sizes`` (K widths of each knot's feature,
-model units, for carrying the motion to another face).
+vertex indices the offsets belong to), ``feature_sizes`` (K widths of each knot's feature,
+model units) and ``iod`` (distance between the outer eye corners, model units): what carrying
+the motion to another face needs.
 """
 
 from __future__ import annotations
