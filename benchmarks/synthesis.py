@@ -97,11 +97,8 @@ def quality(path: Path, landmarks: np.ndarray, valid: np.ndarray, iod: np.ndarra
 def speed(path: Path) -> dict[str, float]:
     with tempfile.TemporaryDirectory() as tmp:
         result = run_video(path, Path(tmp) / "out.mp4", force=True)
-    s = result.seconds
-    busy = sum(v for k, v in s.items() if k not in ("encode", "fit"))
-    return {"fps": result.fps, "frames": result.frames,
-            **{f"share_{k}": s[k] / busy for k in ("decode", "track", "pose", "synth", "compose")},
-            "encode_seconds": s["encode"], "fit_seconds": s["fit"]}
+    return {"fps": result.fps, "frames": result.frames, **{f"share_{k}": v for k, v in result.shares.items()},
+            "encode_seconds": result.seconds["encode"], "fit_seconds": result.seconds["fit"]}
 
 
 def main() -> None:

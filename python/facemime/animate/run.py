@@ -46,10 +46,19 @@ class RunResult:
     seconds: dict[str, float] = field(default_factory=dict)
 
     @property
+    def _busy(self) -> float:
+        """Seconds of per-frame work: all stages but video encoding and the one-off fit."""
+        return max(sum(v for k, v in self.seconds.items() if k not in ("encode", "fit")), 1e-9)
+
+    @property
     def fps(self) -> float:
         """Frames per second of the whole run with video encoding (and the one-off fit) excluded."""
-        busy = sum(v for k, v in self.seconds.items() if k not in ("encode", "fit"))
-        return self.frames / max(busy, 1e-9)
+        return self.frames / self._busy
+
+    @property
+    def shares(self) -> dict[str, float]:
+        """Fraction of the per-frame work spent in each stage."""
+        return {k: self.seconds[k] / self._busy for k in ("decode", "track", "pose", "synth", "compose")}
 
 
 def pose_dict(pose: Pose) -> dict[str, float]:

@@ -142,9 +142,7 @@ def run(video: Path, actor_file: Path | None, out_file: Path, track_file: Path |
         click.echo(f"facemime: warning: {w}", err=True)
     for f in result.files:
         click.echo(str(f))
-    s = result.seconds
-    busy = sum(v for k, v in s.items() if k not in ("encode", "fit"))
-    shares = ", ".join(f"{k} {100 * s[k] / max(busy, 1e-9):.0f}%" for k in ("decode", "track", "pose", "synth", "compose"))
+    shares = ", ".join(f"{k} {100 * v:.0f}%" for k, v in result.shares.items())
     missing = f"; no face in {result.frames_without_face} frames" if result.frames_without_face else ""
     click.echo(f"ran {result.frames} frames at {result.fps:.0f} frames/s (encoding excluded: {shares}){missing}", err=True)
 

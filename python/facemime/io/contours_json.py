@@ -58,6 +58,15 @@ def load_json(path: str | Path, what: str) -> Any:
         raise ContourFileError(f"{p} is not valid JSON: {e.msg} at line {e.lineno} column {e.colno}") from None
 
 
+def load_document(path: str | Path, what: str, fmt: str) -> dict[str, Any]:
+    """Read the JSON ``what`` file at ``path`` and check that it is a ``fmt`` document."""
+    doc = load_json(path, what)
+    if not isinstance(doc, dict) or doc.get("format") != fmt:
+        found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
+        raise ContourFileError(f"{path}: expected format {fmt!r}, found {found!r}")
+    return doc
+
+
 def _contours(doc: Mapping[str, Any], where: str, size: tuple[int, int] | None, require_all: bool) -> Contours:
     raw = doc.get("contours")
     if not isinstance(raw, dict):
@@ -88,11 +97,8 @@ def _contours(doc: Mapping[str, Any], where: str, size: tuple[int, int] | None, 
 def read_init(path: str | Path, size: tuple[int, int] | None = None) -> tuple[int, Contours]:
     """Read a ``facemime.init/1`` file; returns (frame index, contours). With ``size``
     (width, height) every point must lie inside the image."""
-    doc = load_json(path, "init")
+    doc = load_document(path, "init", INIT_FORMAT)
     where = str(path)
-    if not isinstance(doc, dict) or doc.get("format") != INIT_FORMAT:
-        found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
-        raise ContourFileError(f"{where}: expected format {INIT_FORMAT!r}, found {found!r}")
     frame = doc.get("frame", 0)
     if not isinstance(frame, int) or isinstance(frame, bool) or frame < 0:
         raise ContourFileError(f"{where}: 'frame' must be a non-negative integer, got {frame!r}")
@@ -143,11 +149,8 @@ def write_json(path: str | Path, doc: Mapping[str, Any]) -> Path:
 
 def read_track(path: str | Path) -> tuple[dict[str, Any], dict[int, Contours]]:
     """Read a ``facemime.track/1`` file; returns (video info, frame index -> contours)."""
-    doc = load_json(path, "track")
+    doc = load_document(path, "track", TRACK_FORMAT)
     where = str(path)
-    if not isinstance(doc, dict) or doc.get("format") != TRACK_FORMAT:
-        found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
-        raise ContourFileError(f"{where}: expected format {TRACK_FORMAT!r}, found {found!r}")
     frames = doc.get("frames")
     if not isinstance(frames, list):
         raise ContourFileError(f"{where}: 'frames' must be a list")
@@ -163,11 +166,8 @@ def read_motion(path: str | Path) -> tuple[dict[str, Any], dict[str, Any], list[
     """Read the motion of a ``facemime.track/1`` file written by ``facemime run``: (video info,
     the ``model`` block, frames in order as dicts with ``index``, ``face`` (bool), ``pose``
     (mapping of the six pose values) and ``offsets`` ((K, 2) float64 array))."""
-    doc = load_json(path, "track")
+    doc = load_document(path, "track", TRACK_FORMAT)
     where = str(path)
-    if not isinstance(doc, dict) or doc.get("format") != TRACK_FORMAT:
-        found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
-        raise ContourFileError(f"{where}: expected format {TRACK_FORMAT!r}, found {found!r}")
     model = doc.get("model")
     if not isinstance(model, dict) or not isinstance(model.get("knots"), list) or not isinstance(model.get("feature_sizes"), list):
         raise ContourFileError(f"{where}: has no head motion ('model' with 'knots' and 'feature_sizes'); "

@@ -11,17 +11,14 @@ from pathlib import Path
 
 from facemime.errors import InvalidInputError
 from facemime.fit.points import ReferencePoints, check_points
-from facemime.io.contours_json import ContourFileError, load_json
+from facemime.io.contours_json import ContourFileError, load_document
 
 POINTS_FORMAT = "facemime.points/1"
 
 
 def read_points(path: str | Path, size: tuple[int, int]) -> ReferencePoints:
     """Read and validate a points file for an image of ``size`` = (width, height)."""
-    doc = load_json(path, "points")
-    if not isinstance(doc, dict) or doc.get("format") != POINTS_FORMAT:
-        found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
-        raise ContourFileError(f"{path}: expected format {POINTS_FORMAT!r}, got {found!r}")
+    doc = load_document(path, "points", POINTS_FORMAT)
     try:
         return check_points(doc.get("points"), *size, where=str(path))
     except InvalidInputError as e:
