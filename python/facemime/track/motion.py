@@ -1,7 +1,8 @@
 """Head-motion compensation: the similarity transform (rotation, uniform scale, translation) of
 the face between consecutive frames, from pyramidal Lucas-Kanade optical flow of textured points
 in the rigid parts of the face (nose bridge and nose, forehead), forward-backward checked and
-fitted with RANSAC. Mouth and brows ride on this motion before the snakes refine them, so the
+fitted robustly (:func:`robust_similarity`, deterministic: the same frames always give the same
+track). Mouth and brows ride on this motion before the snakes refine them, so the
 snake search range δ0/(1−σ) can stay small (method.md §4).
 
 Transforms are 2×3 float64 matrices mapping (x, y) pixels of one frame to another.
@@ -24,6 +25,7 @@ ZONES = (
 )
 WINDOW = (21, 21)
 LEVELS = 5
+SCALE = 1  # the flow runs on frames shrunk by this factor (1 or 2)
 FB_LIMIT = 1.0  # px: forward-backward error above this rejects a point
 MIN_POINTS = 6
 
@@ -49,14 +51,43 @@ def zone_polygons(contours: Mapping[str, np.ndarray]) -> list[np.ndarray]:
     return polys
 
 
+def similarity(src: np.ndarray, dst: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """The 2×3 similarity (rotation, uniform scale, translation) minimising the weighted squared
+    distances from the mapped ``src`` (N, 2) to ``dst`` (N, 2); ``weights`` (N,) ≥ 0, not all 0."""
+    w = weights / weights.sum()
+    ms, md = w @ src, w @ dst
+    a, b = src - ms, dst - md
+    norm = max(float(w @ (a * a).sum(axis=1)), 1e-12)
+    c = float(w @ (a * b).sum(axis=1)) / norm
+    s = float(w @ (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])) / norm
+    rot = np.array([[c, -s], [s, c]])
+    return np.column_stack([rot, md - rot @ ms])
+
+
+def robust_similarity(src: np.ndarray, dst: np.ndarray, limit: float, rounds: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """The similarity mapping ``src`` (N, 2) onto ``dst`` (N, 2) px despite outliers, and the
+    (N,) inlier mask (residual below ``limit`` px). Iteratively reweighted least squares with
+    Tukey's biweight, started from the median displacement; deterministic."""
+    src, dst = np.asarray(src, np.float64), np.asarray(dst, np.float64)
+    m = IDENTITY.copy()
+    m[:, 2] = np.median(dst - src, axis=0)
+    for _ in range(rounds):
+        r = np.linalg.norm(apply(m, src) - dst, axis=1)
+        cut = 4.685 * max(1.4826 * float(np.median(r)), limit / 2.0)
+        w = np.clip(1.0 - (r / cut) ** 2, 0.0, None) ** 2
+        if np.count_nonzero(w) < 2:
+            break
+        m = similarity(src, dst, w)
+    return m, np.linalg.norm(apply(m, src) - dst, axis=1) < limit
+
+
 def brow_similarity(src: Mapping[str, np.ndarray], dst: Mapping[str, np.ndarray]) -> np.ndarray:
     """The 2×3 similarity that best maps the brow contours of ``src`` onto those of ``dst``
-    (least squares over their points)."""
+    (robust least squares over their points)."""
     names = [n for n in src if n.startswith("brow")]
-    a = np.concatenate([src[n] for n in names]).astype(np.float32)
-    b = np.concatenate([dst[n] for n in names]).astype(np.float32)
-    m, _ = cv2.estimateAffinePartial2D(a, b, method=cv2.LMEDS)
-    return IDENTITY.copy() if m is None else m
+    a = np.concatenate([src[n] for n in names])
+    b = np.concatenate([dst[n] for n in names])
+    return robust_similarity(a, b, limit=1.0)[0]
 
 
 def compose(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -122,7 +153,7 @@ class HeadMotion:
 
     def _crop_box(self, shape: tuple[int, ...], extra: np.ndarray) -> tuple[int, int, int, int]:
         pts = np.concatenate(self._zones + [self.points.astype(float), extra.astype(float)])
-        pad = 2 ** LEVELS * WINDOW[0] // 2 + 8
+        pad = SCALE * (2 ** LEVELS * WINDOW[0] // 2 + 8)
         x0, y0 = np.floor(pts.min(axis=0)).astype(int) - pad
         x1, y1 = np.ceil(pts.max(axis=0)).astype(int) + pad
         return max(x0, 0), max(y0, 0), min(x1, shape[1]), min(y1, shape[0])
@@ -172,23 +203,26 @@ class HeadMotion:
         if len(self.points) >= MIN_POINTS:
             extra_pts = np.zeros((0, 2), np.float32) if extra is None else np.asarray(extra, np.float32)
             x0, y0, x1, y1 = self._crop_box(gray.shape, extra_pts)
+            x0, y0 = x0 // SCALE * SCALE, y0 // SCALE * SCALE
             off = np.array([x0, y0], np.float32)
             a, b = self._prev[y0:y1, x0:x1], gray[y0:y1, x0:x1]
+            if SCALE == 2:
+                a, b = cv2.pyrDown(a), cv2.pyrDown(b)
             p0 = (np.concatenate([self.points, extra_pts]) - off).reshape(-1, 1, 2)
             crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 20, 0.03)
-            p1, st1, _ = cv2.calcOpticalFlowPyrLK(a, b, p0, None, winSize=WINDOW, maxLevel=LEVELS, criteria=crit)
-            pb, st2, _ = cv2.calcOpticalFlowPyrLK(b, a, p1, None, winSize=WINDOW, maxLevel=LEVELS, criteria=crit)
-            good = (st1.ravel() == 1) & (st2.ravel() == 1) & (np.linalg.norm((pb - p0).reshape(-1, 2), axis=1) < FB_LIMIT)
-            p0, p1 = p0.reshape(-1, 2), p1.reshape(-1, 2)
+            q0 = p0 / SCALE
+            q1, st1, _ = cv2.calcOpticalFlowPyrLK(a, b, q0, None, winSize=WINDOW, maxLevel=LEVELS, criteria=crit)
+            qb, st2, _ = cv2.calcOpticalFlowPyrLK(b, a, q1, None, winSize=WINDOW, maxLevel=LEVELS, criteria=crit)
+            good = (st1.ravel() == 1) & (st2.ravel() == 1) & (np.linalg.norm((qb - q0).reshape(-1, 2), axis=1) * SCALE < FB_LIMIT)
+            p0, p1 = p0.reshape(-1, 2), q1.reshape(-1, 2) * SCALE
             n = len(self.points)
             if moved is not None:
                 moved[good[n:]] = p1[n:][good[n:]] + off
             good = good[:n]
             src, dst = p0[:n][good], p1[:n][good]
             if len(src) >= MIN_POINTS:
-                m, inliers = cv2.estimateAffinePartial2D(src, dst, method=cv2.RANSAC, ransacReprojThreshold=1.0)
-                if m is not None and inliers is not None and inliers.sum() >= MIN_POINTS:
-                    keep = inliers.ravel() == 1
+                m, keep = robust_similarity(src, dst, FB_LIMIT)
+                if keep.sum() >= MIN_POINTS:
                     # back to full-frame coordinates: x' = R(x - off) + t + off
                     m[:, 2] += off - m[:, :2] @ off
                     step, ok = m, True

@@ -62,7 +62,12 @@ class TrackerParams:
     forward-backward check) rather than where the head motion alone puts it. ``lost_response``: a feature
     is lost when its edge response falls below this fraction of the first frame's.
     ``calibration_passes``: solver runs on the first frame that measure how far the image edges
-    lie from the given contours (0: no correction).
+    lie from the given contours (0: no correction). ``mouth_affine``: how far each mouth
+    feature's rest shape follows the affine map that best carries it onto the knots' starting
+    positions (0: the first frame's shape moved by the head only; 1: any affine change is free),
+    so that a mouth narrowing into an "O" or opening wide is not pulled back to its neutral
+    shape. ``mouth_passes``: solver passes per frame for the mouth, each moving a knot at most
+    δ0/(1−σ), so a fast-opening mouth can be followed (the brows keep the first pass).
     """
 
     mouth: CurveWeights = CurveWeights(alpha=30.0, beta=24.0, tau=2.0, rho=1.0, gamma=0.0, chroma=0.5)
@@ -84,6 +89,8 @@ class TrackerParams:
     knot_flow: bool = True
     lost_response: float = 0.1
     calibration_passes: int = 3
+    mouth_affine: float = 0.7
+    mouth_passes: int = 2
 
     def with_(self, **changes: object) -> "TrackerParams":
         """A copy with some settings changed."""
@@ -185,6 +192,10 @@ class Tracker:
         contours = _check_contours(contours, self.width, self.height)
         self._knots0, self._index = _layout(contours, p)
         self._down0 = self._mouth_down(self._knots0)
+        self._mouth_features = [np.unique(np.concatenate([self._index[n] for n in names]))
+                                for f, names in FEATURES.items() if f.startswith("mouth")]
+        self._mouth_knots = np.unique(np.concatenate(self._mouth_features))
+        self._mouth_rows = [i for i, n in enumerate(CONTOUR_NAMES) if n.startswith("mouth")]
         self._solver, self._targets0 = self._build_solver()
         gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
         self._motion = motion.HeadMotion(gray, contours) if p.motion else None
@@ -195,11 +206,12 @@ class Tracker:
         # and report them shifted back by that offset (which turns and scales with the head).
         edges = self._knots0
         for _ in range(p.calibration_passes):
-            edges = self._solve(frame, edges, self._knots0, self._down0, self._targets0)[0]
+            edges = self._solve(*self._field(frame, edges), edges, self._knots0, self._down0, self._targets0)[0]
         self._offset = edges - self._knots0
         self._knots0 = edges
         self._knots = edges.copy()
         self._linear = np.eye(2)
+        self._down = self._down0
         self._response0 = np.maximum(self._responses(frame, edges, edges, self._down0, self._targets0), 1e-6)
 
     def _build_solver(self) -> tuple[_core.SnakeSolver, np.ndarray]:
@@ -243,9 +255,10 @@ class Tracker:
         along = (corners[1] - corners[0]) / max(np.linalg.norm(corners[1] - corners[0]), 1e-9)
         return np.array([-along[1], along[0]])
 
-    def _field(self, frame: np.ndarray, knots: np.ndarray) -> tuple[np.ndarray, tuple[float, float]]:
+    def _field(self, frame: np.ndarray, knots: np.ndarray, passes: int = 1) -> tuple[np.ndarray, tuple[float, float]]:
+        """The image field around ``knots`` wide enough for ``passes`` solver runs."""
         p = self.params
-        margin = p.delta0 / (1.0 - p.sigma) + 4.0 * p.smoothing + 2.0
+        margin = passes * p.delta0 / (1.0 - p.sigma) + 4.0 * p.smoothing + 2.0
         box = region(knots, margin, self.width, self.height)
         prev = self._prev if max(p.mouth.gamma, p.brows.gamma) > 0 else None
         return build_field(frame, prev, box, p.smoothing), (float(box[0]), float(box[1]))
@@ -255,9 +268,8 @@ class Tracker:
         _, resp = self._solver.evaluate(fld, origin, (self.width, self.height), start, rest, tuple(down), targets)
         return resp
 
-    def _solve(self, frame: np.ndarray, start: np.ndarray, rest: np.ndarray, down: np.ndarray,
-               targets: np.ndarray) -> tuple[np.ndarray, int, np.ndarray]:
-        fld, origin = self._field(frame, start)
+    def _solve(self, fld: np.ndarray, origin: tuple[float, float], start: np.ndarray, rest: np.ndarray,
+               down: np.ndarray, targets: np.ndarray) -> tuple[np.ndarray, int, np.ndarray]:
         knots, iters, _, resp = self._solver.solve(fld, origin, (self.width, self.height), start, rest, tuple(down), targets)
         return knots, iters, resp
 
@@ -283,20 +295,49 @@ class Tracker:
             followed = np.isfinite(flow[:, 0])
             start[followed] = flow[followed]
         start = np.clip(start, 0.0, bounds_hi)
-        rest = motion.apply(total, self._knots0)
+        carried = motion.apply(total, self._knots0)
+        rest = self._mouth_rest(carried, start)
         targets = self._targets0 * scale
-        knots, iters, resp = self._solve(frame, start, rest, down, targets)
+        fld, origin = self._field(frame, start, p.mouth_passes)
+        knots, iters, resp = self._solve(fld, origin, start, rest, down, targets)
+        for _ in range(p.mouth_passes - 1):
+            again, more, again_resp = self._solve(fld, origin, knots, rest, down, targets)
+            knots[self._mouth_knots] = again[self._mouth_knots]
+            resp[self._mouth_rows] = again_resp[self._mouth_rows]
+            iters += more
         confidence, lost = {}, []
         for feature, names in FEATURES.items():
             rows = [CONTOUR_NAMES.index(n) for n in names]
             conf = float(np.clip(resp[rows] / self._response0[rows], 0.0, 1.0).mean())
             confidence[feature] = conf
-            if conf < p.lost_response or not self._shape_ok(knots, rest, names):
+            if conf < p.lost_response or not self._shape_ok(knots, carried, names):
                 lost.append(feature)
         self._knots = knots
         self._linear = total[:, :2]
+        self._down = down
         self._prev = frame
         return FrameResult(self.frame_index, self.contours, confidence, lost, iters, ok)
+
+    def _uncross(self, knots: np.ndarray, down: np.ndarray) -> None:
+        """Where the inner lower lip lies above the inner upper lip (along ``down``), put both
+        points at their midpoint, so that the reported inner curves never cross (in place)."""
+        upper, lower = self._index["mouth_inner_upper"][1:-1], self._index["mouth_inner_lower"][1:-1]
+        gap = (knots[lower] - knots[upper]) @ down
+        crossed = gap < 0
+        shift = 0.5 * gap[crossed, None] * down
+        knots[upper[crossed]] += shift
+        knots[lower[crossed]] -= shift
+
+    def _mouth_rest(self, carried: np.ndarray, start: np.ndarray) -> np.ndarray:
+        """The rest knots: ``carried`` (the first frame's, moved by the head) with each mouth
+        feature moved ``mouth_affine`` of the way to its affine least-squares fit to ``start``."""
+        amount = self.params.mouth_affine
+        rest = carried.copy()
+        for idx in self._mouth_features:
+            src = np.column_stack([carried[idx], np.ones(len(idx))])
+            fit, *_ = np.linalg.lstsq(src, start[idx], rcond=None)
+            rest[idx] += amount * (src @ fit - carried[idx])
+        return rest
 
     def _shape_ok(self, knots: np.ndarray, rest: np.ndarray, names: tuple[str, str]) -> bool:
         """The upper curve's chord stays within a factor 2 of its rest chord."""
@@ -321,4 +362,5 @@ class Tracker:
     def contours(self) -> dict[str, np.ndarray]:
         """The current contours, name -> (N, 2) float64 pixels."""
         out = self._knots - self._offset @ self._linear.T
+        self._uncross(out, self._down)
         return {n: out[self._index[n]] for n in CONTOUR_NAMES}
