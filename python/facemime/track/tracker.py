@@ -6,8 +6,11 @@ Per frame:
 
 1. the head's similarity motion from the previous frame (:mod:`facemime.track.motion`) moves the
    previous knots (the snakes' start and their temporal anchor) and the rest shape (the first
-   frame's knots carried along by the accumulated head motion);
-2. the sign-descent solver (``facemime._core.SnakeSolver``) moves every knot at most δ0/(1−σ) px;
+   frame's knots carried along by the accumulated head motion; each mouth feature's rest shape
+   also follows, in part, the affine change of its knots, so an "O" or a wide-open mouth is not
+   pulled back to the neutral shape);
+2. the sign-descent solver (``facemime._core.SnakeSolver``) moves every knot at most δ0/(1−σ) px
+   per pass: one pass for the brows, ``mouth_passes`` for the mouth, whose lips move fastest;
 3. each feature's confidence is its mean edge response relative to the first frame's; a feature
    whose confidence collapses or whose shape degenerates is flagged ``lost``, so that it never
    drifts silently. (Putting a lost feature back on its rest shape was measured and made the
