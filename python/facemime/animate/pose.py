@@ -27,7 +27,6 @@ ANGLE_PRIOR = 0.05
 #: frontal; a head held turned for long is under-estimated).
 RELAX = 0.05
 GN_ITERATIONS = 6
-_STEP = np.array([0.05, 0.05, 0.05, 1e-4, 0.01, 0.01])  # finite-difference steps of the parameters
 
 
 def lift(points: np.ndarray, vertices: np.ndarray, triangles: np.ndarray, pose: Pose) -> tuple[np.ndarray, np.ndarray]:
@@ -72,6 +71,26 @@ def _pose(p: np.ndarray) -> Pose:
     return Pose(yaw=float(p[0]), pitch=float(p[1]), roll=float(p[2]), scale=float(np.exp(p[3])), tx=float(p[4]), ty=float(p[5]))
 
 
+def _residual_jacobian(x: np.ndarray, target: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Reprojection residuals (2M,) (u0, v0, u1, ...) px of model points ``x`` (M, 3) against
+    ``target`` (M, 2) at parameters ``p`` (yaw, pitch, roll in degrees, log scale, tx, ty), and
+    their analytic (2M, 6) Jacobian (the rotation of :func:`rotation_matrix`, differentiated)."""
+    (cy, sy), (cp, sp), (cr, sr) = ((np.cos(a), np.sin(a)) for a in np.radians(p[:3]))
+    ry, dry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]]), np.array([[-sy, 0, cy], [0, 0, 0], [-cy, 0, -sy]])
+    rx, drx = np.array([[1, 0, 0], [0, cp, -sp], [0, sp, cp]]), np.array([[0, 0, 0], [0, -sp, -cp], [0, cp, -sp]])
+    rz, drz = np.array([[cr, -sr, 0], [sr, cr, 0], [0, 0, 1]]), np.array([[-sr, -cr, 0], [cr, -sr, 0], [0, 0, 0]])
+    zx = rz @ rx
+    mats = np.stack([zx @ ry, zx @ dry, rz @ drx @ ry, drz @ rx @ ry])[:, :2]  # rows giving u and −v
+    q = np.einsum("kij,mj->mki", mats, x) * np.exp(p[3])  # (M, 4, 2)
+    q[..., 1] *= -1.0
+    r = (q[:, 0] + p[4:6] - target).ravel()
+    jac = np.empty((2 * len(x), 6))
+    jac[:, :3] = np.radians(1.0) * q[:, 1:].transpose(0, 2, 1).reshape(-1, 3)
+    jac[:, 3] = q[:, 0].ravel()
+    jac[:, 4:] = np.tile(np.eye(2), (len(x), 1))
+    return r, jac
+
+
 def fit_pose(model_points: np.ndarray, image_points: np.ndarray, start: Pose,
              towards: tuple[float, float] = (0.0, 0.0)) -> tuple[Pose, float]:
     """The pose that maps (M, 3) ``model_points`` onto (M, 2) ``image_points`` (px), robust
@@ -84,12 +103,8 @@ def fit_pose(model_points: np.ndarray, image_points: np.ndarray, start: Pose,
     anchor = (ANGLE_PRIOR * p[:2] + RELAX * np.asarray(towards)) / (ANGLE_PRIOR + RELAX)
     prior = ANGLE_PRIOR + RELAX
 
-    def residual(q: np.ndarray) -> np.ndarray:
-        return (project(x, _pose(q))[0] - target).ravel()
-
     for _ in range(GN_ITERATIONS):
-        r = residual(p)
-        jac = np.stack([(residual(p + d) - r) / d[k] for k, d in enumerate(np.diag(_STEP))], axis=1)
+        r, jac = _residual_jacobian(x, target, p)
         err = np.hypot(r[0::2], r[1::2])
         w = np.repeat(np.minimum(1.0, HUBER / np.maximum(err, 1e-9)), 2)
         h = jac.T @ (w[:, None] * jac)

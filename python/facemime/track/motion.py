@@ -25,7 +25,6 @@ ZONES = (
 )
 WINDOW = (21, 21)
 LEVELS = 5
-SCALE = 1  # the flow runs on frames shrunk by this factor (1 or 2)
 FB_LIMIT = 1.0  # px: forward-backward error above this rejects a point
 MIN_POINTS = 6
 
@@ -51,34 +50,32 @@ def zone_polygons(contours: Mapping[str, np.ndarray]) -> list[np.ndarray]:
     return polys
 
 
-def similarity(src: np.ndarray, dst: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """The 2×3 similarity (rotation, uniform scale, translation) minimising the weighted squared
-    distances from the mapped ``src`` (N, 2) to ``dst`` (N, 2); ``weights`` (N,) ≥ 0, not all 0."""
-    w = weights / weights.sum()
-    ms, md = w @ src, w @ dst
-    a, b = src - ms, dst - md
-    norm = max(float(w @ (a * a).sum(axis=1)), 1e-12)
-    c = float(w @ (a * b).sum(axis=1)) / norm
-    s = float(w @ (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])) / norm
-    rot = np.array([[c, -s], [s, c]])
-    return np.column_stack([rot, md - rot @ ms])
-
-
-def robust_similarity(src: np.ndarray, dst: np.ndarray, limit: float, rounds: int = 8) -> tuple[np.ndarray, np.ndarray]:
-    """The similarity mapping ``src`` (N, 2) onto ``dst`` (N, 2) px despite outliers, and the
-    (N,) inlier mask (residual below ``limit`` px). Iteratively reweighted least squares with
-    Tukey's biweight, started from the median displacement; deterministic."""
-    src, dst = np.asarray(src, np.float64), np.asarray(dst, np.float64)
-    m = IDENTITY.copy()
-    m[:, 2] = np.median(dst - src, axis=0)
+def robust_similarity(src: np.ndarray, dst: np.ndarray, limit: float, rounds: int = 10) -> tuple[np.ndarray, np.ndarray]:
+    """The 2×3 similarity (rotation, uniform scale, translation) mapping ``src`` (N, 2) onto
+    ``dst`` (N, 2) px despite outliers, and the (N,) inlier mask (residual below ``limit`` px).
+    Iteratively reweighted least squares with Tukey's biweight, started from the median
+    displacement; deterministic. Points are complex numbers here: the map is z ↦ a·z + b."""
+    zs = np.asarray(src, np.float64) @ [1.0, 1j]
+    zd = np.asarray(dst, np.float64) @ [1.0, 1j]
+    diff, reach = zd - zs, float(np.abs(zs).max(initial=0.0))
+    a, b = 1.0 + 0j, complex(np.median(diff.real), np.median(diff.imag))
     for _ in range(rounds):
-        r = np.linalg.norm(apply(m, src) - dst, axis=1)
+        r = np.abs(a * zs + b - zd)
         cut = 4.685 * max(1.4826 * float(np.median(r)), limit / 2.0)
         w = np.clip(1.0 - (r / cut) ** 2, 0.0, None) ** 2
+        total = w.sum()
         if np.count_nonzero(w) < 2:
             break
-        m = similarity(src, dst, w)
-    return m, np.linalg.norm(apply(m, src) - dst, axis=1) < limit
+        ms, md = (w @ zs) / total, (w @ zd) / total
+        cs = zs - ms
+        new_a = ((w * cs.conj()) @ (zd - md)) / max(float(w @ (cs.real ** 2 + cs.imag ** 2)), 1e-12)
+        new_b = md - new_a * ms
+        done = abs(new_a - a) * reach + abs(new_b - b) < 1e-3  # px
+        a, b = new_a, new_b
+        if done:
+            break
+    m = np.array([[a.real, -a.imag, b.real], [a.imag, a.real, b.imag]])
+    return m, np.abs(a * zs + b - zd) < limit
 
 
 def brow_similarity(src: Mapping[str, np.ndarray], dst: Mapping[str, np.ndarray]) -> np.ndarray:
@@ -153,7 +150,7 @@ class HeadMotion:
 
     def _crop_box(self, shape: tuple[int, ...], extra: np.ndarray) -> tuple[int, int, int, int]:
         pts = np.concatenate(self._zones + [self.points.astype(float), extra.astype(float)])
-        pad = SCALE * (2 ** LEVELS * WINDOW[0] // 2 + 8)
+        pad = 2 ** LEVELS * WINDOW[0] // 2 + 8
         x0, y0 = np.floor(pts.min(axis=0)).astype(int) - pad
         x1, y1 = np.ceil(pts.max(axis=0)).astype(int) + pad
         return max(x0, 0), max(y0, 0), min(x1, shape[1]), min(y1, shape[0])
@@ -203,18 +200,14 @@ class HeadMotion:
         if len(self.points) >= MIN_POINTS:
             extra_pts = np.zeros((0, 2), np.float32) if extra is None else np.asarray(extra, np.float32)
             x0, y0, x1, y1 = self._crop_box(gray.shape, extra_pts)
-            x0, y0 = x0 // SCALE * SCALE, y0 // SCALE * SCALE
             off = np.array([x0, y0], np.float32)
             a, b = self._prev[y0:y1, x0:x1], gray[y0:y1, x0:x1]
-            if SCALE == 2:
-                a, b = cv2.pyrDown(a), cv2.pyrDown(b)
             p0 = (np.concatenate([self.points, extra_pts]) - off).reshape(-1, 1, 2)
             crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 20, 0.03)
-            q0 = p0 / SCALE
-            q1, st1, _ = cv2.calcOpticalFlowPyrLK(a, b, q0, None, winSize=WINDOW, maxLevel=LEVELS, criteria=crit)
-            qb, st2, _ = cv2.calcOpticalFlowPyrLK(b, a, q1, None, winSize=WINDOW, maxLevel=LEVELS, criteria=crit)
-            good = (st1.ravel() == 1) & (st2.ravel() == 1) & (np.linalg.norm((qb - q0).reshape(-1, 2), axis=1) * SCALE < FB_LIMIT)
-            p0, p1 = p0.reshape(-1, 2), q1.reshape(-1, 2) * SCALE
+            p1, st1, _ = cv2.calcOpticalFlowPyrLK(a, b, p0, None, winSize=WINDOW, maxLevel=LEVELS, criteria=crit)
+            pb, st2, _ = cv2.calcOpticalFlowPyrLK(b, a, p1, None, winSize=WINDOW, maxLevel=LEVELS, criteria=crit)
+            good = (st1.ravel() == 1) & (st2.ravel() == 1) & (np.linalg.norm((pb - p0).reshape(-1, 2), axis=1) < FB_LIMIT)
+            p0, p1 = p0.reshape(-1, 2), p1.reshape(-1, 2)
             n = len(self.points)
             if moved is not None:
                 moved[good[n:]] = p1[n:][good[n:]] + off
