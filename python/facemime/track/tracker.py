@@ -35,6 +35,8 @@ from facemime.track.contours import CONTOUR_NAMES, FEATURES, POLARITY
 from facemime.track.field import build_field, region
 
 OPERATORS = ("directional", "magnitude")
+#: The mouth gets another solver pass only when a knot moved this fraction of a pass's reach.
+FAST = 0.6
 
 
 @dataclass(frozen=True)
@@ -69,8 +71,9 @@ class TrackerParams:
     feature's rest shape follows the affine map that best carries it onto the knots' starting
     positions (0: the first frame's shape moved by the head only; 1: any affine change is free),
     so that a mouth narrowing into an "O" or opening wide is not pulled back to its neutral
-    shape. ``mouth_passes``: solver passes per frame for the mouth, each moving a knot at most
-    δ0/(1−σ), so a fast-opening mouth can be followed (the brows keep the first pass).
+    shape. ``mouth_passes``: solver passes per frame for the mouth at most, each moving a knot
+    at most δ0/(1−σ), so a fast-opening mouth can be followed; a pass follows only when a mouth
+    knot moved :data:`FAST` of that reach in the previous one (the brows keep the first pass).
     """
 
     mouth: CurveWeights = CurveWeights(alpha=30.0, beta=24.0, tau=2.0, rho=1.0, gamma=0.0, chroma=0.5)
@@ -303,8 +306,13 @@ class Tracker:
         targets = self._targets0 * scale
         fld, origin = self._field(frame, start, p.mouth_passes)
         knots, iters, resp = self._solve(fld, origin, start, rest, down, targets)
+        reach = p.delta0 / (1.0 - p.sigma)
+        before = start
         for _ in range(p.mouth_passes - 1):
-            again, more, again_resp = self._solve(fld, origin, knots, rest, down, targets)
+            if np.abs(knots[self._mouth_knots] - before[self._mouth_knots]).max() < FAST * reach:
+                break
+            before = knots.copy()
+            again, more, again_resp = self._solve(fld, origin, before, rest, down, targets)
             knots[self._mouth_knots] = again[self._mouth_knots]
             resp[self._mouth_rows] = again_resp[self._mouth_rows]
             iters += more
