@@ -37,6 +37,8 @@ from facemime.track.field import build_field, region
 OPERATORS = ("directional", "magnitude")
 #: The mouth gets another solver pass only when a knot moved this fraction of a pass's reach.
 FAST = 0.6
+#: Fraction of the inner mouth's sideways drift from the centre of the outer mouth removed per frame.
+CENTRING = 0.3
 
 
 @dataclass(frozen=True)
@@ -198,9 +200,8 @@ class Tracker:
         contours = _check_contours(contours, self.width, self.height)
         self._knots0, self._index = _layout(contours, p)
         self._down0 = self._mouth_down(self._knots0)
-        self._mouth_features = [np.unique(np.concatenate([self._index[n] for n in names]))
-                                for f, names in FEATURES.items() if f.startswith("mouth")]
-        self._mouth_knots = np.unique(np.concatenate(self._mouth_features))
+        self._features = {f: np.unique(np.concatenate([self._index[n] for n in names])) for f, names in FEATURES.items()}
+        self._mouth_knots = np.unique(np.concatenate([self._features["mouth_outer"], self._features["mouth_inner"]]))
         self._mouth_rows = [i for i, n in enumerate(CONTOUR_NAMES) if n.startswith("mouth")]
         self._solver, self._targets0 = self._build_solver()
         gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
@@ -316,6 +317,7 @@ class Tracker:
             knots[self._mouth_knots] = again[self._mouth_knots]
             resp[self._mouth_rows] = again_resp[self._mouth_rows]
             iters += more
+        self._centre_inner(knots, rest, down)
         confidence, lost = {}, []
         for feature, names in FEATURES.items():
             rows = [CONTOUR_NAMES.index(n) for n in names]
@@ -328,6 +330,15 @@ class Tracker:
         self._down = down
         self._prev = frame
         return FrameResult(self.frame_index, self.contours, confidence, lost, iters, ok)
+
+    def _centre_inner(self, knots: np.ndarray, rest: np.ndarray, down: np.ndarray) -> None:
+        """Slide the inner mouth along the mouth line so that it sits where it sat in the outer
+        mouth in the rest shape (a closed mouth's dark line gives the inner curves nothing to
+        hold them sideways; in place)."""
+        along = np.array([down[1], -down[0]])
+        inner, outer = self._features["mouth_inner"], self._features["mouth_outer"]
+        drift = (knots[inner].mean(axis=0) - knots[outer].mean(axis=0)) - (rest[inner].mean(axis=0) - rest[outer].mean(axis=0))
+        knots[inner] -= CENTRING * (drift @ along) * along
 
     def _uncross(self, knots: np.ndarray, down: np.ndarray) -> None:
         """Where the inner lower lip lies above the inner upper lip (along ``down``), put both
@@ -344,7 +355,7 @@ class Tracker:
         feature moved ``mouth_affine`` of the way to its affine least-squares fit to ``start``."""
         amount = self.params.mouth_affine
         rest = carried.copy()
-        for idx in self._mouth_features:
+        for idx in (self._features["mouth_outer"], self._features["mouth_inner"]):
             src = np.column_stack([carried[idx], np.ones(len(idx))])
             fit, *_ = np.linalg.lstsq(src, start[idx], rcond=None)
             rest[idx] += amount * (src @ fit - carried[idx])
