@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from facemime.render.projection import Pose, project
+from facemime.render.projection import Pose, project, rotation_matrix
 from facemime.track.motion import HeadMotion
 
 #: Fewest lifted points that fit a pose.
@@ -71,16 +71,19 @@ def _pose(p: np.ndarray) -> Pose:
     return Pose(yaw=float(p[0]), pitch=float(p[1]), roll=float(p[2]), scale=float(np.exp(p[3])), tx=float(p[4]), ty=float(p[5]))
 
 
+#: Generators of the rotations about y, x and z: d/dθ of each axis rotation at θ = 0, radians.
+_GY = np.array([[0.0, 0, 1], [0, 0, 0], [-1, 0, 0]])
+_GX = np.array([[0.0, 0, 0], [0, 0, -1], [0, 1, 0]])
+_GZ = np.array([[0.0, -1, 0], [1, 0, 0], [0, 0, 0]])
+
+
 def _residual_jacobian(x: np.ndarray, target: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Reprojection residuals (2M,) (u0, v0, u1, ...) px of model points ``x`` (M, 3) against
     ``target`` (M, 2) at parameters ``p`` (yaw, pitch, roll in degrees, log scale, tx, ty), and
-    their analytic (2M, 6) Jacobian (the rotation of :func:`rotation_matrix`, differentiated)."""
-    (cy, sy), (cp, sp), (cr, sr) = ((np.cos(a), np.sin(a)) for a in np.radians(p[:3]))
-    ry, dry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]]), np.array([[-sy, 0, cy], [0, 0, 0], [-cy, 0, -sy]])
-    rx, drx = np.array([[1, 0, 0], [0, cp, -sp], [0, sp, cp]]), np.array([[0, 0, 0], [0, -sp, -cp], [0, cp, -sp]])
-    rz, drz = np.array([[cr, -sr, 0], [sr, cr, 0], [0, 0, 1]]), np.array([[-sr, -cr, 0], [cr, -sr, 0], [0, 0, 0]])
-    zx = rz @ rx
-    mats = np.stack([zx @ ry, zx @ dry, rz @ drx @ ry, drz @ rx @ ry])[:, :2]  # rows giving u and −v
+    their analytic (2M, 6) Jacobian. With R = Rz·Rx·Ry (:func:`rotation_matrix`):
+    ∂R/∂yaw = R·Gy, ∂R/∂pitch = Rz·Gx·Rzᵀ·R, ∂R/∂roll = Gz·R (per radian)."""
+    rot, rz = rotation_matrix(*p[:3]), rotation_matrix(roll=p[2])
+    mats = np.stack([rot, rot @ _GY, rz @ _GX @ rz.T @ rot, _GZ @ rot])[:, :2]  # rows giving u and −v
     q = np.einsum("kij,mj->mki", mats, x) * np.exp(p[3])  # (M, 4, 2)
     q[..., 1] *= -1.0
     r = (q[:, 0] + p[4:6] - target).ravel()

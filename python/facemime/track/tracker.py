@@ -262,10 +262,10 @@ class Tracker:
         along = (corners[1] - corners[0]) / max(np.linalg.norm(corners[1] - corners[0]), 1e-9)
         return np.array([-along[1], along[0]])
 
-    def _field(self, frame: np.ndarray, knots: np.ndarray, passes: int = 1) -> tuple[np.ndarray, tuple[float, float]]:
-        """The image field around ``knots`` wide enough for ``passes`` solver runs."""
+    def _field(self, frame: np.ndarray, knots: np.ndarray) -> tuple[np.ndarray, tuple[float, float]]:
+        """The image field around ``knots``, wide enough for one solver pass from them."""
         p = self.params
-        margin = passes * p.delta0 / (1.0 - p.sigma) + 4.0 * p.smoothing + 2.0
+        margin = p.delta0 / (1.0 - p.sigma) + 4.0 * p.smoothing + 2.0
         box = region(knots, margin, self.width, self.height)
         prev = self._prev if max(p.mouth.gamma, p.brows.gamma) > 0 else None
         return build_field(frame, prev, box, p.smoothing), (float(box[0]), float(box[1]))
@@ -305,15 +305,14 @@ class Tracker:
         carried = motion.apply(total, self._knots0)
         rest = self._mouth_rest(carried, start)
         targets = self._targets0 * scale
-        fld, origin = self._field(frame, start, p.mouth_passes)
-        knots, iters, resp = self._solve(fld, origin, start, rest, down, targets)
+        knots, iters, resp = self._solve(*self._field(frame, start), start, rest, down, targets)
         reach = p.delta0 / (1.0 - p.sigma)
         before = start
         for _ in range(p.mouth_passes - 1):
             if np.abs(knots[self._mouth_knots] - before[self._mouth_knots]).max() < FAST * reach:
                 break
             before = knots.copy()
-            again, more, again_resp = self._solve(fld, origin, before, rest, down, targets)
+            again, more, again_resp = self._solve(*self._field(frame, before), before, rest, down, targets)
             knots[self._mouth_knots] = again[self._mouth_knots]
             resp[self._mouth_rows] = again_resp[self._mouth_rows]
             iters += more
