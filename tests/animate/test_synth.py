@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from facemime.animate.synth import Puppet, UserMotion, synthesize
+from facemime.animate.synth import Puppet, UserMotion, draw_mouth_interior, synthesize
 from facemime.errors import InvalidInputError
 from facemime.fit.placement import model_iod
 from facemime.render.projection import project
@@ -39,6 +39,21 @@ def test_a_closed_mouth_only_fills_the_sliver_between_the_lips(actor):
     changed = np.abs(synth.astype(int) - plain).max(axis=2) > 1
     # Only pixels where the background leaked between the lips change.
     assert changed.sum() < 30 and (plain[changed] == GREEN).all()
+
+
+@pytest.mark.parametrize("gap", [0.3, 1.0, 2.0])
+def test_lips_barely_apart_show_a_dark_line_and_no_teeth(gap):
+    # A 70 px mouth whose inner lips are a few pixels apart: a real one shows the dark gap
+    # between the lips; a bright line of teeth there cost the synthesis 3-6 dB on real videos.
+    x = np.linspace(100.0, 170.0, 9)
+    arch = gap * np.sin(np.linspace(0.0, np.pi, 9))
+    upper = np.column_stack([x, 80.0 - arch / 2])
+    lower = np.column_stack([x, 80.0 + arch / 2])
+    out = np.full((160, 260, 3), 120, np.uint8)
+    draw_mouth_interior(out, upper, lower)
+    changed = (out != 120).any(axis=2)
+    assert changed.any()
+    assert out[changed].max() <= 120  # darker than the lips around it: no teeth
 
 
 def test_motion_carries_to_a_face_of_other_proportions(actor):

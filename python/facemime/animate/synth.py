@@ -28,6 +28,9 @@ GAPS = (150, 140, 128)
 UPPER_TEETH = 0.11
 LOWER_TEETH = 0.07
 TEETH_SPAN = 0.72
+#: Opening (fraction of the mouth's width) below which no teeth show: a mouth barely apart shows
+#: the dark gap between the lips.
+TEETH_FROM = 0.04
 SHIFT = 4  # sub-pixel bits for cv2 drawing
 
 
@@ -55,10 +58,13 @@ def draw_mouth_interior(out: np.ndarray, upper: np.ndarray, lower: np.ndarray) -
     keep = np.abs(np.linspace(-1.0, 1.0, len(upper))) <= TEETH_SPAN
     if len(upper) != len(lower) or keep.sum() < 2:
         keep[:] = True
-    opening = np.maximum((lower - upper) @ down, 0.0)[keep] if len(upper) == len(lower) else np.full(keep.sum(), width)
+    opening = (lower - upper) @ down if len(upper) == len(lower) else np.full(len(upper), width)
+    opening = np.maximum(opening - TEETH_FROM * width, 0.0)[keep]
     for curve, height, share, sign in ((upper, UPPER_TEETH, 0.55, 1.0), (lower, LOWER_TEETH, 0.3, -1.0)):
         edge = curve[keep]
         reach = np.minimum(height * width, share * opening)[:, None]
+        if reach.max() < 0.5:  # an anti-aliased outline of teeth with no height would still show
+            continue
         band = np.concatenate([edge, (edge + sign * reach * down)[::-1]])
         cv2.fillPoly(paint, [fix(band)], TEETH, cv2.LINE_AA, SHIFT)
         for a, b in zip(edge[1:-1], (edge + sign * reach * down)[1:-1]):  # gaps between the teeth
