@@ -79,7 +79,7 @@ class TrackerParams:
     """
 
     mouth: CurveWeights = CurveWeights(alpha=30.0, beta=24.0, tau=2.0, rho=1.0, gamma=0.0, chroma=0.5)
-    mouth_inner: CurveWeights = CurveWeights(alpha=30.0, beta=24.0, tau=2.0, rho=1.0, gamma=0.0, luma=0.5, chroma=1.0)
+    mouth_inner: CurveWeights = CurveWeights(alpha=8.0, beta=12.0, tau=2.0, rho=1.0, gamma=0.0, luma=0.5, chroma=1.0)
     brows: CurveWeights = CurveWeights(alpha=30.0, beta=24.0, tau=2.0, rho=1.0, gamma=0.0, chroma=0.0)
     operator: str = "directional"
     points_per_segment: int = 3
