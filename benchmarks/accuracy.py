@@ -6,6 +6,11 @@ the reference contours of the first frame, against two baselines measured in the
   same points frame to frame, with a forward-backward check (a point whose back-tracked position
   lands more than 1 px from where it started keeps its previous position).
 
+Next to the NME, **mouth opening**: per frame, the error of the inner lips' opening (the
+distance from the inner upper to the inner lower lip along the mouth's normal, mean over the
+middle half of the mouth) over the IOD. NME hides an inner mouth that stays shut over teeth
+(its error is spread over the curves' points); this figure does not.
+
 With ``--variants`` the tracker also runs with other image operators H (gradient magnitude,
 luma only, colour only) to show why the default is what it is.
 
@@ -26,12 +31,22 @@ import cv2
 import numpy as np
 
 from facemime.io.video import VideoReader
-from facemime.metrics import group_nme, pooled_summary, summarize
+from facemime.metrics import group_nme, pooled_summary, resample, summarize
 from facemime.track import Tracker, TrackerParams
 from facemime.track.contours import CONTOUR_NAMES, GROUPS, from_face_mesh
 
 VIDEOS = ("lp_d0", "lp_d3", "lp_d6", "lp_d12", "vr_1", "vr_2")
 ROOT = Path(__file__).resolve().parents[1]
+SCORED = tuple(GROUPS) + ("mouth_opening",)
+
+
+def mouth_opening(contours: dict) -> float:
+    """Inner-lip opening (px): lower minus upper inner lip along the normal of the corner line,
+    mean over the middle half of the mouth."""
+    upper, lower = resample(contours["mouth_inner_upper"], 9), resample(contours["mouth_inner_lower"], 9)
+    along = upper[-1] - upper[0]
+    down = np.array([-along[1], along[0]]) / max(float(np.linalg.norm(along)), 1e-9)
+    return float(((lower - upper)[2:7] @ down).mean())
 
 
 def variants() -> dict[str, TrackerParams]:
@@ -72,14 +87,16 @@ def run_lk(frames: list[np.ndarray], init: dict) -> list[dict]:
 
 
 def score(tracks: list[dict], landmarks: np.ndarray, valid: np.ndarray, iod: np.ndarray) -> dict[str, np.ndarray]:
-    """Per-frame NME of each group over the scored frames (1..T-1 with a reference face)."""
-    per = {g: [] for g in GROUPS}
+    """Per-frame NME of each group and mouth-opening error over IOD, over the scored frames
+    (1..T-1 with a reference face)."""
+    per = {g: [] for g in SCORED}
     for i, contours in enumerate(tracks, start=1):
         if not valid[i]:
             continue
         ref = from_face_mesh(landmarks[i])
         for g, names in GROUPS.items():
             per[g].append(group_nme(contours, ref, names, float(iod[i])))
+        per["mouth_opening"].append(abs(mouth_opening(contours) - mouth_opening(ref)) / float(iod[i]))
     return {g: np.array(v) for g, v in per.items()}
 
 
@@ -92,7 +109,7 @@ def main() -> None:
     cv2.setNumThreads(1)
     methods = variants() if args.variants else {"facemime (directional, luma + colour)": TrackerParams()}
     names = ["static", "LK + FB"] + list(methods)
-    series: dict[str, dict[str, list[np.ndarray]]] = {m: {g: [] for g in GROUPS} for m in names}
+    series: dict[str, dict[str, list[np.ndarray]]] = {m: {g: [] for g in SCORED} for m in names}
     lost: dict[str, dict[str, int]] = {m: {} for m in methods}
     per_video: dict[str, dict] = {}
     for video in args.videos.split(","):
@@ -112,11 +129,12 @@ def main() -> None:
         for m, tracks in runs.items():
             scores = score(tracks, lm, valid, iod)
             per_video[video][m] = {g: summarize(v) for g, v in scores.items()}
-            for g in GROUPS:
+            for g in SCORED:
                 series[m][g].append(scores[g])
-    pooled = {m: {g: pooled_summary(series[m][g]) for g in GROUPS} for m in names}
-    for g in GROUPS:
-        print(f"\n{g} (NME over {len(per_video)} videos, init frame excluded)")
+    pooled = {m: {g: pooled_summary(series[m][g]) for g in SCORED} for m in names}
+    for g in SCORED:
+        what = "opening error / IOD" if g == "mouth_opening" else "NME"
+        print(f"\n{g} ({what} over {len(per_video)} videos, init frame excluded)")
         print(f"  {'method':48s} {'mean':>7s} {'median':>7s} {'p90':>7s} {'fail%':>6s} {'drift':>7s}   per-video mean")
         for m in names:
             s = pooled[m][g]
