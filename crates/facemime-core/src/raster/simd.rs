@@ -132,3 +132,71 @@ unsafe fn span_avx2<const C: usize>(
     }
     done
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::raster::sampler::{Bilinear, Sampler};
+    use proptest::prelude::*;
+
+    fn noise(w: usize, h: usize, c: usize, seed: u64) -> Vec<u8> {
+        let mut s = seed | 1;
+        (0..w * h * c)
+            .map(|_| {
+                s ^= s << 13;
+                s ^= s >> 7;
+                s ^= s << 17;
+                (s >> 24) as u8
+            })
+            .collect()
+    }
+
+    fn check<const C: usize>(u: i64, v: i64, du: i64, dv: i64, n: usize, seed: u64) {
+        let (w, h) = (37, 29);
+        let data = noise(w, h, C, seed);
+        let tex = ImageRef {
+            data: &data,
+            width: w,
+            height: h,
+            channels: C,
+        };
+        let last = n as i64 - 1;
+        if !(Bilinear::in_bounds(&tex, u, v)
+            && Bilinear::in_bounds(&tex, u + du * last, v + dv * last))
+        {
+            return;
+        }
+        // One guard pixel on each side catches a write outside the span.
+        let mut out = vec![7u8; (n + 2) * C];
+        let wrote =
+            unsafe { bilinear_span_avx2::<C>(&tex, u, v, du, dv, &mut out[C..(n + 1) * C]) };
+        if wrote == 0 {
+            return;
+        }
+        assert_eq!(wrote, n);
+        assert!(
+            out[..C].iter().chain(&out[(n + 1) * C..]).all(|&b| b == 7),
+            "wrote outside the span"
+        );
+        for k in 0..n {
+            let want = Bilinear::sample::<C>(&tex, u + du * k as i64, v + dv * k as i64);
+            assert_eq!(
+                &out[(k + 1) * C..(k + 2) * C],
+                &want[..],
+                "pixel {k} of {n}"
+            );
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn avx2_span_matches_scalar_lookups(
+            u in 0i64..(36 << 16), v in 0i64..(27 << 16),
+            du in -(3i64 << 16)..(3 << 16), dv in -(1i64 << 16)..(1 << 16),
+            n in 1usize..40, seed in any::<u64>(),
+        ) {
+            check::<3>(u, v, du / 16, dv / 16, n, seed);
+            check::<4>(u, v, du / 16, dv / 16, n, seed);
+        }
+    }
+}
