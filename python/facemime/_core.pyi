@@ -38,6 +38,13 @@ def elastic_adjust(
     tolerance: float,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 
+def robust_similarity(
+    src: npt.NDArray[np.float64],
+    dst: npt.NDArray[np.float64],
+    limit: float,
+    rounds: int,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...
+
 FIELD_CHANNELS: int
 
 class SnakeSolver:

@@ -8,6 +8,7 @@
 
 pub mod adjust;
 pub mod error;
+pub mod motion;
 pub mod raster;
 pub mod snake;
 

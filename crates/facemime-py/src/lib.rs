@@ -5,6 +5,7 @@ use pyo3::prelude::*;
 
 mod adjust;
 mod error;
+mod motion;
 mod raster;
 mod snake;
 
@@ -12,6 +13,7 @@ mod snake;
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     adjust::register(m)?;
+    motion::register(m)?;
     raster::register(m)?;
     snake::register(m)?;
     Ok(())

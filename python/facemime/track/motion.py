@@ -15,6 +15,8 @@ from collections.abc import Mapping
 import cv2
 import numpy as np
 
+from facemime import _core
+
 #: Rigid zones in face coordinates (s, t) of the first frame: a point is ``c + s·W·u + t·v``
 #: where ``c`` is the centre of the brows, ``v`` runs from it to the centre of the mouth, ``u`` is
 #: ``v`` turned to image-right (unit) and ``W`` is the outer width of the brows. In later frames
@@ -54,28 +56,9 @@ def robust_similarity(src: np.ndarray, dst: np.ndarray, limit: float, rounds: in
     """The 2×3 similarity (rotation, uniform scale, translation) mapping ``src`` (N, 2) onto
     ``dst`` (N, 2) px despite outliers, and the (N,) inlier mask (residual below ``limit`` px).
     Iteratively reweighted least squares with Tukey's biweight, started from the median
-    displacement; deterministic. Points are complex numbers here: the map is z ↦ a·z + b."""
-    zs = np.asarray(src, np.float64) @ [1.0, 1j]
-    zd = np.asarray(dst, np.float64) @ [1.0, 1j]
-    diff, reach = zd - zs, float(np.abs(zs).max(initial=0.0))
-    a, b = 1.0 + 0j, complex(np.median(diff.real), np.median(diff.imag))
-    for _ in range(rounds):
-        r = np.abs(a * zs + b - zd)
-        cut = 4.685 * max(1.4826 * float(np.median(r)), limit / 2.0)
-        w = np.clip(1.0 - (r / cut) ** 2, 0.0, None) ** 2
-        total = w.sum()
-        if np.count_nonzero(w) < 2:
-            break
-        ms, md = (w @ zs) / total, (w @ zd) / total
-        cs = zs - ms
-        new_a = ((w * cs.conj()) @ (zd - md)) / max(float(w @ (cs.real ** 2 + cs.imag ** 2)), 1e-12)
-        new_b = md - new_a * ms
-        done = abs(new_a - a) * reach + abs(new_b - b) < 1e-3  # px
-        a, b = new_a, new_b
-        if done:
-            break
-    m = np.array([[a.real, -a.imag, b.real], [a.imag, a.real, b.imag]])
-    return m, np.abs(a * zs + b - zd) < limit
+    displacement; deterministic (``facemime._core.robust_similarity``)."""
+    as_points = lambda p: np.ascontiguousarray(p, np.float64).reshape(-1, 2)  # noqa: E731
+    return _core.robust_similarity(as_points(src), as_points(dst), float(limit), int(rounds))
 
 
 def brow_similarity(src: Mapping[str, np.ndarray], dst: Mapping[str, np.ndarray]) -> np.ndarray:

@@ -1,0 +1,51 @@
+//! Bindings of `facemime_core::motion`: the robust similarity fit of the head motion.
+
+use facemime_core::motion;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+fn points(name: &str, a: &PyReadonlyArray2<f64>) -> PyResult<Vec<[f64; 2]>> {
+    let v = a.as_array();
+    if v.shape()[1] != 2 {
+        return Err(PyValueError::new_err(format!(
+            "{name} must have shape (N, 2), got {:?}",
+            v.shape()
+        )));
+    }
+    Ok(v.rows().into_iter().map(|r| [r[0], r[1]]).collect())
+}
+
+/// The 2×3 similarity and the inlier mask.
+type Fit<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>);
+
+/// src, dst: (N, 2) points (pixels); limit: inlier residual (pixels); rounds: IRLS rounds at most.
+/// Returns (the 2×3 similarity mapping src onto dst, the (N,) inlier mask).
+#[pyfunction]
+fn robust_similarity<'py>(
+    py: Python<'py>,
+    src: PyReadonlyArray2<f64>,
+    dst: PyReadonlyArray2<f64>,
+    limit: f64,
+    rounds: usize,
+) -> PyResult<Fit<'py>> {
+    let (s, d) = (points("src", &src)?, points("dst", &dst)?);
+    if s.len() != d.len() {
+        return Err(PyValueError::new_err(format!(
+            "src has {} points but dst has {}",
+            s.len(),
+            d.len()
+        )));
+    }
+    let (m, inliers) = py.detach(|| motion::robust_similarity(&s, &d, limit, rounds));
+    let flat: Vec<f64> = m.iter().flatten().copied().collect();
+    let out = numpy::ndarray::Array2::from_shape_vec((2, 3), flat)
+        .expect("2 x 3")
+        .into_pyarray(py);
+    Ok((out, inliers.into_pyarray(py)))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(robust_similarity, m)?)?;
+    Ok(())
+}
