@@ -44,6 +44,15 @@ def robust_similarity(
     limit: float,
     rounds: int,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...
+def fit_pose(
+    model_points: npt.NDArray[np.float64],
+    image_points: npt.NDArray[np.float64],
+    start: tuple[float, float, float, float, float, float],
+    anchor: tuple[float, float],
+    prior: float,
+    huber: float,
+    iterations: int,
+) -> tuple[float, float, float, float, float, float]: ...
 
 FIELD_CHANNELS: int
 

@@ -9,6 +9,7 @@
 pub mod adjust;
 pub mod error;
 pub mod motion;
+pub mod pose;
 pub mod raster;
 pub mod snake;
 

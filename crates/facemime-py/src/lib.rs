@@ -6,6 +6,7 @@ use pyo3::prelude::*;
 mod adjust;
 mod error;
 mod motion;
+mod pose;
 mod raster;
 mod snake;
 
@@ -14,6 +15,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     adjust::register(m)?;
     motion::register(m)?;
+    pose::register(m)?;
     raster::register(m)?;
     snake::register(m)?;
     Ok(())

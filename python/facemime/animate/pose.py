@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from facemime.render.projection import Pose, project, rotation_matrix
+from facemime import _core
+from facemime.render.projection import Pose, project
 from facemime.track.motion import HeadMotion
 
 #: Fewest lifted points that fit a pose.
@@ -71,53 +72,18 @@ def _pose(p: np.ndarray) -> Pose:
     return Pose(yaw=float(p[0]), pitch=float(p[1]), roll=float(p[2]), scale=float(np.exp(p[3])), tx=float(p[4]), ty=float(p[5]))
 
 
-#: Generators of the rotations about y, x and z: d/dθ of each axis rotation at θ = 0, radians.
-_GY = np.array([[0.0, 0, 1], [0, 0, 0], [-1, 0, 0]])
-_GX = np.array([[0.0, 0, 0], [0, 0, -1], [0, 1, 0]])
-_GZ = np.array([[0.0, -1, 0], [1, 0, 0], [0, 0, 0]])
-
-
-def _residual_jacobian(x: np.ndarray, target: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Reprojection residuals (2M,) (u0, v0, u1, ...) px of model points ``x`` (M, 3) against
-    ``target`` (M, 2) at parameters ``p`` (yaw, pitch, roll in degrees, log scale, tx, ty), and
-    their analytic (2M, 6) Jacobian. With R = Rz·Rx·Ry (:func:`rotation_matrix`):
-    ∂R/∂yaw = R·Gy, ∂R/∂pitch = Rz·Gx·Rzᵀ·R, ∂R/∂roll = Gz·R (per radian)."""
-    rot, rz = rotation_matrix(*p[:3]), rotation_matrix(roll=p[2])
-    mats = np.stack([rot, rot @ _GY, rz @ _GX @ rz.T @ rot, _GZ @ rot])[:, :2]  # rows giving u and −v
-    q = np.einsum("kij,mj->mki", mats, x) * np.exp(p[3])  # (M, 4, 2)
-    q[..., 1] *= -1.0
-    r = (q[:, 0] + p[4:6] - target).ravel()
-    jac = np.empty((2 * len(x), 6))
-    jac[:, :3] = np.radians(1.0) * q[:, 1:].transpose(0, 2, 1).reshape(-1, 3)
-    jac[:, 3] = q[:, 0].ravel()
-    jac[:, 4:] = np.tile(np.eye(2), (len(x), 1))
-    return r, jac
-
-
 def fit_pose(model_points: np.ndarray, image_points: np.ndarray, start: Pose,
              towards: tuple[float, float] = (0.0, 0.0)) -> tuple[Pose, float]:
-    """The pose that maps (M, 3) ``model_points`` onto (M, 2) ``image_points`` (px), robust
-    least squares from ``start``; yaw and pitch are held towards ``start``'s (weight
-    :data:`ANGLE_PRIOR`) and ``towards`` (weight :data:`RELAX`), degrees. Returns the pose and
-    the median reprojection error (px)."""
-    x = np.asarray(model_points, np.float64)
-    target = np.asarray(image_points, np.float64)
+    """The pose that maps (M, 3) ``model_points`` onto (M, 2) ``image_points`` (px): Gauss-Newton
+    with Huber weights (:data:`HUBER`) from ``start`` (``facemime._core.fit_pose``, analytic
+    Jacobian); yaw and pitch are held towards ``start``'s (weight :data:`ANGLE_PRIOR`) and
+    ``towards`` (weight :data:`RELAX`), degrees. Returns the pose and the median reprojection
+    error (px)."""
+    x = np.ascontiguousarray(model_points, np.float64)
+    target = np.ascontiguousarray(image_points, np.float64)
     p = _params(start)
     anchor = (ANGLE_PRIOR * p[:2] + RELAX * np.asarray(towards)) / (ANGLE_PRIOR + RELAX)
-    prior = ANGLE_PRIOR + RELAX
-
-    for _ in range(GN_ITERATIONS):
-        r, jac = _residual_jacobian(x, target, p)
-        err = np.hypot(r[0::2], r[1::2])
-        w = np.repeat(np.minimum(1.0, HUBER / np.maximum(err, 1e-9)), 2)
-        h = jac.T @ (w[:, None] * jac)
-        g = jac.T @ (w * r)
-        h[[0, 1], [0, 1]] += prior
-        g[:2] += prior * (p[:2] - anchor)
-        step = np.linalg.solve(h + 1e-9 * np.eye(6), -g)
-        p = p + step
-        if np.abs(step[:3]).max() < 1e-3 and np.abs(step[4:]).max() < 1e-3:
-            break
+    p = np.array(_core.fit_pose(x, target, tuple(p), tuple(anchor), ANGLE_PRIOR + RELAX, HUBER, GN_ITERATIONS))
     p[:2] = np.clip(p[:2], -75.0, 75.0)
     err = np.hypot(*(project(x, _pose(p))[0] - target).T)
     return _pose(p), float(np.median(err))

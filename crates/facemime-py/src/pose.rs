@@ -1,0 +1,45 @@
+//! Bindings of `facemime_core::pose`: the orthographic head-pose fit.
+
+use facemime_core::pose::{self, FitSettings};
+use numpy::PyReadonlyArray2;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+/// model_points: (M, 3) model units; image_points: (M, 2) pixels; start: (yaw, pitch, roll
+/// degrees, ln scale, tx, ty pixels); yaw and pitch are held at `anchor` with weight `prior`
+/// (px² per degree²). Returns the fitted parameters in the same order.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn fit_pose(
+    py: Python<'_>,
+    model_points: PyReadonlyArray2<f64>,
+    image_points: PyReadonlyArray2<f64>,
+    start: [f64; 6],
+    anchor: [f64; 2],
+    prior: f64,
+    huber: f64,
+    iterations: usize,
+) -> PyResult<[f64; 6]> {
+    let (x, t) = (model_points.as_array(), image_points.as_array());
+    if x.shape()[1] != 3 || t.shape()[1] != 2 || x.shape()[0] != t.shape()[0] {
+        return Err(PyValueError::new_err(format!(
+            "model_points must be (M, 3) and image_points (M, 2), got {:?} and {:?}",
+            x.shape(),
+            t.shape()
+        )));
+    }
+    let x: Vec<[f64; 3]> = x.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect();
+    let t: Vec<[f64; 2]> = t.rows().into_iter().map(|r| [r[0], r[1]]).collect();
+    let settings = FitSettings {
+        huber,
+        prior,
+        anchor,
+        iterations,
+    };
+    Ok(py.detach(|| pose::fit(&x, &t, start, &settings)))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(fit_pose, m)?)?;
+    Ok(())
+}
