@@ -6,17 +6,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
-
-fn pairs(name: &str, a: &PyReadonlyArray2<f64>) -> PyResult<Vec<[f64; 2]>> {
-    let v = a.as_array();
-    if v.shape()[1] != 2 {
-        return Err(PyValueError::new_err(format!(
-            "{name} must have shape (K, 2), got {:?}",
-            v.shape()
-        )));
-    }
-    Ok(v.rows().into_iter().map(|r| [r[0], r[1]]).collect())
-}
+use crate::points::rows;
 
 /// Splits a concatenated array into consecutive runs of the given lengths.
 fn runs<T: Clone>(name: &str, all: &[T], lengths: &[u32]) -> PyResult<Vec<Vec<T>>> {
@@ -58,12 +48,12 @@ fn elastic_adjust<'py>(
     iterations: usize,
     tolerance: f64,
 ) -> PyResult<Adjusted<'py>> {
-    let mut pts = pairs("points", &points)?;
+    let mut pts = rows::<2>("points", &points)?;
     let chain_list: Vec<usize> = chains.as_array().iter().map(|&i| i as usize).collect();
     let chain_runs = runs("chains", &chain_list, chain_lengths.as_slice()?)?;
     let target_runs = runs(
         "targets",
-        &pairs("targets", &targets)?,
+        &rows::<2>("targets", &targets)?,
         target_lengths.as_slice()?,
     )?;
     if chain_runs.len() != target_runs.len() {

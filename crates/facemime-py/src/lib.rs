@@ -6,6 +6,7 @@ use pyo3::prelude::*;
 mod adjust;
 mod error;
 mod motion;
+mod points;
 mod pose;
 mod raster;
 mod snake;

@@ -5,16 +5,7 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-fn points(name: &str, a: &PyReadonlyArray2<f64>) -> PyResult<Vec<[f64; 2]>> {
-    let v = a.as_array();
-    if v.shape()[1] != 2 {
-        return Err(PyValueError::new_err(format!(
-            "{name} must have shape (N, 2), got {:?}",
-            v.shape()
-        )));
-    }
-    Ok(v.rows().into_iter().map(|r| [r[0], r[1]]).collect())
-}
+use crate::points::rows;
 
 /// The 2×3 similarity and the inlier mask.
 type Fit<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>);
@@ -29,7 +20,7 @@ fn robust_similarity<'py>(
     limit: f64,
     rounds: usize,
 ) -> PyResult<Fit<'py>> {
-    let (s, d) = (points("src", &src)?, points("dst", &dst)?);
+    let (s, d) = (rows::<2>("src", &src)?, rows::<2>("dst", &dst)?);
     if s.len() != d.len() {
         return Err(PyValueError::new_err(format!(
             "src has {} points but dst has {}",

@@ -5,6 +5,8 @@ use numpy::PyReadonlyArray2;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
+use crate::points::rows;
+
 /// model_points: (M, 3) model units; image_points: (M, 2) pixels; start: (yaw, pitch, roll
 /// degrees, ln scale, tx, ty pixels); yaw and pitch are held at `anchor` with weight `prior`
 /// (px² per degree²). Returns the fitted parameters in the same order.
@@ -20,16 +22,17 @@ fn fit_pose(
     huber: f64,
     iterations: usize,
 ) -> PyResult<[f64; 6]> {
-    let (x, t) = (model_points.as_array(), image_points.as_array());
-    if x.shape()[1] != 3 || t.shape()[1] != 2 || x.shape()[0] != t.shape()[0] {
+    let (x, t) = (
+        rows::<3>("model_points", &model_points)?,
+        rows::<2>("image_points", &image_points)?,
+    );
+    if x.len() != t.len() {
         return Err(PyValueError::new_err(format!(
-            "model_points must be (M, 3) and image_points (M, 2), got {:?} and {:?}",
-            x.shape(),
-            t.shape()
+            "model_points has {} points but image_points has {}",
+            x.len(),
+            t.len()
         )));
     }
-    let x: Vec<[f64; 3]> = x.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect();
-    let t: Vec<[f64; 2]> = t.rows().into_iter().map(|r| [r[0], r[1]]).collect();
     let settings = FitSettings {
         huber,
         prior,

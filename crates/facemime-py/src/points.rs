@@ -1,0 +1,20 @@
+//! Point arrays from numpy: (K, 2) pixel or (K, 3) model coordinates as fixed-size rows.
+
+use numpy::PyReadonlyArray2;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+/// The rows of a (K, D) float64 array; a clear error naming `name` for another shape.
+pub fn rows<const D: usize>(name: &str, a: &PyReadonlyArray2<f64>) -> PyResult<Vec<[f64; D]>> {
+    let v = a.as_array();
+    if v.shape()[1] != D {
+        return Err(PyValueError::new_err(format!(
+            "{name} must have shape (K, {D}), got {:?}",
+            v.shape()
+        )));
+    }
+    Ok(v.rows()
+        .into_iter()
+        .map(|r| std::array::from_fn(|i| r[i]))
+        .collect())
+}
