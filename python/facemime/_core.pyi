@@ -38,6 +38,21 @@ def elastic_adjust(
     tolerance: float,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 
+class FlowFrames:
+    """The pyramids of the last two frames and the Lucas-Kanade flow between them (see
+    facemime.track.flow)."""
+
+    def __init__(self, max_level: int, window: int) -> None: ...
+    def push(self, gray: npt.NDArray[np.uint8], crop: tuple[int, int, int, int]) -> None: ...
+    def track(
+        self,
+        points: npt.NDArray[np.float64],
+        backward: bool,
+        iterations: int,
+        epsilon: float,
+        min_eigen: float,
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...
+
 def robust_similarity(
     src: npt.NDArray[np.float64],
     dst: npt.NDArray[np.float64],

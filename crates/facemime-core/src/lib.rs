@@ -8,6 +8,7 @@
 
 pub mod adjust;
 pub mod error;
+pub mod flow;
 pub mod motion;
 pub mod pose;
 pub mod raster;

@@ -5,6 +5,7 @@ use pyo3::prelude::*;
 
 mod adjust;
 mod error;
+mod flow;
 mod motion;
 mod points;
 mod pose;
@@ -15,6 +16,7 @@ mod snake;
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     adjust::register(m)?;
+    flow::register(m)?;
     motion::register(m)?;
     pose::register(m)?;
     raster::register(m)?;

@@ -1,5 +1,6 @@
 """Head-motion compensation: the similarity transform (rotation, uniform scale, translation) of
-the face between consecutive frames, from pyramidal Lucas-Kanade optical flow of textured points
+the face between consecutive frames, from pyramidal Lucas-Kanade optical flow
+(:mod:`facemime.track.flow`) of textured points
 in the rigid parts of the face (nose bridge and nose, forehead), forward-backward checked and
 fitted robustly (:func:`robust_similarity`, deterministic: the same frames always give the same
 track). Mouth and brows ride on this motion before the snakes refine them, so the
@@ -16,6 +17,7 @@ import cv2
 import numpy as np
 
 from facemime import _core
+from facemime.track.flow import LEVELS, WINDOW, FrameFlow
 
 #: Rigid zones in face coordinates (s, t) of the first frame: a point is ``c + s·W·u + t·v``
 #: where ``c`` is the centre of the brows, ``v`` runs from it to the centre of the mouth, ``u`` is
@@ -25,8 +27,6 @@ ZONES = (
     ((-0.2, 0.2), (0.2, 0.72)),  # nose bridge, nose, nostrils
     ((-0.45, 0.45), (-1.0, -0.4)),  # forehead above raised brows (hair, glasses)
 )
-WINDOW = (21, 21)
-LEVELS = 5
 FB_LIMIT = 1.0  # px: forward-backward error above this rejects a point
 MIN_POINTS = 6
 
@@ -107,6 +107,8 @@ class HeadMotion:
         self.points, self.ids = self._detect(gray)
         self.followed = (self.points, self.ids)
         self._wanted = max(MIN_POINTS, len(self.points) // 2)
+        self._flow = FrameFlow()
+        self._flow.push(gray, self._crop_box(gray.shape, np.zeros((0, 2))))
 
     def _detect(self, gray: np.ndarray) -> np.ndarray:
         mask = np.zeros(gray.shape, np.uint8)
@@ -132,9 +134,12 @@ class HeadMotion:
         return inside
 
     def _crop_box(self, shape: tuple[int, ...], extra: np.ndarray) -> tuple[int, int, int, int]:
+        """The part of the frame the flow uses: the zones, points and ``extra`` with room for
+        the coarsest level's window. Its corner is on a multiple of 2^LEVELS px, so that the
+        pyramid levels of consecutive frames sample the same grid."""
         pts = np.concatenate(self._zones + [self.points.astype(float), extra.astype(float)])
-        pad = 2 ** LEVELS * WINDOW[0] // 2 + 8
-        x0, y0 = np.floor(pts.min(axis=0)).astype(int) - pad
+        pad, grid = 2 ** LEVELS * WINDOW // 2 + 8, 2 ** LEVELS
+        x0, y0 = (np.floor(pts.min(axis=0)).astype(int) - pad) // grid * grid
         x1, y1 = np.ceil(pts.max(axis=0)).astype(int) + pad
         return max(x0, 0), max(y0, 0), min(x1, shape[1]), min(y1, shape[0])
 
@@ -180,30 +185,25 @@ class HeadMotion:
         step, ok = IDENTITY.copy(), False
         n_extra = 0 if extra is None else len(extra)
         moved = None if extra is None else np.full((n_extra, 2), np.nan)
+        extra_pts = np.zeros((0, 2)) if extra is None else np.asarray(extra, float).reshape(-1, 2)
+        self._flow.push(gray, self._crop_box(gray.shape, extra_pts))
         if len(self.points) >= MIN_POINTS:
-            extra_pts = np.zeros((0, 2), np.float32) if extra is None else np.asarray(extra, np.float32)
-            x0, y0, x1, y1 = self._crop_box(gray.shape, extra_pts)
-            off = np.array([x0, y0], np.float32)
-            a, b = self._prev[y0:y1, x0:x1], gray[y0:y1, x0:x1]
-            p0 = (np.concatenate([self.points, extra_pts]) - off).reshape(-1, 1, 2)
-            crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 20, 0.03)
-            p1, st1, _ = cv2.calcOpticalFlowPyrLK(a, b, p0, None, winSize=WINDOW, maxLevel=LEVELS, criteria=crit)
-            pb, st2, _ = cv2.calcOpticalFlowPyrLK(b, a, p1, None, winSize=WINDOW, maxLevel=LEVELS, criteria=crit)
-            good = (st1.ravel() == 1) & (st2.ravel() == 1) & (np.linalg.norm((pb - p0).reshape(-1, 2), axis=1) < FB_LIMIT)
-            p0, p1 = p0.reshape(-1, 2), p1.reshape(-1, 2)
+            p0 = np.concatenate([self.points, extra_pts])
+            p1, ok1 = self._flow.track(p0)
+            pb, ok2 = self._flow.track(p1, backward=True)
+            with np.errstate(invalid="ignore"):
+                good = ok1 & ok2 & (np.linalg.norm(pb - p0, axis=1) < FB_LIMIT)
             n = len(self.points)
             if moved is not None:
-                moved[good[n:]] = p1[n:][good[n:]] + off
+                moved[good[n:]] = p1[n:][good[n:]]
             good = good[:n]
             src, dst = p0[:n][good], p1[:n][good]
             if len(src) >= MIN_POINTS:
                 m, keep = robust_similarity(src, dst, FB_LIMIT)
                 if keep.sum() >= MIN_POINTS:
-                    # back to full-frame coordinates: x' = R(x - off) + t + off
-                    m[:, 2] += off - m[:, :2] @ off
                     step, ok = m, True
                     self._keep(np.flatnonzero(good)[keep])
-                    self.points = dst[keep] + off
+                    self.points = dst[keep].astype(np.float32)
         if not ok:
             step, ok = self._coarse_shift(gray)
         self.total = compose(step, self.total)

@@ -1,0 +1,104 @@
+//! Bindings of `facemime_core::flow`: `FlowFrames`, the pyramids of the last two frames
+//! (each built once, their memory reused) and the Lucas-Kanade flow between them.
+
+use facemime_core::flow::{self, LkParams, Pyramid};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use crate::error::CoreErr;
+use crate::points::rows;
+
+/// The moved points and the mask of those followed.
+type Flow<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>);
+
+/// See `facemime.track.flow` for the documented API.
+#[pyclass(module = "facemime._core")]
+pub struct FlowFrames {
+    max_level: usize,
+    prev: Pyramid,
+    cur: Pyramid,
+    pushed: usize,
+}
+
+#[pymethods]
+impl FlowFrames {
+    /// max_level: pyramid levels above the frame at most; window: odd Lucas-Kanade window side.
+    #[new]
+    fn new(max_level: usize, window: usize) -> PyResult<Self> {
+        Ok(Self {
+            max_level,
+            prev: Pyramid::new(window).map_err(CoreErr)?,
+            cur: Pyramid::new(window).map_err(CoreErr)?,
+            pushed: 0,
+        })
+    }
+
+    /// gray: (H, W) C-contiguous uint8, the next frame; crop: (x0, y0, x1, y1) pixels,
+    /// exclusive ends, the part of it the flow may use.
+    fn push(
+        &mut self,
+        py: Python<'_>,
+        gray: PyReadonlyArray2<u8>,
+        crop: [usize; 4],
+    ) -> PyResult<()> {
+        let shape = gray.as_array().shape().to_vec();
+        let data = gray
+            .as_slice()
+            .map_err(|_| PyValueError::new_err("gray must be a C-contiguous uint8 array"))?;
+        std::mem::swap(&mut self.prev, &mut self.cur);
+        let (cur, max_level) = (&mut self.cur, self.max_level);
+        py.detach(|| cur.rebuild(data, shape[1], shape[0], crop, max_level))
+            .map_err(CoreErr)?;
+        self.pushed += 1;
+        Ok(())
+    }
+
+    /// points: (N, 2) pixels in the previous frame (the current one if `backward`). Returns
+    /// ((N, 2) positions in the current frame (the previous one), NaN where the flow failed;
+    /// (N,) mask of the points followed).
+    #[pyo3(signature = (points, backward, iterations, epsilon, min_eigen))]
+    fn track<'py>(
+        &self,
+        py: Python<'py>,
+        points: PyReadonlyArray2<f64>,
+        backward: bool,
+        iterations: usize,
+        epsilon: f64,
+        min_eigen: f64,
+    ) -> PyResult<Flow<'py>> {
+        if self.pushed < 2 {
+            return Err(PyValueError::new_err(
+                "the flow needs two frames; push another",
+            ));
+        }
+        let pts = rows::<2>("points", &points)?;
+        let params = LkParams {
+            iterations,
+            epsilon,
+            min_eigen,
+        };
+        let (from, to) = if backward {
+            (&self.cur, &self.prev)
+        } else {
+            (&self.prev, &self.cur)
+        };
+        let moved = py
+            .detach(|| flow::lucas_kanade(from, to, &pts, &params))
+            .map_err(CoreErr)?;
+        let ok: Vec<bool> = moved.iter().map(Option::is_some).collect();
+        let flat: Vec<f64> = moved
+            .iter()
+            .flat_map(|m| m.unwrap_or([f64::NAN; 2]))
+            .collect();
+        let out = numpy::ndarray::Array2::from_shape_vec((pts.len(), 2), flat)
+            .expect("N x 2")
+            .into_pyarray(py);
+        Ok((out, ok.into_pyarray(py)))
+    }
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<FlowFrames>()?;
+    Ok(())
+}

@@ -1,0 +1,38 @@
+"""Pyramidal Lucas-Kanade optical flow between consecutive frames (the algorithm of OpenCV's
+``calcOpticalFlowPyrLK``: same window, derivatives, stopping rules and texture test), with each
+frame's pyramid built once in the Rust core and kept for the next frame, where OpenCV builds
+two per call. Points are (x, y) pixels of the whole frame, pixel centres on integers.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from facemime import _core
+
+WINDOW = 21  # px: side of the square window matched around each point
+LEVELS = 5  # pyramid levels above the frame at most (fewer on small crops)
+ITERATIONS = 20  # per level at most
+EPSILON = 0.03  # px (of the level): stop once a step is shorter
+#: Refuse a point whose window's smaller gradient-matrix eigenvalue over the window area is
+#: below this ((grey levels / px)²); OpenCV's default ``minEigThreshold`` of 1e-4.
+MIN_EIGEN = 1e-4 * 1024
+
+
+class FrameFlow:
+    """Feed gray frames with :meth:`push`; :meth:`track` follows points from the previous frame
+    into the current one, or back."""
+
+    def __init__(self) -> None:
+        self._frames = _core.FlowFrames(LEVELS, WINDOW)
+
+    def push(self, gray: np.ndarray, crop: tuple[int, int, int, int]) -> None:
+        """The next (H, W) uint8 frame; only ``crop`` = (x0, y0, x1, y1) px, exclusive ends,
+        is used: points outside it are not followed."""
+        self._frames.push(np.ascontiguousarray(gray, np.uint8), tuple(int(v) for v in crop))
+
+    def track(self, points: np.ndarray, backward: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """Positions in the current frame of (N, 2) points of the previous one (the reverse
+        with ``backward``): ((N, 2) float64, NaN where lost; (N,) bool, followed)."""
+        pts = np.ascontiguousarray(points, np.float64).reshape(-1, 2)
+        return self._frames.track(pts, backward, ITERATIONS, EPSILON, MIN_EIGEN)
