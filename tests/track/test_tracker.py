@@ -55,6 +55,7 @@ def test_repulsion_keeps_thinning_lips_from_merging_onto_one_edge(repulsion):
 def test_no_coordinate_moves_more_than_the_solver_bound_per_pass_in_a_frame(mouth_passes):
     # The brows get one solver pass per frame, the mouth ``mouth_passes``: each pass moves a
     # coordinate at most δ0/(1−σ); a motion faster than that uses the mouth's extra passes.
+    # A brow that this fast motion loses jumps back to its rest shape instead (not a pass).
     params = TrackerParams(motion=False, delta0=1.0, sigma=0.6, mouth_passes=mouth_passes)
     bound = params.delta0 / (1.0 - params.sigma)
     frame0, truth0 = band_face()
@@ -62,9 +63,11 @@ def test_no_coordinate_moves_more_than_the_solver_bound_per_pass_in_a_frame(mout
     before = tracker.contours
     moved = dict.fromkeys(CONTOUR_NAMES, 0.0)
     for frame, _ in sequence(6, shift=(5.0, -4.0)):
-        after = tracker.update(frame).contours
+        result = tracker.update(frame)
+        after = result.contours
         for name in CONTOUR_NAMES:
-            moved[name] = max(moved[name], np.abs(after[name] - before[name]).max())
+            if not any(name.startswith(f) for f in result.lost if f.startswith("brow")):
+                moved[name] = max(moved[name], np.abs(after[name] - before[name]).max())
         before = after
     for name, most in moved.items():
         passes = mouth_passes if name.startswith("mouth") else 1
@@ -93,6 +96,26 @@ def test_confidence_and_lost_flag_when_the_face_disappears():
     blank = np.full_like(frame0, 128)
     gone = tracker.update(blank)
     assert sorted(gone.lost) == sorted(FEATURES) and max(gone.confidence.values()) < 0.1
+
+
+def test_a_lost_brow_goes_back_to_its_rest_shape_and_is_found_again():
+    frame0, truth0 = band_face()
+    tracker = Tracker(frame0, truth0)
+    for raise_ in (2.0, 4.0, 6.0, 8.0, 8.0):
+        raised, truth = band_face(brow_raise=raise_, noise=1.0, seed=int(raise_))
+        tracker.update(raised)
+    brows = [n for n in CONTOUR_NAMES if n.startswith("brow")]
+    assert max(curve_error(tracker.contours[n], truth[n]) for n in brows) < 1.0
+    erased = raised.copy()
+    erased[40:100, 40:216] = (205, 160, 140)  # skin over both brows
+    gone = tracker.update(erased)
+    assert {"brow_left", "brow_right"} <= set(gone.lost)
+    for n in brows:  # back on the first frame's brows (the head has not moved), not 8 px up
+        assert curve_error(gone.contours[n], truth0[n]) < 1.0
+    back, truth = band_face(noise=1.0, seed=9)
+    found = tracker.update(back)
+    assert not any(f.startswith("brow") for f in found.lost)
+    assert max(curve_error(found.contours[n], truth[n]) for n in brows) < 1.0
 
 
 @pytest.mark.parametrize(

@@ -13,8 +13,10 @@ Per frame:
    per pass: one pass for the brows, ``mouth_passes`` for the mouth, whose lips move fastest;
 3. each feature's confidence is its mean edge response relative to the first frame's; a feature
    whose confidence collapses or whose shape degenerates is flagged ``lost``, so that it never
-   drifts silently. (Putting a lost feature back on its rest shape was measured and made the
-   tracks worse: the rest shape follows the head, not the mouth.)
+   drifts silently. A lost brow goes back to its first-frame shape carried by the head motion,
+   from where the next frame's snakes find it again (a brow that slid onto the eye otherwise
+   stays there); a lost mouth stays where it is (measured: its rest shape follows the head, not
+   the mouth, and resetting it made the tracks worse).
 
 Coordinates are (x, y) pixels, origin at the centre of the top-left pixel, y down.
 """
@@ -108,7 +110,7 @@ class TrackerParams:
 @dataclass
 class FrameResult:
     """One frame's output: ``contours`` name -> (N, 2) float64 pixels; ``confidence`` feature ->
-    0..1; ``lost`` features re-initialised in this frame; ``iterations`` the solver ran;
+    0..1; ``lost`` features flagged in this frame (a lost brow is reported on its rest shape); ``iterations`` the solver ran;
     ``motion_ok`` whether the head motion was measured."""
 
     index: int
@@ -324,6 +326,8 @@ class Tracker:
             confidence[feature] = conf
             if conf < p.lost_response or not self._shape_ok(knots, carried, names):
                 lost.append(feature)
+                if feature.startswith("brow"):
+                    knots[self._features[feature]] = carried[self._features[feature]]
         self._knots = knots
         self._linear = total[:, :2]
         self._down = down
