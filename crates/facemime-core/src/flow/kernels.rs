@@ -9,8 +9,9 @@ use std::arch::x86_64::*;
 /// Width of the partial sums.
 pub const LANES: usize = 8;
 
-/// Bilinear samples of a padded plane: the sample at window (row r, column c) is
-/// `w[0]·P[a] + w[1]·P[a+1] + w[2]·P[a+s] + w[3]·P[a+s+1]` with a = start + r·s + c, s = stride.
+/// Bilinear samples of a padded plane P: the sample at window (row r, column c) is
+/// `w[0]·P[a] + w[1]·P[a+1] + w[2]·P[a+s] + w[3]·P[a+s+1]`,
+/// with s = stride and a = start + r·s + c.
 #[derive(Clone, Copy)]
 pub struct Grid<'a> {
     pub plane: &'a [f32],
@@ -66,7 +67,8 @@ fn sample_portable(g: &Grid, rows: usize, cols: usize, out: &mut [f32]) {
 /// Scharr derivatives of the window whose samples, grown by one pixel on every side, are
 /// `ext` (rows of `ecols` ≥ `cols` + 2 values): window (r, c) is `ext` (r + 1, c + 1).
 /// Writes `gx`, `gy` (`win` × `cols`) scaled by `live` per column (1/32 in the window, which
-/// makes them grey levels per pixel, as the Scharr weights sum to 32; 0 past it) and returns the gradient matrix (Σgx², Σgx·gy, Σgy²).
+/// makes them grey levels per pixel, as the Scharr weights sum to 32; 0 past it) and returns
+/// the gradient matrix (Σgx², Σgx·gy, Σgy²).
 pub fn gradients(
     ext: &[f32],
     ecols: usize,
