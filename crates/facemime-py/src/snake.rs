@@ -10,20 +10,10 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
+use crate::points::rows;
 
 fn err(msg: String) -> PyErr {
     PyValueError::new_err(msg)
-}
-
-fn points(name: &str, a: &PyReadonlyArray2<f64>) -> PyResult<Vec<[f64; 2]>> {
-    let v = a.as_array();
-    if v.shape()[1] != 2 {
-        return Err(err(format!(
-            "{name} must have shape (K, 2), got {:?}",
-            v.shape()
-        )));
-    }
-    Ok(v.rows().into_iter().map(|r| [r[0], r[1]]).collect())
 }
 
 /// Curves over one shared knot array solved jointly by sign descent. See
@@ -227,8 +217,8 @@ impl<'a> FrameArgs<'a> {
             shape,
             origin: [origin.0, origin.1],
             bounds: [bounds.0, bounds.1],
-            start: points("start", start)?,
-            rest: points("rest", rest)?,
+            start: rows::<2>("start", start)?,
+            rest: rows::<2>("rest", rest)?,
             down: [down.0, down.1],
             targets: pair_targets.as_array().to_vec(),
         })
