@@ -71,6 +71,13 @@ def fit_pose(
 
 FIELD_CHANNELS: int
 
+def frame_field(
+    frame: npt.NDArray[np.uint8],
+    prev: npt.NDArray[np.uint8] | None,
+    region: tuple[int, int, int, int],
+    sigma: float,
+) -> npt.NDArray[np.float32]: ...
+
 class SnakeSolver:
     """Curves over one shared knot array, solved jointly by sign descent (see facemime.track)."""
 

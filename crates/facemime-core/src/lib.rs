@@ -7,6 +7,7 @@
 //! - Depth is a float along the view direction, **larger = nearer the camera**.
 
 pub mod adjust;
+mod border;
 pub mod error;
 pub mod flow;
 pub mod motion;

@@ -1,10 +1,12 @@
 //! Bindings of `facemime_core::snake`: a `SnakeSolver` built once per tracker, solved per frame.
 
+use facemime_core::raster::ImageRef;
 use facemime_core::snake::{
-    CurveParams, Field, FrameInput, Operator, PairKind, PairSpec, Problem, Settings,
+    self, CurveParams, Field, FrameInput, Operator, PairKind, PairSpec, Problem, Settings,
+    FIELD_CHANNELS,
 };
 use numpy::{
-    IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+    IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -204,10 +206,10 @@ impl<'a> FrameArgs<'a> {
         pair_targets: &PyReadonlyArray1<f64>,
     ) -> PyResult<Self> {
         let shape = field.as_array().shape().to_vec();
-        if shape[2] != facemime_core::snake::FIELD_CHANNELS {
+        if shape[2] != FIELD_CHANNELS {
             return Err(err(format!(
                 "field must have shape (H, W, {}), got {shape:?}",
-                facemime_core::snake::FIELD_CHANNELS
+                FIELD_CHANNELS
             )));
         }
         Ok(FrameArgs {
@@ -241,8 +243,39 @@ impl<'a> FrameArgs<'a> {
     }
 }
 
+/// A (H, W, 3) C-contiguous uint8 frame as a core image view.
+fn rgb_view<'a>(name: &str, img: &'a PyReadonlyArray3<'_, u8>) -> PyResult<ImageRef<'a>> {
+    let shape = img.as_array().shape().to_vec();
+    let data = img
+        .as_slice()
+        .map_err(|_| err(format!("{name} must be a C-contiguous uint8 array")))?;
+    Ok(ImageRef::named(name, data, shape[1], shape[0], shape[2]).map_err(CoreErr)?)
+}
+
+/// The (y1 − y0, x1 − x0, FIELD_CHANNELS) float32 field of `frame` over `region`
+/// (x0, y0, x1, y1); see `facemime.track.field`.
+#[pyfunction]
+#[pyo3(signature = (frame, prev, region, sigma))]
+fn frame_field<'py>(
+    py: Python<'py>,
+    frame: PyReadonlyArray3<u8>,
+    prev: Option<PyReadonlyArray3<u8>>,
+    region: [usize; 4],
+    sigma: f64,
+) -> PyResult<Bound<'py, PyArray3<f32>>> {
+    let img = rgb_view("frame", &frame)?;
+    let before = prev.as_ref().map(|p| rgb_view("prev", p)).transpose()?;
+    let flat = py
+        .detach(|| snake::frame_field(&img, before.as_ref(), region, sigma))
+        .map_err(CoreErr)?;
+    let shape = (region[3] - region[1], region[2] - region[0], FIELD_CHANNELS);
+    let out = ndarray::Array3::from_shape_vec(shape, flat).expect("H x W x C");
+    Ok(out.into_pyarray(py))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<SnakeSolver>()?;
-    m.add("FIELD_CHANNELS", facemime_core::snake::FIELD_CHANNELS)?;
+    m.add_function(wrap_pyfunction!(frame_field, m)?)?;
+    m.add("FIELD_CHANNELS", FIELD_CHANNELS)?;
     Ok(())
 }

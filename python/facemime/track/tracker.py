@@ -269,7 +269,7 @@ class Tracker:
         p = self.params
         margin = p.delta0 / (1.0 - p.sigma) + 4.0 * p.smoothing + 2.0
         box = region(knots, margin, self.width, self.height)
-        prev = self._prev if max(p.mouth.gamma, p.brows.gamma) > 0 else None
+        prev = self._prev if max(p.mouth.gamma, p.mouth_inner.gamma, p.brows.gamma) > 0 else None
         return build_field(frame, prev, box, p.smoothing), (float(box[0]), float(box[1]))
 
     def _responses(self, frame: np.ndarray, start: np.ndarray, rest: np.ndarray, down: np.ndarray, targets: np.ndarray) -> np.ndarray:

@@ -11,21 +11,10 @@
 
 mod kernels;
 
+use crate::border::reflect101;
 use crate::error::Result;
 use crate::invalid;
 use kernels::{Grid, LANES};
-
-/// Index into 0..n mirrored about the end pixels (OpenCV's BORDER_REFLECT_101).
-fn reflect(mut i: isize, n: usize) -> usize {
-    let last = n as isize - 1;
-    if last == 0 {
-        return 0;
-    }
-    while i < 0 || i > last {
-        i = if i < 0 { -i } else { 2 * last - i };
-    }
-    i as usize
-}
 
 /// One level's image, padded by `pad` mirrored pixels on every side.
 #[derive(Default)]
@@ -69,12 +58,12 @@ impl Level {
                 continue;
             }
             for x in 0..p {
-                row[x] = row[p + reflect(x as isize - p as isize, w)];
-                row[p + w + x] = row[p + reflect((w + x) as isize, w)];
+                row[x] = row[p + reflect101(x as isize - p as isize, w)];
+                row[p + w + x] = row[p + reflect101((w + x) as isize, w)];
             }
         }
         for y in (0..p).chain(p + h..h + 2 * p) {
-            let from = p + reflect(y as isize - p as isize, h);
+            let from = p + reflect101(y as isize - p as isize, h);
             self.img.copy_within(from * s..(from + 1) * s, y * s);
         }
     }

@@ -42,9 +42,20 @@ pub struct ImageRef<'a> {
 }
 
 impl<'a> ImageRef<'a> {
-    /// Wraps a row-major buffer of `height * width * channels` bytes.
+    /// Wraps a row-major buffer of `height * width * channels` bytes (a texture).
     pub fn new(data: &'a [u8], width: usize, height: usize, channels: usize) -> Result<Self> {
-        check_dims("texture", data.len(), width, height, channels)?;
+        Self::named("texture", data, width, height, channels)
+    }
+
+    /// [`ImageRef::new`] for an image that errors call `what`.
+    pub fn named(
+        what: &str,
+        data: &'a [u8],
+        width: usize,
+        height: usize,
+        channels: usize,
+    ) -> Result<Self> {
+        check_dims(what, data.len(), width, height, channels)?;
         Ok(Self {
             data,
             width,

@@ -10,8 +10,10 @@
 
 mod energy;
 mod field;
+mod frame_field;
 mod solver;
 
 pub use energy::{CurveParams, Operator, PairKind, PairSpec};
 pub use field::{Field, FIELD_CHANNELS};
+pub use frame_field::{frame_field, MAX_SIGMA};
 pub use solver::{FrameInput, Problem, Settings, Solution};

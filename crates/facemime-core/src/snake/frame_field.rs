@@ -1,0 +1,314 @@
+//! Building a frame's [`Field`](super::Field) from RGB pixels: over a region of the frame, the
+//! luma L = 0.299 R + 0.587 G + 0.114 B and the lip-sensitive colour channel C = R − G, each
+//! smoothed by a Gaussian, their central differences, and the previous frame's smoothed luma.
+//!
+//! The filters match OpenCV's `GaussianBlur` (kernel side round(8σ + 1) | 1, taps normalised to
+//! sum 1) and `Sobel(ksize=1, scale=0.5)`, both with BORDER_REFLECT_101 at the region's edges, to
+//! within float rounding. Values are in 0..255 levels, derivatives in levels per pixel.
+
+use super::field::FIELD_CHANNELS;
+use crate::border::reflect101;
+use crate::error::Result;
+use crate::invalid;
+use crate::raster::ImageRef;
+
+/// Largest Gaussian σ (pixels) accepted.
+pub const MAX_SIGMA: f64 = 16.0;
+
+/// The region `[x0, y0, x1, y1)` (pixels, exclusive ends) of `frame` as a row-major
+/// (y1 − y0, x1 − x0, [`FIELD_CHANNELS`]) float32 field smoothed by a Gaussian of `sigma`
+/// pixels. `frame` and `prev` are (H, W, 3) RGB; without `prev`, L′ = L.
+pub fn frame_field(
+    frame: &ImageRef,
+    prev: Option<&ImageRef>,
+    region: [usize; 4],
+    sigma: f64,
+) -> Result<Vec<f32>> {
+    check(frame, prev, region, sigma)?;
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: AVX2 is present.
+        return Ok(unsafe { build_avx2(frame, prev, region, sigma) });
+    }
+    Ok(build(frame, prev, region, sigma))
+}
+
+fn check(frame: &ImageRef, prev: Option<&ImageRef>, region: [usize; 4], sigma: f64) -> Result<()> {
+    if frame.channels != 3 {
+        return invalid!("the frame must be RGB (3 channels), got {}", frame.channels);
+    }
+    if let Some(p) = prev {
+        if (p.width, p.height, p.channels) != (frame.width, frame.height, 3) {
+            return invalid!(
+                "the previous frame must be {}x{} RGB like the frame, got {}x{}x{}",
+                frame.width,
+                frame.height,
+                p.width,
+                p.height,
+                p.channels
+            );
+        }
+    }
+    let [x0, y0, x1, y1] = region;
+    if x1 > frame.width || y1 > frame.height || x1 < x0 + 2 || y1 < y0 + 2 {
+        return invalid!(
+            "the region ({x0}, {y0}, {x1}, {y1}) must lie inside the {}x{} frame and be at \
+             least 2x2 pixels",
+            frame.width,
+            frame.height
+        );
+    }
+    if !(sigma > 0.0 && sigma <= MAX_SIGMA) {
+        return invalid!("sigma must be in (0, {MAX_SIGMA}] pixels, got {sigma}");
+    }
+    Ok(())
+}
+
+/// OpenCV's Gaussian taps for a float image: side round(8σ + 1) | 1, computed in f64.
+fn gaussian(sigma: f64) -> Vec<f32> {
+    let side = ((sigma * 8.0 + 1.0).round() as usize) | 1;
+    let r = (side / 2) as f64;
+    let taps: Vec<f64> = (0..side)
+        .map(|i| (-(i as f64 - r).powi(2) / (2.0 * sigma * sigma)).exp())
+        .collect();
+    let sum: f64 = taps.iter().sum();
+    taps.iter().map(|t| (t / sum) as f32).collect()
+}
+
+/// `out[i] = Σ_t taps[t] · rows[t][i]`, summed in tap order, [`BLOCK`] outputs at a time so
+/// that the sums stay in registers.
+#[inline(always)]
+fn weighted(out: &mut [f32], taps: &[f32], rows: &[&[f32]]) {
+    let n = out.len();
+    let mut x = 0;
+    while x + BLOCK <= n {
+        let mut acc = [0.0f32; BLOCK];
+        for (&k, row) in taps.iter().zip(rows) {
+            for (a, s) in acc.iter_mut().zip(&row[x..x + BLOCK]) {
+                *a += k * s;
+            }
+        }
+        out[x..x + BLOCK].copy_from_slice(&acc);
+        x += BLOCK;
+    }
+    for (i, o) in out.iter_mut().enumerate().skip(x) {
+        *o = taps
+            .iter()
+            .zip(rows)
+            .fold(0.0, |a, (&k, row)| a + k * row[i]);
+    }
+}
+
+/// Outputs per block of [`weighted`]: four AVX2 registers.
+const BLOCK: usize = 32;
+
+/// Smooths the (h, w) plane `img` in place with the separable `taps`; `pad` and `rows` are
+/// scratch.
+#[inline(always)]
+fn blur(
+    img: &mut [f32],
+    w: usize,
+    h: usize,
+    taps: &[f32],
+    pad: &mut Vec<f32>,
+    rows: &mut Vec<f32>,
+) {
+    let r = taps.len() / 2;
+    pad.resize(w + 2 * r, 0.0);
+    rows.resize(w * h, 0.0);
+    for y in 0..h {
+        let line = &img[y * w..][..w];
+        pad[r..r + w].copy_from_slice(line);
+        for i in 0..r {
+            pad[i] = line[reflect101(i as isize - r as isize, w)];
+            pad[r + w + i] = line[reflect101((w + i) as isize, w)];
+        }
+        let shifted: Vec<&[f32]> = (0..taps.len()).map(|t| &pad[t..][..w]).collect();
+        weighted(&mut rows[y * w..][..w], taps, &shifted);
+    }
+    for y in 0..h {
+        let around: Vec<&[f32]> = (0..taps.len())
+            .map(|t| &rows[reflect101((y + t) as isize - r as isize, h) * w..][..w])
+            .collect();
+        weighted(&mut img[y * w..][..w], taps, &around);
+    }
+}
+
+/// Luma and R − G planes of the region of `frame`.
+#[inline(always)]
+fn planes(
+    frame: &ImageRef,
+    region: [usize; 4],
+    luma: &mut Vec<f32>,
+    mut chroma: Option<&mut Vec<f32>>,
+) {
+    let [x0, y0, x1, y1] = region;
+    let w = x1 - x0;
+    luma.resize(w * (y1 - y0), 0.0);
+    if let Some(c) = chroma.as_deref_mut() {
+        c.resize(w * (y1 - y0), 0.0);
+    }
+    for y in y0..y1 {
+        let row = &frame.data[(y * frame.width + x0) * 3..][..w * 3];
+        let at = (y - y0) * w;
+        for (l, p) in luma[at..at + w].iter_mut().zip(row.chunks_exact(3)) {
+            *l = 0.299 * p[0] as f32 + 0.587 * p[1] as f32 + 0.114 * p[2] as f32;
+        }
+        if let Some(c) = chroma.as_deref_mut() {
+            for (c, p) in c[at..at + w].iter_mut().zip(row.chunks_exact(3)) {
+                *c = p[0] as f32 - p[1] as f32;
+            }
+        }
+    }
+}
+
+#[inline(always)]
+fn build(frame: &ImageRef, prev: Option<&ImageRef>, region: [usize; 4], sigma: f64) -> Vec<f32> {
+    let [x0, y0, x1, y1] = region;
+    let (w, h) = (x1 - x0, y1 - y0);
+    let taps = gaussian(sigma);
+    let (mut pad, mut rows) = (Vec::new(), Vec::new());
+    let (mut luma, mut chroma) = (Vec::new(), Vec::new());
+    planes(frame, region, &mut luma, Some(&mut chroma));
+    blur(&mut luma, w, h, &taps, &mut pad, &mut rows);
+    blur(&mut chroma, w, h, &taps, &mut pad, &mut rows);
+    let before = prev.map(|p| {
+        let mut l = Vec::new();
+        planes(p, region, &mut l, None);
+        blur(&mut l, w, h, &taps, &mut pad, &mut rows);
+        l
+    });
+    let before = before.as_deref().unwrap_or(&luma);
+    let mut out = vec![0.0f32; w * h * FIELD_CHANNELS];
+    let mut d = [
+        vec![0.0f32; w],
+        vec![0.0f32; w],
+        vec![0.0f32; w],
+        vec![0.0f32; w],
+    ];
+    fn line(plane: &[f32], w: usize, y: usize) -> &[f32] {
+        &plane[y * w..][..w]
+    }
+    for (y, o) in out.chunks_exact_mut(w * FIELD_CHANNELS).enumerate() {
+        // Central differences with mirrored borders: across an edge both neighbours are the
+        // same pixel, so the first and last columns (and rows) get 0.
+        let (up, down) = (reflect101(y as isize - 1, h), reflect101(y as isize + 1, h));
+        let [dlx, dly, dcx, dcy] = &mut d;
+        for (plane, dx, dy) in [(&luma, dlx, dly), (&chroma, dcx, dcy)] {
+            let l = line(plane, w, y);
+            for ((o, a), b) in dx[1..w - 1].iter_mut().zip(&l[2..]).zip(l) {
+                *o = 0.5 * (a - b);
+            }
+            let (u, v) = (line(plane, w, up), line(plane, w, down));
+            for ((o, a), b) in dy.iter_mut().zip(v).zip(u) {
+                *o = 0.5 * (a - b);
+            }
+        }
+        let (l, lp) = (line(&luma, w, y), line(before, w, y));
+        for (x, px) in o.chunks_exact_mut(FIELD_CHANNELS).enumerate() {
+            px.copy_from_slice(&[d[0][x], d[1][x], d[2][x], d[3][x], l[x], lp[x]]);
+        }
+    }
+    out
+}
+
+/// [`build`] compiled for AVX2; the same operations in the same order, so the same values.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn build_avx2(
+    frame: &ImageRef,
+    prev: Option<&ImageRef>,
+    region: [usize; 4],
+    sigma: f64,
+) -> Vec<f32> {
+    build(frame, prev, region, sigma)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rgb(w: usize, h: usize, f: impl Fn(usize, usize) -> [u8; 3]) -> Vec<u8> {
+        (0..h)
+            .flat_map(|y| (0..w).flat_map(move |x| (0..3).map(move |c| (x, y, c))))
+            .map(|(x, y, c)| f(x, y)[c])
+            .collect()
+    }
+
+    #[test]
+    fn taps_are_opencvs() {
+        let t = gaussian(1.5);
+        assert_eq!(t.len(), 13);
+        assert!((t.iter().sum::<f32>() - 1.0).abs() < 1e-6);
+        assert!((t[6] - 0.265_962).abs() < 1e-4);
+        assert_eq!(gaussian(0.3).len(), 3);
+    }
+
+    #[test]
+    fn a_linear_ramp_keeps_its_slope_and_level() {
+        // Smoothing leaves a linear ramp unchanged away from the borders.
+        let (w, h) = (40, 30);
+        let data = rgb(w, h, |x, y| [(2 * x + y) as u8, (x + y) as u8, 7]);
+        let img = ImageRef::new(&data, w, h, 3).unwrap();
+        let f = frame_field(&img, None, [5, 4, 35, 26], 1.5).unwrap();
+        let (fw, at) = (30, |x: usize, y: usize, c: usize| {
+            (y * 30 + x) * FIELD_CHANNELS + c
+        });
+        let (x, y) = (15, 11);
+        let luma = |x: f32, y: f32| 0.299 * (2.0 * x + y) + 0.587 * (x + y) + 0.114 * 7.0;
+        assert!((f[at(x, y, 4)] - luma(20.0, 15.0)).abs() < 1e-3);
+        assert!((f[at(x, y, 0)] - (2.0 * 0.299 + 0.587)).abs() < 1e-4);
+        assert!((f[at(x, y, 1)] - (0.299 + 0.587)).abs() < 1e-4);
+        assert!((f[at(x, y, 2)] - 1.0).abs() < 1e-4);
+        assert!((f[at(x, y, 3)] - 0.0).abs() < 1e-4);
+        assert_eq!(f[at(x, y, 5)], f[at(x, y, 4)]);
+        // Mirrored borders: the outermost derivatives across the edge vanish.
+        assert_eq!(f[at(0, y, 0)], 0.0);
+        assert_eq!(f[at(fw - 1, y, 2)], 0.0);
+        assert_eq!(f[at(x, 0, 1)], 0.0);
+    }
+
+    #[test]
+    fn the_previous_frame_fills_the_last_channel() {
+        let (w, h) = (12, 10);
+        let a = rgb(w, h, |x, _| [x as u8 * 10, 0, 0]);
+        let b = rgb(w, h, |_, _| [100, 100, 100]);
+        let (fa, fb) = (
+            ImageRef::new(&a, w, h, 3).unwrap(),
+            ImageRef::new(&b, w, h, 3).unwrap(),
+        );
+        let f = frame_field(&fa, Some(&fb), [0, 0, w, h], 1.0).unwrap();
+        for px in f.chunks_exact(FIELD_CHANNELS) {
+            assert!((px[5] - 100.0).abs() < 1e-3);
+        }
+    }
+
+    #[test]
+    fn avx2_equals_portable() {
+        let (w, h) = (64, 48);
+        let data = rgb(w, h, |x, y| {
+            [((x * 37 + y * 11) % 251) as u8, ((x * y) % 253) as u8, 9]
+        });
+        let img = ImageRef::new(&data, w, h, 3).unwrap();
+        let region = [3, 2, 61, 45];
+        let portable = build(&img, Some(&img), region, 1.5);
+        assert_eq!(
+            frame_field(&img, Some(&img), region, 1.5).unwrap(),
+            portable
+        );
+    }
+
+    #[test]
+    fn refuses_bad_arguments() {
+        let data = rgb(8, 8, |_, _| [1, 2, 3]);
+        let img = ImageRef::new(&data, 8, 8, 3).unwrap();
+        let gray = ImageRef::new(&data[..64], 8, 8, 1).unwrap();
+        let small = ImageRef::new(&data[..48], 4, 4, 3).unwrap();
+        assert!(frame_field(&gray, None, [0, 0, 8, 8], 1.0).is_err());
+        assert!(frame_field(&img, Some(&small), [0, 0, 8, 8], 1.0).is_err());
+        assert!(frame_field(&img, None, [0, 0, 9, 8], 1.0).is_err());
+        assert!(frame_field(&img, None, [3, 0, 4, 8], 1.0).is_err());
+        assert!(frame_field(&img, None, [0, 0, 8, 8], 0.0).is_err());
+        assert!(frame_field(&img, None, [0, 0, 8, 8], f64::NAN).is_err());
+    }
+}

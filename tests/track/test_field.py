@@ -1,0 +1,49 @@
+"""The snakes' image field (built in the Rust core) equals the OpenCV recipe it replaces."""
+
+import cv2
+import numpy as np
+import pytest
+
+from facemime.io.video import VideoReader
+from facemime.track.field import build_field, region
+
+LUMA = np.array([[0.299, 0.587, 0.114]], np.float32)
+
+
+def opencv_field(frame, prev, box, sigma):
+    """The field by OpenCV on the box's crop: GaussianBlur, then Sobel(ksize=1, scale=0.5)."""
+    x0, y0, x1, y1 = box
+    smooth = lambda img: cv2.GaussianBlur(img, (0, 0), sigma)  # noqa: E731
+    luma = lambda rgb: smooth(cv2.transform(rgb[y0:y1, x0:x1].astype(np.float32), LUMA))  # noqa: E731
+    crop = frame[y0:y1, x0:x1]
+    lum, chroma = luma(frame), smooth(np.subtract(crop[..., 0], crop[..., 1], dtype=np.float32))
+    d = lambda img, dx, dy: cv2.Sobel(img, cv2.CV_32F, dx, dy, ksize=1, scale=0.5)  # noqa: E731
+    return cv2.merge([d(lum, 1, 0), d(lum, 0, 1), d(chroma, 1, 0), d(chroma, 0, 1), lum, luma(prev)])
+
+
+@pytest.fixture(scope="module")
+def frames(shared):
+    with VideoReader(shared / "video" / "vr_1.mp4") as reader:
+        it = iter(reader)
+        return next(it), next(it)
+
+
+@pytest.mark.parametrize("box", [(200, 300, 480, 520), (0, 0, 37, 700), (690, 10, 700, 14)])
+@pytest.mark.parametrize("sigma", [0.8, 1.5, 3.0])
+def test_equals_opencv_on_a_real_frame_up_to_float_rounding(frames, box, sigma):
+    prev, frame = frames
+    got = build_field(frame, prev, box, sigma)
+    want = opencv_field(frame, prev, box, sigma)
+    assert got.dtype == np.float32 and got.shape == want.shape == (box[3] - box[1], box[2] - box[0], 6)
+    np.testing.assert_allclose(got, want, atol=2e-3)
+
+
+def test_without_a_previous_frame_the_last_channel_repeats_the_luma(frames):
+    got = build_field(frames[1], None, (100, 100, 160, 150), 1.5)
+    np.testing.assert_array_equal(got[..., 5], got[..., 4])
+
+
+def test_the_region_covers_the_points_with_their_margin_inside_the_image():
+    points = np.array([[10.2, 50.0], [90.7, 60.5]])
+    assert region(points, 5.0, 100, 80) == (5, 45, 97, 67)
+    assert region(np.array([[99.0, 79.0]]), 0.0, 100, 80) == (96, 76, 100, 80)
