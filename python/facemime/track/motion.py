@@ -29,6 +29,7 @@ ZONES = (
 )
 FB_LIMIT = 1.0  # px: forward-backward error above this rejects a point
 MIN_POINTS = 6
+DETECT_MARGIN = 8  # px around the zones for the corner measure (block 5, Sobel 3)
 
 
 def face_frame(contours: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
@@ -111,11 +112,20 @@ class HeadMotion:
         self._flow.push(gray, self._crop_box(gray.shape, np.zeros((0, 2))))
 
     def _detect(self, gray: np.ndarray) -> np.ndarray:
-        mask = np.zeros(gray.shape, np.uint8)
-        for poly in self._zones:
-            cv2.fillConvexPoly(mask, np.round(poly).astype(np.int32), 255)
-        pts = cv2.goodFeaturesToTrack(gray, self._max_points, 0.01, self._min_distance, mask=mask, blockSize=5)
-        pts = np.zeros((0, 2), np.float32) if pts is None else pts.reshape(-1, 2).astype(np.float32)
+        """Corners in the zones. The corner measure reads a few pixels around each pixel, so it
+        runs on the zones' box grown by :data:`DETECT_MARGIN` px only: the same corners as on the
+        whole frame, for a fraction of the work."""
+        pts = np.concatenate(self._zones)
+        x0, y0 = np.maximum(np.floor(pts.min(axis=0)).astype(int) - DETECT_MARGIN, 0)
+        x1, y1 = np.minimum(np.ceil(pts.max(axis=0)).astype(int) + DETECT_MARGIN + 1, [gray.shape[1], gray.shape[0]])
+        pts = None
+        if x1 - x0 > 2 * DETECT_MARGIN and y1 - y0 > 2 * DETECT_MARGIN:
+            mask = np.zeros((y1 - y0, x1 - x0), np.uint8)
+            for poly in self._zones:
+                cv2.fillConvexPoly(mask, np.round(poly - [x0, y0]).astype(np.int32), 255)
+            pts = cv2.goodFeaturesToTrack(gray[y0:y1, x0:x1], self._max_points, 0.01, self._min_distance, mask=mask,
+                                          blockSize=5)
+        pts = np.zeros((0, 2), np.float32) if pts is None else (pts.reshape(-1, 2) + [x0, y0]).astype(np.float32)
         ids = np.arange(self._next_id, self._next_id + len(pts), dtype=np.int64)
         self._next_id += len(pts)
         return pts, ids
