@@ -76,6 +76,7 @@ def frame_field(
     prev: npt.NDArray[np.uint8] | None,
     region: tuple[int, int, int, int],
     sigma: float,
+    bands: list[tuple[int, int]] | None = None,
 ) -> npt.NDArray[np.float32]: ...
 
 class SnakeSolver:

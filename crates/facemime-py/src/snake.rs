@@ -253,20 +253,22 @@ fn rgb_view<'a>(name: &str, img: &'a PyReadonlyArray3<'_, u8>) -> PyResult<Image
 }
 
 /// The (y1 − y0, x1 − x0, FIELD_CHANNELS) float32 field of `frame` over `region`
-/// (x0, y0, x1, y1); see `facemime.track.field`.
+/// (x0, y0, x1, y1), only in the rows of `bands` ((b0, b1) frame rows) when given; see
+/// `facemime.track.field`.
 #[pyfunction]
-#[pyo3(signature = (frame, prev, region, sigma))]
+#[pyo3(signature = (frame, prev, region, sigma, bands=None))]
 fn frame_field<'py>(
     py: Python<'py>,
     frame: PyReadonlyArray3<u8>,
     prev: Option<PyReadonlyArray3<u8>>,
     region: [usize; 4],
     sigma: f64,
+    bands: Option<Vec<[usize; 2]>>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
     let img = rgb_view("frame", &frame)?;
     let before = prev.as_ref().map(|p| rgb_view("prev", p)).transpose()?;
     let flat = py
-        .detach(|| snake::frame_field(&img, before.as_ref(), region, sigma))
+        .detach(|| snake::frame_field(&img, before.as_ref(), region, sigma, bands.as_deref()))
         .map_err(CoreErr)?;
     let shape = (region[3] - region[1], region[2] - region[0], FIELD_CHANNELS);
     let out = ndarray::Array3::from_shape_vec(shape, flat).expect("H x W x C");

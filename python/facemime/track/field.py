@@ -24,9 +24,11 @@ def region(points: np.ndarray, margin: float, width: int, height: int) -> tuple[
     return min(x0, width - 4), min(y0, height - 4), max(x1, min(x0, width - 4) + 4), max(y1, min(y0, height - 4) + 4)
 
 
-def build_field(frame: np.ndarray, prev: np.ndarray | None, box: tuple[int, int, int, int], sigma: float) -> np.ndarray:
+def build_field(frame: np.ndarray, prev: np.ndarray | None, box: tuple[int, int, int, int], sigma: float,
+                bands: list[tuple[int, int]] | None = None) -> np.ndarray:
     """The (h, w, 6) float32 field of ``frame`` (H, W, 3) uint8 RGB over ``box``
     (x0, y0, x1, y1), exclusive ends, smoothed by a Gaussian of ``sigma`` px; ``prev`` is the
-    previous frame (or None: L_prev = L)."""
+    previous frame (or None: L_prev = L). With ``bands``, (y0, y1) frame rows, only the box's
+    rows inside a band are computed (the same values) and the others are 0."""
     before = None if prev is None else np.ascontiguousarray(prev)
-    return _core.frame_field(np.ascontiguousarray(frame), before, box, sigma)
+    return _core.frame_field(np.ascontiguousarray(frame), before, box, sigma, bands)

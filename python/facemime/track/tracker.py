@@ -204,6 +204,7 @@ class Tracker:
         self._down0 = self._mouth_down(self._knots0)
         self._features = {f: np.unique(np.concatenate([self._index[n] for n in names])) for f, names in FEATURES.items()}
         self._mouth_knots = np.unique(np.concatenate([self._features["mouth_outer"], self._features["mouth_inner"]]))
+        self._bands = (self._mouth_knots, np.unique(np.concatenate([self._features["brow_left"], self._features["brow_right"]])))
         self._mouth_rows = [i for i, n in enumerate(CONTOUR_NAMES) if n.startswith("mouth")]
         self._solver, self._targets0 = self._build_solver()
         gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
@@ -269,8 +270,14 @@ class Tracker:
         p = self.params
         margin = p.delta0 / (1.0 - p.sigma) + 4.0 * p.smoothing + 2.0
         box = region(knots, margin, self.width, self.height)
+        # The snakes read the image only near the knots: the rows of the brows and of the
+        # mouth, not the eyes and nose between them.
+        bands = []
+        for idx in self._bands:
+            ys = knots[idx, 1]
+            bands.append((max(int(np.floor(ys.min() - margin)), 0), max(int(np.ceil(ys.max() + margin)) + 1, 0)))
         prev = self._prev if max(p.mouth.gamma, p.mouth_inner.gamma, p.brows.gamma) > 0 else None
-        return build_field(frame, prev, box, p.smoothing), (float(box[0]), float(box[1]))
+        return build_field(frame, prev, box, p.smoothing, bands), (float(box[0]), float(box[1]))
 
     def _responses(self, frame: np.ndarray, start: np.ndarray, rest: np.ndarray, down: np.ndarray, targets: np.ndarray) -> np.ndarray:
         fld, origin = self._field(frame, start)

@@ -17,20 +17,48 @@ pub const MAX_SIGMA: f64 = 16.0;
 
 /// The region `[x0, y0, x1, y1)` (pixels, exclusive ends) of `frame` as a row-major
 /// (y1 − y0, x1 − x0, [`FIELD_CHANNELS`]) float32 field smoothed by a Gaussian of `sigma`
-/// pixels. `frame` and `prev` are (H, W, 3) RGB; without `prev`, L′ = L.
+/// pixels. `frame` and `prev` are (H, W, 3) RGB; without `prev`, L′ = L. With `bands`, frame
+/// rows `[b0, b1)`, only the rows of the region inside a band are computed (the same values
+/// as without) and the others are 0: the snakes of a frame read two bands, brows and mouth.
 pub fn frame_field(
     frame: &ImageRef,
     prev: Option<&ImageRef>,
     region: [usize; 4],
     sigma: f64,
+    bands: Option<&[[usize; 2]]>,
 ) -> Result<Vec<f32>> {
     check(frame, prev, region, sigma)?;
+    let [_, y0, _, y1] = region;
+    let wanted: Vec<bool> = match bands {
+        None => vec![true; y1 - y0],
+        Some(b) => (y0..y1)
+            .map(|y| b.iter().any(|&[b0, b1]| (b0..b1).contains(&y)))
+            .collect(),
+    };
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: AVX2 is present.
-        return Ok(unsafe { build_avx2(frame, prev, region, sigma) });
+        return Ok(unsafe { build_avx2(frame, prev, region, sigma, &wanted) });
     }
-    Ok(build(frame, prev, region, sigma))
+    Ok(build(frame, prev, region, sigma, &wanted))
+}
+
+/// The rows each stage needs for the output rows `wanted`: (rows smoothed, rows blurred
+/// across), through the mirrored borders.
+fn needed(wanted: &[bool], radius: usize) -> (Vec<bool>, Vec<bool>) {
+    let h = wanted.len();
+    let reach = |rows: &[bool], by: usize| -> Vec<bool> {
+        let mut out = vec![false; h];
+        for y in (0..h).filter(|&y| rows[y]) {
+            for k in -(by as isize)..=by as isize {
+                out[reflect101(y as isize + k, h)] = true;
+            }
+        }
+        out
+    };
+    let smoothed = reach(wanted, 1);
+    let across = reach(&smoothed, radius);
+    (smoothed, across)
 }
 
 fn check(frame: &ImageRef, prev: Option<&ImageRef>, region: [usize; 4], sigma: f64) -> Result<()> {
@@ -102,21 +130,24 @@ fn weighted(out: &mut [f32], taps: &[f32], rows: &[&[f32]]) {
 /// Outputs per block of [`weighted`]: four AVX2 registers.
 const BLOCK: usize = 32;
 
-/// Smooths the (h, w) plane `img` in place with the separable `taps`; `pad` and `rows` are
+/// Smooths the (h, w) plane `img` in place with the separable `taps`, in the rows `smoothed`
+/// (reading the rows `across`, which must hold all that they reach); `pad` and `rows` are
 /// scratch.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn blur(
     img: &mut [f32],
     w: usize,
-    h: usize,
     taps: &[f32],
+    smoothed: &[bool],
+    across: &[bool],
     pad: &mut Vec<f32>,
     rows: &mut Vec<f32>,
 ) {
-    let r = taps.len() / 2;
+    let (r, h) = (taps.len() / 2, smoothed.len());
     pad.resize(w + 2 * r, 0.0);
     rows.resize(w * h, 0.0);
-    for y in 0..h {
+    for y in (0..h).filter(|&y| across[y]) {
         let line = &img[y * w..][..w];
         pad[r..r + w].copy_from_slice(line);
         for i in 0..r {
@@ -126,7 +157,7 @@ fn blur(
         let shifted: Vec<&[f32]> = (0..taps.len()).map(|t| &pad[t..][..w]).collect();
         weighted(&mut rows[y * w..][..w], taps, &shifted);
     }
-    for y in 0..h {
+    for y in (0..h).filter(|&y| smoothed[y]) {
         let around: Vec<&[f32]> = (0..taps.len())
             .map(|t| &rows[reflect101((y + t) as isize - r as isize, h) * w..][..w])
             .collect();
@@ -134,11 +165,12 @@ fn blur(
     }
 }
 
-/// Luma and R − G planes of the region of `frame`.
+/// Luma and R − G planes of the region of `frame`, in its rows `rows` (the others 0).
 #[inline(always)]
 fn planes(
     frame: &ImageRef,
     region: [usize; 4],
+    rows: &[bool],
     luma: &mut Vec<f32>,
     mut chroma: Option<&mut Vec<f32>>,
 ) {
@@ -148,7 +180,7 @@ fn planes(
     if let Some(c) = chroma.as_deref_mut() {
         c.resize(w * (y1 - y0), 0.0);
     }
-    for y in y0..y1 {
+    for y in (y0..y1).filter(|&y| rows[y - y0]) {
         let row = &frame.data[(y * frame.width + x0) * 3..][..w * 3];
         let at = (y - y0) * w;
         for (l, p) in luma[at..at + w].iter_mut().zip(row.chunks_exact(3)) {
@@ -163,19 +195,27 @@ fn planes(
 }
 
 #[inline(always)]
-fn build(frame: &ImageRef, prev: Option<&ImageRef>, region: [usize; 4], sigma: f64) -> Vec<f32> {
+fn build(
+    frame: &ImageRef,
+    prev: Option<&ImageRef>,
+    region: [usize; 4],
+    sigma: f64,
+    wanted: &[bool],
+) -> Vec<f32> {
     let [x0, y0, x1, y1] = region;
     let (w, h) = (x1 - x0, y1 - y0);
     let taps = gaussian(sigma);
+    let (smoothed, across) = needed(wanted, taps.len() / 2);
     let (mut pad, mut rows) = (Vec::new(), Vec::new());
     let (mut luma, mut chroma) = (Vec::new(), Vec::new());
-    planes(frame, region, &mut luma, Some(&mut chroma));
-    blur(&mut luma, w, h, &taps, &mut pad, &mut rows);
-    blur(&mut chroma, w, h, &taps, &mut pad, &mut rows);
+    planes(frame, region, &across, &mut luma, Some(&mut chroma));
+    for plane in [&mut luma, &mut chroma] {
+        blur(plane, w, &taps, &smoothed, &across, &mut pad, &mut rows);
+    }
     let before = prev.map(|p| {
         let mut l = Vec::new();
-        planes(p, region, &mut l, None);
-        blur(&mut l, w, h, &taps, &mut pad, &mut rows);
+        planes(p, region, &across, &mut l, None);
+        blur(&mut l, w, &taps, &smoothed, &across, &mut pad, &mut rows);
         l
     });
     let before = before.as_deref().unwrap_or(&luma);
@@ -189,7 +229,11 @@ fn build(frame: &ImageRef, prev: Option<&ImageRef>, region: [usize; 4], sigma: f
     fn line(plane: &[f32], w: usize, y: usize) -> &[f32] {
         &plane[y * w..][..w]
     }
-    for (y, o) in out.chunks_exact_mut(w * FIELD_CHANNELS).enumerate() {
+    for (y, o) in out
+        .chunks_exact_mut(w * FIELD_CHANNELS)
+        .enumerate()
+        .filter(|&(y, _)| wanted[y])
+    {
         // Central differences with mirrored borders: across an edge both neighbours are the
         // same pixel, so the first and last columns (and rows) get 0.
         let (up, down) = (reflect101(y as isize - 1, h), reflect101(y as isize + 1, h));
@@ -220,8 +264,9 @@ fn build_avx2(
     prev: Option<&ImageRef>,
     region: [usize; 4],
     sigma: f64,
+    wanted: &[bool],
 ) -> Vec<f32> {
-    build(frame, prev, region, sigma)
+    build(frame, prev, region, sigma, wanted)
 }
 
 #[cfg(test)]
@@ -250,7 +295,7 @@ mod tests {
         let (w, h) = (40, 30);
         let data = rgb(w, h, |x, y| [(2 * x + y) as u8, (x + y) as u8, 7]);
         let img = ImageRef::new(&data, w, h, 3).unwrap();
-        let f = frame_field(&img, None, [5, 4, 35, 26], 1.5).unwrap();
+        let f = frame_field(&img, None, [5, 4, 35, 26], 1.5, None).unwrap();
         let (fw, at) = (30, |x: usize, y: usize, c: usize| {
             (y * 30 + x) * FIELD_CHANNELS + c
         });
@@ -277,7 +322,7 @@ mod tests {
             ImageRef::new(&a, w, h, 3).unwrap(),
             ImageRef::new(&b, w, h, 3).unwrap(),
         );
-        let f = frame_field(&fa, Some(&fb), [0, 0, w, h], 1.0).unwrap();
+        let f = frame_field(&fa, Some(&fb), [0, 0, w, h], 1.0, None).unwrap();
         for px in f.chunks_exact(FIELD_CHANNELS) {
             assert!((px[5] - 100.0).abs() < 1e-3);
         }
@@ -291,11 +336,34 @@ mod tests {
         });
         let img = ImageRef::new(&data, w, h, 3).unwrap();
         let region = [3, 2, 61, 45];
-        let portable = build(&img, Some(&img), region, 1.5);
-        assert_eq!(
-            frame_field(&img, Some(&img), region, 1.5).unwrap(),
-            portable
-        );
+        let bands = [[10, 14], [40, 60]];
+        let wanted: Vec<bool> = (2..45).map(|y| (10..14).contains(&y) || y >= 40).collect();
+        let portable = build(&img, Some(&img), region, 1.5, &wanted);
+        let got = frame_field(&img, Some(&img), region, 1.5, Some(&bands)).unwrap();
+        assert_eq!(got, portable);
+    }
+
+    #[test]
+    fn bands_compute_the_same_rows_and_leave_the_others_zero() {
+        let (w, h) = (50, 60);
+        let data = rgb(w, h, |x, y| {
+            [((x * 7 + y * 13) % 256) as u8, ((x * y) % 199) as u8, 3]
+        });
+        let img = ImageRef::new(&data, w, h, 3).unwrap();
+        let region = [4, 3, 46, 57];
+        let full = frame_field(&img, Some(&img), region, 1.5, None).unwrap();
+        // One band at the region's top edge, one inside, one past its bottom.
+        let bands = [[0, 5], [20, 24], [55, 70]];
+        let part = frame_field(&img, Some(&img), region, 1.5, Some(&bands)).unwrap();
+        let row = FIELD_CHANNELS * (region[2] - region[0]);
+        for (i, (a, b)) in full.chunks(row).zip(part.chunks(row)).enumerate() {
+            let y = i + region[1];
+            if bands.iter().any(|&[b0, b1]| (b0..b1).contains(&y)) {
+                assert_eq!(a, b, "row {y}");
+            } else {
+                assert!(b.iter().all(|&v| v == 0.0), "row {y}");
+            }
+        }
     }
 
     #[test]
@@ -304,11 +372,11 @@ mod tests {
         let img = ImageRef::new(&data, 8, 8, 3).unwrap();
         let gray = ImageRef::new(&data[..64], 8, 8, 1).unwrap();
         let small = ImageRef::new(&data[..48], 4, 4, 3).unwrap();
-        assert!(frame_field(&gray, None, [0, 0, 8, 8], 1.0).is_err());
-        assert!(frame_field(&img, Some(&small), [0, 0, 8, 8], 1.0).is_err());
-        assert!(frame_field(&img, None, [0, 0, 9, 8], 1.0).is_err());
-        assert!(frame_field(&img, None, [3, 0, 4, 8], 1.0).is_err());
-        assert!(frame_field(&img, None, [0, 0, 8, 8], 0.0).is_err());
-        assert!(frame_field(&img, None, [0, 0, 8, 8], f64::NAN).is_err());
+        assert!(frame_field(&gray, None, [0, 0, 8, 8], 1.0, None).is_err());
+        assert!(frame_field(&img, Some(&small), [0, 0, 8, 8], 1.0, None).is_err());
+        assert!(frame_field(&img, None, [0, 0, 9, 8], 1.0, None).is_err());
+        assert!(frame_field(&img, None, [3, 0, 4, 8], 1.0, None).is_err());
+        assert!(frame_field(&img, None, [0, 0, 8, 8], 0.0, None).is_err());
+        assert!(frame_field(&img, None, [0, 0, 8, 8], f64::NAN, None).is_err());
     }
 }
