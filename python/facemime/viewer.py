@@ -32,6 +32,7 @@ from facemime.fit.placement import model_iod
 from facemime.io.contours_json import read_motion
 from facemime.io.video import VideoReader
 from facemime.render.projection import Pose
+from facemime.render.texture_map import fill
 from facemime.track.overlay import draw_contours
 
 #: Key -> the change it makes to the user motion.
@@ -98,8 +99,7 @@ class Viewer:
 
     def _render(self) -> np.ndarray:
         left, pose, offsets, puppet = self._shown
-        synth = np.empty((self.size[1], self.size[0], 3), np.uint8)
-        synth[:] = BACKGROUND
+        synth = fill(np.empty((self.size[1], self.size[0], 3), np.uint8), BACKGROUND)
         puppet.render(pose, offsets, self.size, self.user, out=synth)
         return synth if left is None else np.hstack([left, synth])
 

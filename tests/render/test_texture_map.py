@@ -3,7 +3,7 @@ import pytest
 
 from facemime.errors import InvalidInputError
 from facemime.model import generic_head, painted_texture
-from facemime.render import Pose, coverage, project, render_mesh, render_mesh_into
+from facemime.render import Pose, coverage, fill, project, render_mesh, render_mesh_into
 
 RNG = np.random.default_rng(7)
 
@@ -172,3 +172,10 @@ def test_render_into_a_non_contiguous_or_readonly_image_is_refused():
     out = np.zeros((8, 8, 3), np.uint8)[:, ::2]
     with pytest.raises(InvalidInputError, match="C-contiguous"):
         render_mesh_into(out, np.zeros((2, 2, 3), np.uint8), np.zeros((3, 2)), np.zeros((3, 2)), np.zeros(3), [[0, 1, 2]])
+
+
+@pytest.mark.parametrize("shape, colour", [((5, 7, 3), (38, 40, 46)), ((5, 7, 4), (1, 2, 3, 255)), ((5, 7), 9)])
+def test_fill_paints_every_pixel_with_the_colour(shape, colour):
+    img = np.zeros(shape, np.uint8)
+    assert fill(img, colour) is img
+    assert (img.reshape(-1, *shape[2:]) == np.asarray(colour, np.uint8)).all()

@@ -25,6 +25,7 @@ from facemime.io.outputs import check_outputs
 from facemime.io.video import CODECS, VideoReader, VideoWriter
 from facemime.progress import track as progress
 from facemime.render.projection import Pose
+from facemime.render.texture_map import fill
 from facemime.track.overlay import draw_contours
 from facemime.track.tracker import TrackerParams
 
@@ -111,7 +112,7 @@ def run_video(video: str | Path, out: str | Path, actor: str | Path | Actor | No
             else:
                 motion = analysis.update(frame)
             t1 = time.perf_counter()
-            synth[:] = BACKGROUND
+            fill(synth, BACKGROUND)
             puppet.render(motion.pose, motion.offsets, size, user, out=synth)
             t2 = time.perf_counter()
             canvas[:, :reader.width] = draw_contours(frame, motion.contours, motion.lost) if motion.face else frame

@@ -17,7 +17,7 @@ from facemime.errors import InvalidInputError
 from facemime.fit.actor import Actor
 from facemime.fit.placement import model_iod
 from facemime.render.projection import Pose, project
-from facemime.render.texture_map import render_mesh_into
+from facemime.render.texture_map import fill, render_mesh_into
 
 BACKGROUND = (38, 40, 46)
 CAVITY = (52, 18, 22)
@@ -50,8 +50,7 @@ def draw_mouth_interior(out: np.ndarray, upper: np.ndarray, lower: np.ndarray) -
     cv2.fillPoly(mask, [fix(poly)], 255, cv2.LINE_AA, SHIFT)
     if not mask.any():
         return
-    paint = np.empty((y1 - y0, x1 - x0, 3), np.uint8)
-    paint[:] = CAVITY
+    paint = fill(np.empty((y1 - y0, x1 - x0, 3), np.uint8), CAVITY)
     along = upper[-1] - upper[0]
     width = float(np.linalg.norm(along))
     down = np.array([-along[1], along[0]]) / max(width, 1e-9)
@@ -87,7 +86,10 @@ def synthesize(actor: Actor, vertices: np.ndarray, pose: Pose, size: tuple[int, 
     w, h = size
     if out is None:
         out = np.empty((h, w, 3), np.uint8)
-        out[...] = background
+        if np.ndim(background) == 1:
+            fill(out, background)
+        else:
+            out[...] = background
     points, depth = project(vertices, pose)
     g = actor.model.groups
     draw_mouth_interior(out, points[g["mouth_inner_upper"]], points[g["mouth_inner_lower"]])

@@ -2,6 +2,6 @@
 per-triangle affine texture mapping, the last three in the Rust core."""
 
 from facemime.render.projection import Pose, project, rotation_matrix
-from facemime.render.texture_map import RenderStats, coverage, render_mesh, render_mesh_into
+from facemime.render.texture_map import RenderStats, coverage, fill, render_mesh, render_mesh_into
 
-__all__ = ["Pose", "project", "rotation_matrix", "RenderStats", "coverage", "render_mesh", "render_mesh_into"]
+__all__ = ["Pose", "project", "rotation_matrix", "RenderStats", "coverage", "fill", "render_mesh", "render_mesh_into"]
