@@ -7,7 +7,8 @@ reference Face Mesh points) and inside the mouth region (the hull of the referen
 grown by 0.15 IOD). Next to it, in the same run: **pose only** (the frame-0 face moved by the
 measured head pose, no local deformation) and **no motion** (the frame-0 face where it was).
 
-Speed: ``run`` on a 512×512 video with encoding excluded, and the share of each stage.
+Speed: ``run`` on a 512×512 video with encoding excluded, and the share of each stage; OpenCV
+and numpy's BLAS on one thread (the video decoder keeps its own threads).
 
     python benchmarks/synthesis.py [--data ../shared/data] [--videos lp_d0,vr_1] [--speed lp_d3]
 
@@ -15,6 +16,10 @@ Prints a table and, last, one JSON line with every figure.
 """
 
 from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # one core: no BLAS threads (set before numpy loads)
 
 import argparse
 import json
@@ -107,6 +112,7 @@ def main() -> None:
     ap.add_argument("--videos", default=",".join(VIDEOS))
     ap.add_argument("--speed", default="lp_d3", help="512x512 video for the speed measurement")
     args = ap.parse_args()
+    cv2.setNumThreads(1)
     per_video = {}
     for name in args.videos.split(","):
         z = np.load(args.data / "video" / f"{name}.landmarks.npz")

@@ -14,9 +14,12 @@ The last line of output is one JSON object with at least ``fps_tracker`` and ``f
 
 from __future__ import annotations
 
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # one core: no BLAS threads (set before numpy loads)
+
 import argparse
 import json
-import os
 import platform
 import time
 from pathlib import Path
