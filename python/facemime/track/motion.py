@@ -111,13 +111,18 @@ class HeadMotion:
         self._flow = FrameFlow()
         self._flow.push(gray, self._crop_box(gray.shape, np.zeros((0, 2))))
 
-    def _detect(self, gray: np.ndarray) -> np.ndarray:
-        """Corners in the zones. The corner measure reads a few pixels around each pixel, so it
-        runs on the zones' box grown by :data:`DETECT_MARGIN` px only: the same corners as on the
-        whole frame, for a fraction of the work."""
-        pts = np.concatenate(self._zones)
-        x0, y0 = np.maximum(np.floor(pts.min(axis=0)).astype(int) - DETECT_MARGIN, 0)
-        x1, y1 = np.minimum(np.ceil(pts.max(axis=0)).astype(int) + DETECT_MARGIN + 1, [gray.shape[1], gray.shape[0]])
+    def _zones_box(self, shape: tuple[int, ...], margin: int) -> tuple[int, int, int, int]:
+        """(x0, y0, x1, y1), exclusive ends: the zones' box grown by ``margin`` px, inside the frame."""
+        corners = np.concatenate(self._zones)
+        x0, y0 = np.maximum(np.floor(corners.min(axis=0)).astype(int) - margin, 0)
+        x1, y1 = np.minimum(np.ceil(corners.max(axis=0)).astype(int) + margin + 1, [shape[1], shape[0]])
+        return int(x0), int(y0), int(x1), int(y1)
+
+    def _detect(self, gray: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Corners in the zones and their new ids. The corner measure reads a few pixels around
+        each pixel, so it runs on the zones' box grown by :data:`DETECT_MARGIN` px only: the
+        same corners as on the whole frame, for a fraction of the work."""
+        x0, y0, x1, y1 = self._zones_box(gray.shape, DETECT_MARGIN)
         pts = None
         if x1 - x0 > 2 * DETECT_MARGIN and y1 - y0 > 2 * DETECT_MARGIN:
             mask = np.zeros((y1 - y0, x1 - x0), np.uint8)
@@ -157,9 +162,7 @@ class HeadMotion:
         """Fallback for motion too fast or blurred for the flow: the translation that best
         matches the previous frame's face zones (normalised cross-correlation at 1/4 scale,
         searched up to half the zone size away)."""
-        pts = np.concatenate(self._zones)
-        x0, y0 = np.maximum(np.floor(pts.min(axis=0)).astype(int), 0)
-        x1, y1 = np.minimum(np.ceil(pts.max(axis=0)).astype(int), [gray.shape[1], gray.shape[0]])
+        x0, y0, x1, y1 = self._zones_box(gray.shape, 0)
         if x1 - x0 < 16 or y1 - y0 < 16:
             return IDENTITY.copy(), False
         rx, ry = (x1 - x0) // 2, (y1 - y0) // 2

@@ -134,7 +134,6 @@ const BLOCK: usize = 32;
 /// (reading the rows `across`, which must hold all that they reach); `pad` and `rows` are
 /// scratch.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn blur(
     img: &mut [f32],
     w: usize,
@@ -194,6 +193,7 @@ fn planes(
     }
 }
 
+/// [`frame_field`] once its arguments are checked; `wanted`: the region's rows to compute.
 #[inline(always)]
 fn build(
     frame: &ImageRef,
