@@ -328,13 +328,17 @@ mod tests {
         }
     }
 
+    /// A `w`×`h` RGB image with fine texture in red and green.
+    fn textured(w: usize, h: usize) -> Vec<u8> {
+        rgb(w, h, |x, y| {
+            [((x * 37 + y * 11) % 251) as u8, ((x * y) % 253) as u8, 9]
+        })
+    }
+
     #[test]
     fn avx2_equals_portable() {
-        let (w, h) = (64, 48);
-        let data = rgb(w, h, |x, y| {
-            [((x * 37 + y * 11) % 251) as u8, ((x * y) % 253) as u8, 9]
-        });
-        let img = ImageRef::new(&data, w, h, 3).unwrap();
+        let data = textured(64, 48);
+        let img = ImageRef::new(&data, 64, 48, 3).unwrap();
         let region = [3, 2, 61, 45];
         let bands = [[10, 14], [40, 60]];
         let wanted: Vec<bool> = (2..45).map(|y| (10..14).contains(&y) || y >= 40).collect();
@@ -345,11 +349,8 @@ mod tests {
 
     #[test]
     fn bands_compute_the_same_rows_and_leave_the_others_zero() {
-        let (w, h) = (50, 60);
-        let data = rgb(w, h, |x, y| {
-            [((x * 7 + y * 13) % 256) as u8, ((x * y) % 199) as u8, 3]
-        });
-        let img = ImageRef::new(&data, w, h, 3).unwrap();
+        let data = textured(50, 60);
+        let img = ImageRef::new(&data, 50, 60, 3).unwrap();
         let region = [4, 3, 46, 57];
         let full = frame_field(&img, Some(&img), region, 1.5, None).unwrap();
         // One band at the region's top edge, one inside, one past its bottom.
