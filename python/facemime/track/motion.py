@@ -112,10 +112,11 @@ class HeadMotion:
         self._flow.push(gray, self._crop_box(gray.shape, np.zeros((0, 2))))
 
     def _zones_box(self, shape: tuple[int, ...], margin: int) -> tuple[int, int, int, int]:
-        """(x0, y0, x1, y1), exclusive ends: the zones' box grown by ``margin`` px, inside the frame."""
+        """(x0, y0, x1, y1), exclusive ends: the zones' box, from the floor of their smallest
+        to the ceiling of their largest coordinates, grown by ``margin`` px, inside the frame."""
         corners = np.concatenate(self._zones)
         x0, y0 = np.maximum(np.floor(corners.min(axis=0)).astype(int) - margin, 0)
-        x1, y1 = np.minimum(np.ceil(corners.max(axis=0)).astype(int) + margin + 1, [shape[1], shape[0]])
+        x1, y1 = np.minimum(np.ceil(corners.max(axis=0)).astype(int) + margin, [shape[1], shape[0]])
         return int(x0), int(y0), int(x1), int(y1)
 
     def _detect(self, gray: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
