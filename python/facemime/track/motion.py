@@ -30,6 +30,7 @@ ZONES = (
 FB_LIMIT = 1.0  # px: forward-backward error above this rejects a point
 MIN_POINTS = 6
 DETECT_MARGIN = 8  # px around the zones for the corner measure (block 5, Sobel 3)
+NEXT_CORNER = [1, 2, 3, 0]  # each zone corner's successor
 
 
 def face_frame(contours: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
@@ -143,7 +144,7 @@ class HeadMotion:
         """Which of ``pts`` (N, 2) lie in a zone (convex quadrilaterals, either winding)."""
         inside = np.zeros(len(pts), bool)
         for poly in self._zones:
-            edges = np.roll(poly, -1, axis=0) - poly
+            edges = poly[NEXT_CORNER] - poly
             rel = pts[:, None, :] - poly[None]
             cross = edges[None, :, 0] * rel[..., 1] - edges[None, :, 1] * rel[..., 0]
             inside |= (cross >= 0).all(axis=1) | (cross <= 0).all(axis=1)

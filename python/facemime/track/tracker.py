@@ -23,6 +23,7 @@ Coordinates are (x, y) pixels, origin at the centre of the top-left pixel, y dow
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
@@ -164,6 +165,11 @@ def _check_contours(contours: Mapping[str, object], width: int, height: int) -> 
     return out
 
 
+def _length(d: np.ndarray) -> float:
+    """Euclidean length of a vector (= np.linalg.norm, less overhead)."""
+    return math.sqrt(d @ d)
+
+
 def _rgb(name: str, frame: object) -> np.ndarray:
     img = validate.image(name, frame)
     if img.ndim != 3 or img.shape[2] != 3:
@@ -206,6 +212,7 @@ class Tracker:
         self._mouth_knots = np.unique(np.concatenate([self._features["mouth_outer"], self._features["mouth_inner"]]))
         self._bands = (self._mouth_knots, np.unique(np.concatenate([self._features["brow_left"], self._features["brow_right"]])))
         self._mouth_rows = [i for i, n in enumerate(CONTOUR_NAMES) if n.startswith("mouth")]
+        self._feature_rows = {f: [CONTOUR_NAMES.index(n) for n in names] for f, names in FEATURES.items()}
         self._solver, self._targets0 = self._build_solver()
         gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
         self._motion = motion.HeadMotion(gray, contours) if p.motion else None
@@ -223,6 +230,7 @@ class Tracker:
         self._linear = np.eye(2)
         self._down = self._down0
         self._response0 = np.maximum(self._responses(frame, edges, edges, self._down0, self._targets0), 1e-6)
+        self._reported = self.contours
 
     def _build_solver(self) -> tuple[_core.SnakeSolver, np.ndarray]:
         p = self.params
@@ -299,7 +307,7 @@ class Tracker:
         step, ok, flow = motion.IDENTITY, True, None
         if self._motion is not None:
             gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
-            step, ok, flow = self._motion.update(gray, self.contours, self._knots if p.knot_flow else None)
+            step, ok, flow = self._motion.update(gray, self._reported, self._knots if p.knot_flow else None)
         total = self._motion.total if self._motion is not None else motion.IDENTITY
         scale = float(np.sqrt(abs(np.linalg.det(total[:, :2]))))
         rot = total[:, :2] / max(scale, 1e-9)
@@ -328,8 +336,8 @@ class Tracker:
         self._centre_inner(knots, rest, down)
         confidence, lost = {}, []
         for feature, names in FEATURES.items():
-            rows = [CONTOUR_NAMES.index(n) for n in names]
-            conf = float(np.clip(resp[rows] / self._response0[rows], 0.0, 1.0).mean())
+            rows = self._feature_rows[feature]
+            conf = float(np.minimum(np.maximum(resp[rows] / self._response0[rows], 0.0), 1.0).mean())
             confidence[feature] = conf
             if conf < p.lost_response or not self._shape_ok(knots, carried, names):
                 lost.append(feature)
@@ -339,7 +347,10 @@ class Tracker:
         self._linear = total[:, :2]
         self._down = down
         self._prev = frame
-        return FrameResult(self.frame_index, self.contours, confidence, lost, iters, ok)
+        reported = self._reported_knots()
+        # The head motion reads the contours next frame: its own copy, not the caller's.
+        self._reported = self._named(reported)
+        return FrameResult(self.frame_index, self._named(reported), confidence, lost, iters, ok)
 
     def _centre_inner(self, knots: np.ndarray, rest: np.ndarray, down: np.ndarray) -> None:
         """Slide the inner mouth along the mouth line so that it sits where it sat in the outer
@@ -347,7 +358,8 @@ class Tracker:
         hold them sideways; in place)."""
         along = np.array([down[1], -down[0]])
         inner, outer = self._features["mouth_inner"], self._features["mouth_outer"]
-        drift = (knots[inner].mean(axis=0) - knots[outer].mean(axis=0)) - (rest[inner].mean(axis=0) - rest[outer].mean(axis=0))
+        mean = lambda pts, idx: pts[idx].sum(axis=0) / len(idx)  # noqa: E731 (= ndarray.mean, less overhead)
+        drift = (mean(knots, inner) - mean(knots, outer)) - (mean(rest, inner) - mean(rest, outer))
         knots[inner] -= CENTRING * (drift @ along) * along
 
     def _uncross(self, knots: np.ndarray, down: np.ndarray) -> None:
@@ -373,9 +385,9 @@ class Tracker:
 
     def _shape_ok(self, knots: np.ndarray, rest: np.ndarray, names: tuple[str, str]) -> bool:
         """The upper curve's chord stays within a factor 2 of its rest chord."""
-        ends = self._index[names[0]][[0, -1]]
-        chord = np.linalg.norm(knots[ends[1]] - knots[ends[0]])
-        rest_chord = np.linalg.norm(rest[ends[1]] - rest[ends[0]])
+        first, last = self._index[names[0]][[0, -1]]
+        chord = _length(knots[last] - knots[first])
+        rest_chord = _length(rest[last] - rest[first])
         return bool(0.5 * rest_chord <= chord <= 2.0 * rest_chord)
 
     @property
@@ -393,6 +405,14 @@ class Tracker:
     @property
     def contours(self) -> dict[str, np.ndarray]:
         """The current contours, name -> (N, 2) float64 pixels."""
+        return self._named(self._reported_knots())
+
+    def _reported_knots(self) -> np.ndarray:
+        """The knots as reported: calibration offset taken out, inner curves uncrossed."""
         out = self._knots - self._offset @ self._linear.T
         self._uncross(out, self._down)
-        return {n: out[self._index[n]] for n in CONTOUR_NAMES}
+        return out
+
+    def _named(self, knots: np.ndarray) -> dict[str, np.ndarray]:
+        """name -> (N, 2) copies of the contours' knots."""
+        return {n: knots[self._index[n]] for n in CONTOUR_NAMES}
