@@ -102,6 +102,17 @@ def test_confidence_and_lost_flag_when_the_face_disappears():
     assert sorted(gone.lost) == sorted(FEATURES) and max(gone.confidence.values()) < 0.1
 
 
+def test_editing_a_result_does_not_change_the_track():
+    frame0, truth0 = band_face()
+    frames = [band_face(shift=(0.7 * k, 0.3 * k))[0] for k in range(1, 4)]
+    plain, edited = Tracker(frame0, truth0), Tracker(frame0, truth0)
+    for frame in frames:
+        want = plain.update(frame).contours
+        got = edited.update(frame).contours
+        for name in CONTOUR_NAMES:
+            np.testing.assert_array_equal(got[name], want[name])
+            got[name] += 40.0  # a caller drawing or smoothing in place
+
 def test_a_lost_brow_goes_back_to_its_rest_shape_and_is_found_again():
     frame0, truth0 = band_face()
     tracker = Tracker(frame0, truth0)
