@@ -78,6 +78,28 @@ impl Sampler for Nearest {
         let p = tex.data.as_ptr().add((y * tex.width + x) * C);
         std::ptr::read_unaligned(p as *const [u8; C])
     }
+
+    #[inline(always)]
+    unsafe fn fill_span_unchecked<const C: usize>(
+        tex: &ImageRef,
+        mut u: i64,
+        mut v: i64,
+        du: i64,
+        dv: i64,
+        out: &mut [u8],
+    ) {
+        // The texture's pointer and row length in locals: the writes to `out` would otherwise
+        // make the compiler reload them for every pixel.
+        let (data, stride) = (tex.data.as_ptr(), tex.width * C);
+        u += ONE / 2;
+        v += ONE / 2;
+        for px in out.chunks_exact_mut(C) {
+            let i = (v >> FRAC_BITS) as usize * stride + (u >> FRAC_BITS) as usize * C;
+            px.copy_from_slice(&std::ptr::read_unaligned(data.add(i) as *const [u8; C]));
+            u += du;
+            v += dv;
+        }
+    }
 }
 
 /// Bits of the bilinear weights: 12, rounded, so that the four products of a channel sum to at

@@ -62,15 +62,25 @@ impl CeilStepper {
         }
     }
 
+    /// A stepper whose value stays `x` on every row (a bound that never binds).
+    fn constant(x: i64) -> Self {
+        Self {
+            x,
+            s: 0,
+            d: 1,
+            dq: 0,
+            dr: 0,
+        }
+    }
+
     #[inline(always)]
     fn step(&mut self) {
-        // n + dn = d·(x + dq) - (s - dr)
+        // n + dn = d·(x + dq) - (s - dr); the carry is irregular, so keep it branch-free.
         self.x += self.dq;
         self.s -= self.dr;
-        if self.s < 0 {
-            self.s += self.d;
-            self.x += 1;
-        }
+        let borrow = self.s >> 63; // -1 when s < 0, else 0
+        self.s += self.d & borrow;
+        self.x -= borrow;
     }
 }
 
@@ -119,45 +129,53 @@ fn fill_snapped(
     let xmin = p0.0.min(p1.0).min(p2.0);
     let xmax = p0.0.max(p1.0).max(p2.0);
     // Bounding box in pixel centres, clipped to the target.
-    let row_first = (-((-ymin).div_euclid(SUB))).max(0);
-    let row_last = ymax.div_euclid(SUB).min(ymax_px);
+    let mut row_first = (-((-ymin).div_euclid(SUB))).max(0);
+    let mut row_last = ymax.div_euclid(SUB).min(ymax_px);
     let col_first = (-((-xmin).div_euclid(SUB))).max(0);
     let col_last = xmax.div_euclid(SUB).min(xmax_px);
+    // A flat edge (a = 0) bounds the rows: b·py + c >= 0, with b != 0 as the area is not zero.
+    for e in edges.iter().filter(|e| e.a == 0) {
+        if e.b > 0 {
+            row_first = row_first.max(-(e.c.div_euclid(e.b))); // py >= ceil(-c / b)
+        } else {
+            row_last = row_last.min(e.c.div_euclid(-e.b)); // py <= floor(c / -b)
+        }
+    }
     if row_first > row_last || col_first > col_last {
         return;
     }
-    // Per edge, the first (a > 0) or one past the last (a < 0) pixel of each row, stepped
-    // exactly from row to row; flat edges (a = 0) exclude the rows where they are negative.
-    let mut lower: [Option<CeilStepper>; 3] = [None, None, None];
-    let mut upper: [Option<CeilStepper>; 3] = [None, None, None];
-    let mut flat: [Option<(i64, i64)>; 3] = [None, None, None]; // (r, dr) with r = b·py + c
-    for (k, e) in edges.iter().enumerate() {
+    // The other edges bound each row: the first pixel (a > 0) or one past the last (a < 0),
+    // stepped exactly from row to row. A triangle has at most two of each kind; a missing one
+    // is a constant bound at the box's edge.
+    let mut lower = [
+        CeilStepper::constant(col_first),
+        CeilStepper::constant(col_first),
+    ];
+    let mut upper = [
+        CeilStepper::constant(col_last + 1),
+        CeilStepper::constant(col_last + 1),
+    ];
+    let (mut nl, mut nu) = (0, 0);
+    for e in &edges {
         let r = e.b * row_first + e.c; // E = a·px + r >= 0
         if e.a > 0 {
-            lower[k] = Some(CeilStepper::new(-r, e.a, -e.b)); // px >= ceil(-r / a)
+            lower[nl] = CeilStepper::new(-r, e.a, -e.b); // px >= ceil(-r / a)
+            nl += 1;
         } else if e.a < 0 {
-            upper[k] = Some(CeilStepper::new(r + 1, -e.a, e.b)); // px < ceil((r + 1) / -a)
-        } else {
-            flat[k] = Some((r, e.b));
+            upper[nu] = CeilStepper::new(r + 1, -e.a, e.b); // px < ceil((r + 1) / -a)
+            nu += 1;
         }
     }
+    // Four named steppers rather than an array, so that they stay in registers.
+    let ([mut l0, mut l1], [mut u0, mut u1]) = (lower, upper);
     for py in row_first..=row_last {
-        let (mut lo, mut hi, mut empty) = (col_first, col_last, false);
-        for k in 0..3 {
-            if let Some(b) = &mut lower[k] {
-                lo = lo.max(b.x);
-                b.step();
-            }
-            if let Some(b) = &mut upper[k] {
-                hi = hi.min(b.x - 1);
-                b.step();
-            }
-            if let Some((r, dr)) = &mut flat[k] {
-                empty |= *r < 0;
-                *r += *dr;
-            }
-        }
-        if !empty && lo <= hi {
+        let lo = col_first.max(l0.x).max(l1.x);
+        let hi = col_last.min(u0.x - 1).min(u1.x - 1);
+        l0.step();
+        l1.step();
+        u0.step();
+        u1.step();
+        if lo <= hi {
             f(py as usize, lo as usize, hi as usize);
         }
     }
