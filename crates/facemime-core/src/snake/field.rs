@@ -66,17 +66,22 @@ impl<'a> Field<'a> {
         let (fy, cy, y0) = axis(y - self.origin[1], self.height);
         let row = self.width * FIELD_CHANNELS;
         let a = y0 * row + x0 * FIELD_CHANNELS;
-        let (b, c) = (a + FIELD_CHANNELS, a + row);
-        let d = c + FIELD_CHANNELS;
+        // The cell's two pixels on its top and its bottom row, one bounds check each.
+        let top: &[f32; 2 * FIELD_CHANNELS] = self.data[a..][..2 * FIELD_CHANNELS]
+            .try_into()
+            .expect("two pixels");
+        let bot: &[f32; 2 * FIELD_CHANNELS] = self.data[a + row..][..2 * FIELD_CHANNELS]
+            .try_into()
+            .expect("two pixels");
         let (fx, fy) = (fx as f32, fy as f32);
         let mut s = Sample {
             v: [0.0; FIELD_CHANNELS],
             dx: [0.0; FIELD_CHANNELS],
             dy: [0.0; FIELD_CHANNELS],
         };
-        let p = &self.data;
         for ch in 0..FIELD_CHANNELS {
-            let (va, vb, vc, vd) = (p[a + ch], p[b + ch], p[c + ch], p[d + ch]);
+            let (va, vb) = (top[ch], top[FIELD_CHANNELS + ch]);
+            let (vc, vd) = (bot[ch], bot[FIELD_CHANNELS + ch]);
             let top = va + fx * (vb - va);
             let bottom = vc + fx * (vd - vc);
             s.v[ch] = top + fy * (bottom - top);
@@ -102,7 +107,7 @@ fn axis(t: f64, size: usize) -> (f64, bool, usize) {
     if t >= max {
         return (1.0, false, size - 2);
     }
-    let i = (t.floor() as usize).min(size - 2);
+    let i = (t as usize).min(size - 2); // t > 0: truncation is floor, without a libm call
     (t - i as f64, true, i)
 }
 
