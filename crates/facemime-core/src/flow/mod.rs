@@ -89,7 +89,7 @@ impl Level {
     /// The bilinear samples of this level on the unit grid whose top-left sample is the level
     /// point (x, y); the grid must fit in the padded plane (see [`Pyramid::inside`]).
     fn grid(&self, x: f32, y: f32) -> Grid<'_> {
-        let (ix, iy) = (x.floor(), y.floor());
+        let (ix, iy) = (floor(x), floor(y));
         let (a, b) = (x - ix, y - iy);
         let p = self.pad as isize;
         let start = (iy as isize + p) as usize * self.stride() + (ix as isize + p) as usize;
@@ -204,7 +204,7 @@ impl Pyramid {
     fn inside(&self, level: usize, corner: [f32; 2]) -> bool {
         let l = &self.levels[level];
         let lo = -(self.window as f32);
-        let (x, y) = (corner[0].floor(), corner[1].floor());
+        let (x, y) = (floor(corner[0]), floor(corner[1]));
         x >= lo && y >= lo && x < l.width as f32 && y < l.height as f32
     }
 
@@ -218,6 +218,22 @@ impl Pyramid {
     fn to_frame(&self, q: [f64; 2], level: usize) -> [f64; 2] {
         let s = (1u64 << level) as f64;
         [q[0] * s + self.origin[0], q[1] * s + self.origin[1]]
+    }
+}
+
+/// `x.floor()`, without its libm call (baseline x86-64 has no rounding instruction) for the
+/// values windows take; NaN and huge values go to libm.
+#[inline]
+fn floor(x: f32) -> f32 {
+    if x.abs() < 1e9 {
+        let t = x as i32 as f32; // truncation towards zero, exact here
+        if t > x {
+            t - 1.0
+        } else {
+            t
+        }
+    } else {
+        x.floor()
     }
 }
 
@@ -393,6 +409,27 @@ mod tests {
 
     fn pyramid(img: &[u8], w: usize, h: usize) -> Pyramid {
         Pyramid::build(img, w, h, [0, 0, w, h], 5, 21).unwrap()
+    }
+
+    #[test]
+    fn floor_matches_libm() {
+        for x in [
+            -21.0f32,
+            -20.5,
+            -1.0,
+            -0.75,
+            -0.0,
+            0.0,
+            0.25,
+            1.0,
+            3.999_999_8,
+            1e8,
+            -1e8,
+            2e9,
+        ] {
+            assert_eq!(floor(x), x.floor(), "floor({x})");
+        }
+        assert!(floor(f32::NAN).is_nan());
     }
 
     #[test]

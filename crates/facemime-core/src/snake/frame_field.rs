@@ -104,12 +104,14 @@ fn gaussian(sigma: f64) -> Vec<f32> {
 }
 
 /// `out[i] = Σ_t taps[t] · rows[t][i]`, summed in tap order, [`BLOCK`] outputs at a time so
-/// that the sums stay in registers.
+/// that the sums stay in registers; a ragged end is one more block overlapping the last one
+/// (every output is the same sum whichever block computes it).
 #[inline(always)]
 fn weighted(out: &mut [f32], taps: &[f32], rows: &[&[f32]]) {
     let n = out.len();
     let mut x = 0;
-    while x + BLOCK <= n {
+    while x < n && n >= BLOCK {
+        x = x.min(n - BLOCK);
         let mut acc = [0.0f32; BLOCK];
         for (&k, row) in taps.iter().zip(rows) {
             for (a, s) in acc.iter_mut().zip(&row[x..x + BLOCK]) {
@@ -193,6 +195,22 @@ fn planes(
     }
 }
 
+/// The planes and row buffers of [`build`], kept per thread from call to call: the tracker asks
+/// for a field of about the same size every frame, and zeroing fresh buffers cost more than
+/// filling them. A call reads only the rows it has written.
+#[derive(Default)]
+struct Scratch {
+    luma: Vec<f32>,
+    chroma: Vec<f32>,
+    prev_luma: Vec<f32>,
+    pad: Vec<f32>,
+    rows: Vec<f32>,
+}
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
+}
+
 /// [`frame_field`] once its arguments are checked; `wanted`: the region's rows to compute.
 #[inline(always)]
 fn build(
@@ -206,20 +224,27 @@ fn build(
     let (w, h) = (x1 - x0, y1 - y0);
     let taps = gaussian(sigma);
     let (smoothed, across) = needed(wanted, taps.len() / 2);
-    let (mut pad, mut rows) = (Vec::new(), Vec::new());
-    let (mut luma, mut chroma) = (Vec::new(), Vec::new());
-    planes(frame, region, &across, &mut luma, Some(&mut chroma));
-    for plane in [&mut luma, &mut chroma] {
-        blur(plane, w, &taps, &smoothed, &across, &mut pad, &mut rows);
+    // Taken out and put back rather than borrowed in `SCRATCH.with(|s| ...)`, and no
+    // `prev.map(|p| ...)`: a closure would not inherit `build_avx2`'s target feature.
+    let mut scratch = SCRATCH.take();
+    let Scratch {
+        luma,
+        chroma,
+        prev_luma,
+        pad,
+        rows,
+    } = &mut scratch;
+    planes(frame, region, &across, luma, Some(chroma));
+    for plane in [&mut *luma, &mut *chroma] {
+        blur(plane, w, &taps, &smoothed, &across, pad, rows);
     }
-    let before = prev.map(|p| {
-        let mut l = Vec::new();
-        planes(p, region, &across, &mut l, None);
-        blur(&mut l, w, &taps, &smoothed, &across, &mut pad, &mut rows);
-        l
-    });
-    let before = before.as_deref().unwrap_or(&luma);
-    let mut out = vec![0.0f32; w * h * FIELD_CHANNELS];
+    if let Some(p) = prev {
+        planes(p, region, &across, prev_luma, None);
+        blur(prev_luma, w, &taps, &smoothed, &across, pad, rows);
+    }
+    let (luma, chroma) = (&*luma, &*chroma);
+    let before = if prev.is_some() { &*prev_luma } else { luma };
+    let mut out = Vec::with_capacity(w * h * FIELD_CHANNELS);
     let mut d = [
         vec![0.0f32; w],
         vec![0.0f32; w],
@@ -229,16 +254,19 @@ fn build(
     fn line(plane: &[f32], w: usize, y: usize) -> &[f32] {
         &plane[y * w..][..w]
     }
-    for (y, o) in out
-        .chunks_exact_mut(w * FIELD_CHANNELS)
-        .enumerate()
-        .filter(|&(y, _)| wanted[y])
-    {
+    for (y, &want) in wanted.iter().enumerate() {
+        // Each row is zeroed just before it is filled, while it is in the cache.
+        let at = out.len();
+        out.resize(at + w * FIELD_CHANNELS, 0.0);
+        if !want {
+            continue;
+        }
+        let o = &mut out[at..];
         // Central differences with mirrored borders: across an edge both neighbours are the
         // same pixel, so the first and last columns (and rows) get 0.
         let (up, down) = (reflect101(y as isize - 1, h), reflect101(y as isize + 1, h));
         let [dlx, dly, dcx, dcy] = &mut d;
-        for (plane, dx, dy) in [(&luma, dlx, dly), (&chroma, dcx, dcy)] {
+        for (plane, dx, dy) in [(luma, dlx, dly), (chroma, dcx, dcy)] {
             let l = line(plane, w, y);
             for ((o, a), b) in dx[1..w - 1].iter_mut().zip(&l[2..]).zip(l) {
                 *o = 0.5 * (a - b);
@@ -248,11 +276,12 @@ fn build(
                 *o = 0.5 * (a - b);
             }
         }
-        let (l, lp) = (line(&luma, w, y), line(before, w, y));
+        let (l, lp) = (line(luma, w, y), line(before, w, y));
         for (x, px) in o.chunks_exact_mut(FIELD_CHANNELS).enumerate() {
             px.copy_from_slice(&[d[0][x], d[1][x], d[2][x], d[3][x], l[x], lp[x]]);
         }
     }
+    SCRATCH.set(scratch);
     out
 }
 
