@@ -397,6 +397,28 @@ mod tests {
     }
 
     #[test]
+    fn a_field_does_not_depend_on_earlier_calls() {
+        // The planes are reused from call to call: stale rows of another image and region
+        // must not leak into a banded field.
+        let (data, other) = (
+            textured(50, 60),
+            rgb(50, 60, |x, y| [(x * y % 256) as u8, 200, 3]),
+        );
+        let field = |d: &[u8], region, bands: Option<&[[usize; 2]]>| {
+            let img = ImageRef::new(d, 50, 60, 3).unwrap();
+            frame_field(&img, Some(&img), region, 1.5, bands).unwrap()
+        };
+        let bands = [[8, 12], [30, 41]];
+        let moved = data.clone();
+        let fresh = std::thread::spawn(move || field(&moved, [4, 3, 46, 57], Some(&bands)))
+            .join()
+            .unwrap();
+        field(&other, [0, 0, 50, 60], None);
+        field(&other, [10, 5, 30, 50], Some(&[[9, 40]]));
+        assert_eq!(field(&data, [4, 3, 46, 57], Some(&bands)), fresh);
+    }
+
+    #[test]
     fn refuses_bad_arguments() {
         let data = rgb(8, 8, |_, _| [1, 2, 3]);
         let img = ImageRef::new(&data, 8, 8, 3).unwrap();
