@@ -53,69 +53,109 @@ unsafe fn span_avx2<const C: usize>(
     n: usize,
 ) -> usize {
     const WB: i32 = 12; // weight bits, as the scalar sampler
-    let lanes = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-    let (du_v, dv_v) = (_mm256_set1_epi32(du), _mm256_set1_epi32(dv));
     let frac = _mm256_set1_epi32((1 << FRAC_BITS) - 1);
     let half = _mm256_set1_epi32(1 << (FRAC_BITS as i32 - WB - 1));
     let one = _mm256_set1_epi32(1 << WB);
     let round = _mm256_set1_epi32(1 << (2 * WB - 1));
-    let byte = _mm256_set1_epi32(0xFF);
-    let (cc, stride) = (
-        _mm256_set1_epi32(C as i32),
-        _mm256_set1_epi32((tex.width * C) as i32),
-    );
+    let stride = _mm256_set1_epi32((tex.width * C) as i32);
+    // Byte c of every 32-bit lane to the lane's low 16 bits (`low`) or its high 16 bits
+    // (`high`), the rest zero: with both, one lane holds a texel pair (t0 | t1 << 16) of
+    // channel c, ready for a 16-bit multiply-add with the weight pair (1 - f | f << 16).
+    let pick = |c: i8, at: i8| {
+        let z = -128i8; // 0x80: a zero byte
+        let lane = |k: i8| {
+            let mut b = [z; 4];
+            b[at as usize] = 4 * k + c;
+            b
+        };
+        let [a, b, cc, d] = [lane(0), lane(1), lane(2), lane(3)];
+        _mm256_setr_epi8(
+            a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3], cc[0], cc[1], cc[2], cc[3], d[0], d[1],
+            d[2], d[3], a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3], cc[0], cc[1], cc[2], cc[3],
+            d[0], d[1], d[2], d[3],
+        )
+    };
+    let low: [__m256i; 4] = std::array::from_fn(|c| pick(c as i8, 0));
+    let high: [__m256i; 4] = std::array::from_fn(|c| pick(c as i8, 2));
     let base = tex.data.as_ptr() as *const i32;
+    let lanes = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    // Positions of the chunk's eight pixels, stepped by eight pixels per chunk.
+    let mut uu = _mm256_add_epi32(
+        _mm256_set1_epi32(u),
+        _mm256_mullo_epi32(lanes, _mm256_set1_epi32(du)),
+    );
+    let mut vv = _mm256_add_epi32(
+        _mm256_set1_epi32(v),
+        _mm256_mullo_epi32(lanes, _mm256_set1_epi32(dv)),
+    );
+    let (du8, dv8) = (
+        _mm256_set1_epi32(du.wrapping_mul(8)),
+        _mm256_set1_epi32(dv.wrapping_mul(8)),
+    );
     let mut done = 0;
     let mut buf = [0u32; 8];
     while done < n {
-        // Lanes past the span's end repeat its last pixel, so every gather stays in bounds.
         let m = (n - done).min(8);
-        let k = _mm256_min_epi32(lanes, _mm256_set1_epi32(m as i32 - 1));
-        let uu = _mm256_add_epi32(
-            _mm256_set1_epi32(u.wrapping_add((done as i32).wrapping_mul(du))),
-            _mm256_mullo_epi32(k, du_v),
-        );
-        let vv = _mm256_add_epi32(
-            _mm256_set1_epi32(v.wrapping_add((done as i32).wrapping_mul(dv))),
-            _mm256_mullo_epi32(k, dv_v),
-        );
+        let (mut cu, mut cv) = (uu, vv);
+        if m < 8 {
+            // Lanes past the span's end repeat its last pixel, so every gather stays in bounds.
+            let k = _mm256_min_epi32(lanes, _mm256_set1_epi32(m as i32 - 1));
+            cu = _mm256_add_epi32(
+                _mm256_set1_epi32(u.wrapping_add((done as i32).wrapping_mul(du))),
+                _mm256_mullo_epi32(k, _mm256_set1_epi32(du)),
+            );
+            cv = _mm256_add_epi32(
+                _mm256_set1_epi32(v.wrapping_add((done as i32).wrapping_mul(dv))),
+                _mm256_mullo_epi32(k, _mm256_set1_epi32(dv)),
+            );
+        }
         let fx = _mm256_srli_epi32::<{ FRAC_BITS as i32 - WB }>(_mm256_add_epi32(
-            _mm256_and_si256(uu, frac),
+            _mm256_and_si256(cu, frac),
             half,
         ));
         let fy = _mm256_srli_epi32::<{ FRAC_BITS as i32 - WB }>(_mm256_add_epi32(
-            _mm256_and_si256(vv, frac),
+            _mm256_and_si256(cv, frac),
             half,
         ));
-        let (gx, gy) = (_mm256_sub_epi32(one, fx), _mm256_sub_epi32(one, fy));
-        let w = [
-            _mm256_mullo_epi32(gx, gy),
-            _mm256_mullo_epi32(fx, gy),
-            _mm256_mullo_epi32(gx, fy),
-            _mm256_mullo_epi32(fx, fy),
-        ];
-        let x = _mm256_srai_epi32::<{ FRAC_BITS as i32 }>(uu);
-        let y = _mm256_srai_epi32::<{ FRAC_BITS as i32 }>(vv);
-        let o00 = _mm256_add_epi32(_mm256_mullo_epi32(y, stride), _mm256_mullo_epi32(x, cc));
-        let o01 = _mm256_add_epi32(o00, cc);
+        // Weight pairs (1 - fx | fx << 16) across; 1 - fy and fy down, as 32-bit lanes.
+        let wx = _mm256_or_si256(_mm256_sub_epi32(one, fx), _mm256_slli_epi32::<16>(fx));
+        let gy = _mm256_sub_epi32(one, fy);
+        let x = _mm256_srai_epi32::<{ FRAC_BITS as i32 }>(cu);
+        let y = _mm256_srai_epi32::<{ FRAC_BITS as i32 }>(cv);
+        let xc = if C == 4 {
+            _mm256_slli_epi32::<2>(x)
+        } else {
+            _mm256_add_epi32(_mm256_slli_epi32::<1>(x), x)
+        };
+        let o00 = _mm256_add_epi32(_mm256_mullo_epi32(y, stride), xc);
+        let o01 = _mm256_add_epi32(o00, _mm256_set1_epi32(C as i32));
         let (o10, o11) = (_mm256_add_epi32(o00, stride), _mm256_add_epi32(o01, stride));
-        let t = [
-            _mm256_i32gather_epi32::<1>(base, o00),
-            _mm256_i32gather_epi32::<1>(base, o01),
-            _mm256_i32gather_epi32::<1>(base, o10),
-            _mm256_i32gather_epi32::<1>(base, o11),
-        ];
+        let t00 = _mm256_i32gather_epi32::<1>(base, o00);
+        let t01 = _mm256_i32gather_epi32::<1>(base, o01);
+        let t10 = _mm256_i32gather_epi32::<1>(base, o10);
+        let t11 = _mm256_i32gather_epi32::<1>(base, o11);
         let mut px = _mm256_setzero_si256();
         for c in 0..C.min(4) {
-            let shift = _mm_cvtsi32_si128(8 * c as i32);
-            let mut s = round;
-            for k in 0..4 {
-                let ch = _mm256_and_si256(_mm256_srl_epi32(t[k], shift), byte);
-                s = _mm256_add_epi32(s, _mm256_mullo_epi32(ch, w[k]));
-            }
+            let pair = |a: __m256i, b: __m256i| {
+                _mm256_or_si256(
+                    _mm256_shuffle_epi8(a, low[c]),
+                    _mm256_shuffle_epi8(b, high[c]),
+                )
+            };
+            // Across, exact in 32 bits (< 2^20); then down, the same sum as the scalar
+            // sampler's four products (< 2^32).
+            let top = _mm256_madd_epi16(pair(t00, t01), wx);
+            let bottom = _mm256_madd_epi16(pair(t10, t11), wx);
+            let s = _mm256_add_epi32(
+                _mm256_add_epi32(_mm256_mullo_epi32(top, gy), _mm256_mullo_epi32(bottom, fy)),
+                round,
+            );
             px = _mm256_or_si256(
                 px,
-                _mm256_sll_epi32(_mm256_srli_epi32::<{ 2 * WB }>(s), shift),
+                _mm256_sll_epi32(
+                    _mm256_srli_epi32::<{ 2 * WB }>(s),
+                    _mm_cvtsi32_si128(8 * c as i32),
+                ),
             );
         }
         _mm256_storeu_si256(buf.as_mut_ptr() as *mut __m256i, px);
@@ -129,6 +169,8 @@ unsafe fn span_avx2<const C: usize>(
             }
         }
         done += m;
+        uu = _mm256_add_epi32(uu, du8);
+        vv = _mm256_add_epi32(vv, dv8);
     }
     done
 }
