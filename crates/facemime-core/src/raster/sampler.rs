@@ -13,34 +13,22 @@ pub trait Sampler {
     /// Lookup with edge clamping, valid for any position.
     fn sample<const C: usize>(tex: &ImageRef, u: i64, v: i64) -> [u8; C];
 
-    /// Whether [`Sampler::sample_unchecked`] is valid at (u, v): every texel it reads exists.
+    /// Whether a lookup at (u, v) reads only texels inside the texture, so that it needs no
+    /// clamping.
     fn in_bounds(tex: &ImageRef, u: i64, v: i64) -> bool;
-
-    /// Lookup without clamping or bounds checks.
-    ///
-    /// # Safety
-    /// `Self::in_bounds(tex, u, v)` must hold and `tex.data` must hold W·H·C bytes.
-    unsafe fn sample_unchecked<const C: usize>(tex: &ImageRef, u: i64, v: i64) -> [u8; C];
 
     /// Fills `out` (whole pixels of C bytes) with the samples at (u + k·du, v + k·dv).
     ///
     /// # Safety
     /// `Self::in_bounds` must hold at the first and the last pixel of the span.
-    #[inline(always)]
     unsafe fn fill_span_unchecked<const C: usize>(
         tex: &ImageRef,
-        mut u: i64,
-        mut v: i64,
+        u: i64,
+        v: i64,
         du: i64,
         dv: i64,
         out: &mut [u8],
-    ) {
-        for px in out.chunks_exact_mut(C) {
-            px.copy_from_slice(&Self::sample_unchecked::<C>(tex, u, v));
-            u += du;
-            v += dv;
-        }
-    }
+    );
 }
 
 /// Nearest texel (round half up).
@@ -69,14 +57,6 @@ impl Sampler for Nearest {
     fn in_bounds(tex: &ImageRef, u: i64, v: i64) -> bool {
         let (x, y) = ((u + ONE / 2) >> FRAC_BITS, (v + ONE / 2) >> FRAC_BITS);
         x >= 0 && y >= 0 && x < tex.width as i64 && y < tex.height as i64
-    }
-
-    #[inline(always)]
-    unsafe fn sample_unchecked<const C: usize>(tex: &ImageRef, u: i64, v: i64) -> [u8; C] {
-        let x = ((u + ONE / 2) >> FRAC_BITS) as usize;
-        let y = ((v + ONE / 2) >> FRAC_BITS) as usize;
-        let p = tex.data.as_ptr().add((y * tex.width + x) * C);
-        std::ptr::read_unaligned(p as *const [u8; C])
     }
 
     #[inline(always)]
@@ -154,23 +134,6 @@ impl Sampler for Bilinear {
     }
 
     #[inline(always)]
-    unsafe fn sample_unchecked<const C: usize>(tex: &ImageRef, u: i64, v: i64) -> [u8; C] {
-        let (xi, yi, w) = bilinear_weights(u, v);
-        let stride = tex.width * C;
-        let i00 = yi as usize * stride + xi as usize * C;
-        let d = tex.data;
-        blend::<C>(
-            [
-                d.get_unchecked(i00..i00 + C),
-                d.get_unchecked(i00 + C..i00 + 2 * C),
-                d.get_unchecked(i00 + stride..i00 + stride + C),
-                d.get_unchecked(i00 + stride + C..i00 + stride + 2 * C),
-            ],
-            w,
-        )
-    }
-
-    #[inline(always)]
     unsafe fn fill_span_unchecked<const C: usize>(
         tex: &ImageRef,
         mut u: i64,
@@ -188,5 +151,28 @@ impl Sampler for Bilinear {
             u += du;
             v += dv;
         }
+    }
+}
+
+impl Bilinear {
+    /// Lookup without clamping or bounds checks.
+    ///
+    /// # Safety
+    /// `Self::in_bounds(tex, u, v)` must hold.
+    #[inline(always)]
+    unsafe fn sample_unchecked<const C: usize>(tex: &ImageRef, u: i64, v: i64) -> [u8; C] {
+        let (xi, yi, w) = bilinear_weights(u, v);
+        let stride = tex.width * C;
+        let i00 = yi as usize * stride + xi as usize * C;
+        let d = tex.data;
+        blend::<C>(
+            [
+                d.get_unchecked(i00..i00 + C),
+                d.get_unchecked(i00 + C..i00 + 2 * C),
+                d.get_unchecked(i00 + stride..i00 + stride + C),
+                d.get_unchecked(i00 + stride + C..i00 + stride + 2 * C),
+            ],
+            w,
+        )
     }
 }
