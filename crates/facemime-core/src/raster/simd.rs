@@ -79,35 +79,25 @@ unsafe fn span_avx2<const C: usize>(
     let high: [__m256i; 4] = std::array::from_fn(|c| pick(c as i8, 2));
     let base = tex.data.as_ptr() as *const i32;
     let lanes = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    let (du_v, dv_v) = (_mm256_set1_epi32(du), _mm256_set1_epi32(dv));
     // Positions of the chunk's eight pixels, stepped by eight pixels per chunk.
-    let mut uu = _mm256_add_epi32(
-        _mm256_set1_epi32(u),
-        _mm256_mullo_epi32(lanes, _mm256_set1_epi32(du)),
-    );
-    let mut vv = _mm256_add_epi32(
-        _mm256_set1_epi32(v),
-        _mm256_mullo_epi32(lanes, _mm256_set1_epi32(dv)),
-    );
-    let (du8, dv8) = (
-        _mm256_set1_epi32(du.wrapping_mul(8)),
-        _mm256_set1_epi32(dv.wrapping_mul(8)),
-    );
+    let mut uu = _mm256_add_epi32(_mm256_set1_epi32(u), _mm256_mullo_epi32(lanes, du_v));
+    let mut vv = _mm256_add_epi32(_mm256_set1_epi32(v), _mm256_mullo_epi32(lanes, dv_v));
+    let (du8, dv8) = (_mm256_slli_epi32::<3>(du_v), _mm256_slli_epi32::<3>(dv_v));
     let mut done = 0;
     let mut buf = [0u32; 8];
     while done < n {
         let m = (n - done).min(8);
         let (mut cu, mut cv) = (uu, vv);
         if m < 8 {
-            // Lanes past the span's end repeat its last pixel, so every gather stays in bounds.
-            let k = _mm256_min_epi32(lanes, _mm256_set1_epi32(m as i32 - 1));
-            cu = _mm256_add_epi32(
-                _mm256_set1_epi32(u.wrapping_add((done as i32).wrapping_mul(du))),
-                _mm256_mullo_epi32(k, _mm256_set1_epi32(du)),
+            // Lanes past the span's end step back to its last pixel, so every gather stays
+            // in bounds.
+            let back = _mm256_sub_epi32(
+                _mm256_min_epi32(lanes, _mm256_set1_epi32(m as i32 - 1)),
+                lanes,
             );
-            cv = _mm256_add_epi32(
-                _mm256_set1_epi32(v.wrapping_add((done as i32).wrapping_mul(dv))),
-                _mm256_mullo_epi32(k, _mm256_set1_epi32(dv)),
-            );
+            cu = _mm256_add_epi32(uu, _mm256_mullo_epi32(back, du_v));
+            cv = _mm256_add_epi32(vv, _mm256_mullo_epi32(back, dv_v));
         }
         let fx = _mm256_srli_epi32::<{ FRAC_BITS as i32 - WB }>(_mm256_add_epi32(
             _mm256_and_si256(cu, frac),
