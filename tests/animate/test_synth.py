@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from facemime.animate.synth import Puppet, UserMotion, draw_mouth_interior, synthesize
+from facemime.animate.synth import SEAL, Puppet, UserMotion, draw_mouth_interior, synthesize
 from facemime.errors import InvalidInputError
 from facemime.fit.placement import model_iod
 from facemime.render.projection import project
@@ -56,6 +56,48 @@ def test_lips_barely_apart_show_a_dark_line_and_no_teeth(gap):
     assert out[changed].max() <= 120  # darker than the lips around it: no teeth
 
 
+def test_teeth_meet_in_a_grin_and_the_cavity_shows_once_the_mouth_opens_wide():
+    # A 100 px mouth: a grin's opening is filled by the teeth (a dark band there cost the
+    # synthesis about 1 dB on a grinning face); a wide-open mouth shows the cavity between them.
+    x = np.linspace(100.0, 200.0, 11)
+    arch = np.sin(np.linspace(0.0, np.pi, 11))
+
+    def middle_column(opening):
+        out = np.full((200, 300, 3), 120, np.uint8)
+        draw_mouth_interior(out, np.column_stack([x, 80.0 - 0.4 * opening * arch]),
+                            np.column_stack([x, 80.0 + 0.6 * opening * arch]))
+        column = out[:, 155].astype(int).mean(axis=1)  # between two gaps of the teeth
+        return column[column != 120]
+
+    grin = middle_column(14.0)
+    assert len(grin) >= 12 and not (grin < 60).any()
+    wide = middle_column(40.0)
+    assert (wide < 60).sum() >= 15 and (wide > 150).sum() >= 12
+
+
+def test_lips_all_but_touching_are_shown_closed_and_an_opening_mouth_grows_smoothly(actor):
+    puppet = Puppet(actor, Puppet(actor, np.ones(60), 1.0).deformer.feature_sizes(), model_iod(actor.model))
+    d, g = puppet.deformer, actor.model.groups
+    upper, lower = g["mouth_inner_upper"][1:-1], g["mouth_inner_lower"][1:-1]
+    width = np.ptp(actor.model.vertices[g["mouth_outer_upper"][[0, -1]], 0])
+    lower_knots = np.isin(d.knots, lower)
+
+    def gap(opening):  # the shown gap at the middle of the lips, model units
+        offsets = np.zeros((len(d.knots), 2))
+        offsets[lower_knots, 1] = -opening
+        v = puppet.vertices(offsets)
+        return float(np.median(v[upper, 1] - v[lower, 1]))
+
+    rest = float(np.median(actor.model.vertices[upper, 1] - actor.model.vertices[lower, 1]))
+    small = 0.5 * SEAL * width - rest
+    assert gap(small) == pytest.approx(0.0, abs=1e-3 * width)
+    wide = 3.0 * SEAL * width - rest
+    assert gap(wide) == pytest.approx(wide + rest, abs=1e-3 * width)
+    openings = np.linspace(small, wide, 40)
+    shown = [gap(o) for o in openings]
+    assert (np.diff(shown) >= -1e-9).all() and np.abs(np.diff(shown)).max() < 4.0 * (openings[1] - openings[0])
+
+
 def test_motion_carries_to_a_face_of_other_proportions(actor):
     from dataclasses import replace
 
@@ -66,7 +108,7 @@ def test_motion_carries_to_a_face_of_other_proportions(actor):
     puppet = Puppet(other, source.deformer.feature_sizes(), model_iod(actor.model))
     offsets = np.zeros((60, 2))
     offsets[:40, 1] = -4.0
-    moved = puppet.vertices(offsets) - other.model.vertices
+    moved = puppet.vertices(offsets) - puppet.vertices(np.zeros((60, 2)))  # lips kept apart: both sealed alike
     assert np.allclose(moved[:40, 1], -4.0 * 1.3, atol=0.01)
     # The driven face keeps the measured face's size on screen.
     assert puppet.pose(actor.pose).scale * model_iod(other.model) == pytest.approx(actor.pose.scale * model_iod(actor.model))

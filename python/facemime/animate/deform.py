@@ -113,6 +113,31 @@ class Deformer:
         out[:, :2] += gain * (self.weights @ offsets)
         return out
 
+    def sealed(self, vertices: np.ndarray, closed: float) -> np.ndarray:
+        """``vertices`` (N, 3) with the lips shut where the inner lips lie closer than ``closed``
+        times the mouth's width (corner to corner, model units), measured across the corner
+        line; above that the gap opens from nothing to its full size at twice ``closed``, so the
+        opening never jumps. The inner-lip knots meet halfway and the other vertices follow
+        them like offsets (:meth:`vertices`)."""
+        g = self.model.groups
+        upper, lower = g["mouth_inner_upper"][1:-1], g["mouth_inner_lower"][1:-1]
+        corners = vertices[g["mouth_outer_upper"][[0, -1]], :2]
+        along = corners[1] - corners[0]
+        width = float(np.hypot(*along))
+        if len(upper) != len(lower) or width <= 0.0:
+            return vertices
+        up = np.array([-along[1], along[0]]) / width  # model y is up
+        gap = (vertices[upper, :2] - vertices[lower, :2]) @ up
+        limit = closed * width
+        shown = np.where(gap < limit, 0.0, np.where(gap < 2.0 * limit, 2.0 * (gap - limit), gap))
+        close = np.zeros((len(self.knots), 2))
+        half = 0.5 * (gap - shown)[:, None] * up
+        close[[self._slot[int(i)] for i in upper]] = -half
+        close[[self._slot[int(i)] for i in lower]] = half
+        out = vertices.copy()
+        out[:, :2] += self.weights @ close
+        return out
+
     def feature_sizes(self) -> np.ndarray:
         """Per knot, the width of its feature (the mouth's corner-to-corner distance for mouth
         knots, the brow's length for brow knots), model units: the scale motion is measured in

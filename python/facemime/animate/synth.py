@@ -28,9 +28,17 @@ GAPS = (150, 140, 128)
 UPPER_TEETH = 0.11
 LOWER_TEETH = 0.07
 TEETH_SPAN = 0.72
+#: Most of the opening each row of teeth fills: together all of it, so that teeth meet in a
+#: grin and the dark cavity shows only once the opening exceeds both rows' heights.
+UPPER_SHARE = 0.6
+LOWER_SHARE = 0.4
 #: Opening (fraction of the mouth's width) below which no teeth show: a mouth barely apart shows
 #: the dark gap between the lips.
 TEETH_FROM = 0.04
+#: Measured motion shows lips whose inner edges are closer than this fraction of the mouth's
+#: width as closed (:meth:`Deformer.sealed`): the tracked inner lips of a closed mouth lie a
+#: pixel or two apart, and the dark line that gap drew cost up to 8 dB in the mouth region.
+SEAL = 0.05
 SHIFT = 4  # sub-pixel bits for cv2 drawing
 
 
@@ -58,8 +66,9 @@ def draw_mouth_interior(out: np.ndarray, upper: np.ndarray, lower: np.ndarray) -
     if len(upper) != len(lower) or keep.sum() < 2:
         keep[:] = True
     opening = (lower - upper) @ down if len(upper) == len(lower) else np.full(len(upper), width)
-    opening = np.maximum(opening - TEETH_FROM * width, 0.0)[keep]
-    for curve, height, share, sign in ((upper, UPPER_TEETH, 0.55, 1.0), (lower, LOWER_TEETH, 0.3, -1.0)):
+    # teeth grow from nothing at TEETH_FROM to their full share of the opening at twice it
+    opening = (opening * np.clip(opening / (TEETH_FROM * width) - 1.0, 0.0, 1.0))[keep]
+    for curve, height, share, sign in ((upper, UPPER_TEETH, UPPER_SHARE, 1.0), (lower, LOWER_TEETH, LOWER_SHARE, -1.0)):
         edge = curve[keep]
         reach = np.minimum(height * width, share * opening)[:, None]
         if reach.max() < 0.5:  # an anti-aliased outline of teeth with no height would still show
@@ -156,8 +165,9 @@ class Puppet:
                     scale=measured.scale * self._scale * user.zoom, tx=measured.tx, ty=measured.ty)
 
     def vertices(self, offsets: np.ndarray, user: UserMotion = UserMotion()) -> np.ndarray:
-        """The actor's vertices moved by the source's knot ``offsets`` (K, 2)."""
-        return self.deformer.vertices(offsets * self._ratio, user.gain)
+        """The actor's vertices moved by the source's knot ``offsets`` (K, 2), lips all but
+        touching shown closed (:data:`SEAL`)."""
+        return self.deformer.sealed(self.deformer.vertices(offsets * self._ratio, user.gain), SEAL)
 
     def render(self, measured: Pose, offsets: np.ndarray, size: tuple[int, int], user: UserMotion = UserMotion(),
                out: np.ndarray | None = None) -> np.ndarray:
