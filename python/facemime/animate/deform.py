@@ -61,6 +61,10 @@ class Deformer:
         g = model.groups
         self.knots = np.unique(np.concatenate([g[n] for n in CONTOUR_GROUPS]))
         self._slot = {int(v): k for k, v in enumerate(self.knots)}
+        # every contour's vertices in CONTOUR_GROUPS order, their knot slots and how often each knot appears
+        self._members = np.concatenate([g[n] for n in CONTOUR_GROUPS])
+        self._member_slots = np.array([self._slot[int(i)] for i in self._members])
+        self._member_counts = np.bincount(self._member_slots, minlength=len(self.knots)).astype(np.float64)
         self.weights = self._spread()
 
     def _spread(self) -> np.ndarray:
@@ -93,18 +97,19 @@ class Deformer:
         """The knots' model-space (x, y) (K, 2) where the image ``contours`` (name -> (M, 2) px,
         resampled to the model's group lengths) put them, seen in ``pose``."""
         g, v = self.model.groups, self.model.vertices
-        pts = np.zeros((len(self.knots), 2))
-        seen = np.zeros(len(self.knots))
+        points = []
         for name in CONTOUR_GROUPS:
             idx = g[name]
             c = np.asarray(contours[name], np.float64)
             c = c if len(c) == len(idx) else resample(c, len(idx))
             if np.linalg.norm(c[0] - c[-1]) > 0 and (c[-1, 0] - c[0, 0]) * (v[idx[-1], 0] - v[idx[0], 0]) < 0:
                 c = c[::-1]  # the model's groups run image-left to image-right in a frontal view
-            slots = [self._slot[int(i)] for i in idx]
-            np.add.at(pts, slots, head_plane(c, v[idx, 2], pose))
-            np.add.at(seen, slots, 1.0)
-        return pts / seen[:, None]
+            points.append(c)
+        # one inverse projection for all points; knots on two curves (the mouth corners) average
+        plane = head_plane(np.concatenate(points), v[self._members, 2], pose)
+        pts = np.zeros((len(self.knots), 2))
+        np.add.at(pts, self._member_slots, plane)
+        return pts / self._member_counts[:, None]
 
     def vertices(self, offsets: np.ndarray, gain: float = 1.0) -> np.ndarray:
         """The model's vertices moved by knot ``offsets`` (K, 2) model units times ``gain`` (the
