@@ -79,6 +79,10 @@ class TrackerParams:
     shape. ``mouth_passes``: solver passes per frame for the mouth at most, each moving a knot
     at most δ0/(1−σ), so a fast-opening mouth can be followed; a pass follows only when a mouth
     knot moved :data:`FAST` of that reach in the previous one (the brows keep the first pass).
+    ``iterations``, ``tol``: each solver pass runs at most ``iterations`` steps, and a feature
+    stops early once its own energy changes by less than ``tol`` between steps (0: never;
+    measured on the six videos, stopping at 1e-4 raised the outer mouth's failure rate from 2.9%
+    to 6.9%, as features stopped short of their edges).
     """
 
     mouth: CurveWeights = CurveWeights(alpha=30.0, beta=24.0, tau=2.0, rho=1.0, gamma=0.0, chroma=0.5)
@@ -89,7 +93,7 @@ class TrackerParams:
     delta0: float = 1.5
     sigma: float = 0.75
     iterations: int = 15
-    tol: float = 1e-4
+    tol: float = 0.0
     smoothing: float = 1.5
     lip_keep: float = 0.5
     gap_weight: float = 0.5
