@@ -73,11 +73,10 @@ def draw_mouth_interior(out: np.ndarray, upper: np.ndarray, lower: np.ndarray) -
         reach = np.minimum(height * width, share * opening)[:, None]
         if reach.max() < 0.5:  # an anti-aliased outline of teeth with no height would still show
             continue
-        band = np.concatenate([edge, (edge + sign * reach * down)[::-1]])
-        cv2.fillPoly(paint, [fix(band)], TEETH, cv2.LINE_AA, SHIFT)
-        for a, b in zip(edge[1:-1], (edge + sign * reach * down)[1:-1]):  # gaps between the teeth
-            cv2.line(paint, tuple(int(v) for v in fix(a).ravel()), tuple(int(v) for v in fix(b).ravel()),
-                     GAPS, 1, cv2.LINE_AA, SHIFT)
+        tips = edge + sign * reach * down
+        cv2.fillPoly(paint, [fix(np.concatenate([edge, tips[::-1]]))], TEETH, cv2.LINE_AA, SHIFT)
+        for a, b in zip(fix(edge[1:-1]).reshape(-1, 2).tolist(), fix(tips[1:-1]).reshape(-1, 2).tolist()):
+            cv2.line(paint, a, b, GAPS, 1, cv2.LINE_AA, SHIFT)  # gaps between the teeth
     # shade the far corners of the cavity and the teeth towards dark
     cx = (np.arange(x0, x1) - (upper[0, 0] + upper[-1, 0]) / 2.0) / max(width / 2.0, 1.0)
     shade = np.clip(1.15 - 0.6 * cx ** 2, 0.35, 1.0)[None, :, None]
