@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from facemime.animate.synth import SEAL, Puppet, UserMotion, draw_mouth_interior, synthesize
+from facemime.animate.synth import SEAL, Puppet, UserMotion, draw_mouth_interior, synthesize, teeth_uncovered
 from facemime.errors import InvalidInputError
 from facemime.fit.placement import model_iod
 from facemime.render.projection import project
@@ -73,6 +73,27 @@ def test_teeth_meet_in_a_grin_and_the_cavity_shows_once_the_mouth_opens_wide():
     assert len(grin) >= 12 and not (grin < 60).any()
     wide = middle_column(40.0)
     assert (wide < 60).sum() >= 15 and (wide > 150).sum() >= 12
+
+
+def test_lips_cover_the_teeth_unless_the_mouth_spreads(actor):
+    # Talking or an "O" shows the dark cavity under the edge of the upper teeth; a smile, whose
+    # corners spread, uncovers both rows (measured: +0.6 dB in the mouth on lp_d3).
+    def teeth_rows(weights):
+        vertices = actor.model.deform(weights)
+        img = synthesize(actor, vertices, actor.pose, (512, 512), background=GREEN)
+        inside = mouth_polygon_mask(project(vertices, actor.pose)[0], actor, img.shape[:2])
+        ys = np.nonzero(inside)[0]
+        middle = (ys.min() + ys.max()) / 2
+        bright = inside & (img.astype(int).mean(axis=2) > 150)
+        rows = np.nonzero(bright)[0]
+        return (rows < middle).sum(), (rows > middle).sum(), inside.sum()
+
+    o_upper, o_lower, o_area = teeth_rows({"jaw_drop": 1.0, "lip_stretch": -1.0})  # corners at 0.77 of rest
+    assert o_upper > 0.02 * o_area and o_lower == 0
+    _, open_lower, _ = teeth_rows({"jaw_drop": 1.0})
+    s_upper, s_lower, s_area = teeth_rows({"jaw_drop": 1.0, "lip_stretch": 1.0})  # corners at 1.23 of rest
+    assert s_upper > 0.05 * s_area and s_lower > 0.02 * s_area and 0 < open_lower < s_lower
+    assert teeth_uncovered(0.85) == 0.0 and teeth_uncovered(1.2) == 1.0 and 0.0 < teeth_uncovered(1.0) < 1.0
 
 
 def test_lips_all_but_touching_are_shown_closed_and_an_opening_mouth_grows_smoothly(actor):
