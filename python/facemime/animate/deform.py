@@ -45,6 +45,13 @@ def head_plane(points: np.ndarray, depth: np.ndarray, pose: Pose) -> np.ndarray:
     return np.linalg.solve(a, rhs.T).T
 
 
+def mouth_width(model: HeadModel, vertices: np.ndarray) -> float:
+    """Distance between the mouth's corners (the ends of the outer lips) of ``vertices`` (N, 3),
+    a pose of ``model``'s, in the model's (x, y) plane, model units."""
+    first, last = model.groups["mouth_outer_upper"][[0, -1]]
+    return float(np.hypot(*(vertices[last, :2] - vertices[first, :2])))
+
+
 class Deformer:
     """Drives one head model by the eight tracked contours.
 
@@ -126,9 +133,9 @@ class Deformer:
         them like offsets (:meth:`vertices`)."""
         g = self.model.groups
         upper, lower = g["mouth_inner_upper"][1:-1], g["mouth_inner_lower"][1:-1]
-        corners = vertices[g["mouth_outer_upper"][[0, -1]], :2]
-        along = corners[1] - corners[0]
-        width = float(np.hypot(*along))
+        corners = g["mouth_outer_upper"][[0, -1]]
+        along = vertices[corners[1], :2] - vertices[corners[0], :2]
+        width = mouth_width(self.model, vertices)
         if len(upper) != len(lower) or width <= 0.0:
             return vertices
         up = np.array([-along[1], along[0]]) / width  # model y is up
@@ -151,7 +158,7 @@ class Deformer:
         sizes = np.zeros(len(self.knots))
         for name in CONTOUR_GROUPS:
             idx = g[name]
-            ends = g["mouth_outer_upper"][[0, -1]] if name.startswith("mouth") else idx[[0, -1]]
-            sizes[[self._slot[int(i)] for i in idx]] = np.linalg.norm(v[ends[1], :2] - v[ends[0], :2])
+            size = mouth_width(self.model, v) if name.startswith("mouth") else np.hypot(*(v[idx[-1], :2] - v[idx[0], :2]))
+            sizes[[self._slot[int(i)] for i in idx]] = size
         return sizes
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass, replace
 import cv2
 import numpy as np
 
-from facemime.animate.deform import Deformer
+from facemime.animate.deform import Deformer, mouth_width
 from facemime.errors import InvalidInputError
 from facemime.fit.actor import Actor
 from facemime.fit.placement import model_iod
@@ -119,9 +119,7 @@ def synthesize(actor: Actor, vertices: np.ndarray, pose: Pose, size: tuple[int, 
             out[...] = background
     points, depth = project(vertices, pose)
     g = actor.model.groups
-    corners = g["mouth_outer_upper"][[0, -1]]
-    width = lambda v: float(np.hypot(*(v[corners[1], :2] - v[corners[0], :2])))  # noqa: E731
-    spread = width(vertices) / max(width(actor.model.vertices), 1e-9)
+    spread = mouth_width(actor.model, vertices) / max(mouth_width(actor.model, actor.model.vertices), 1e-9)
     draw_mouth_interior(out, points[g["mouth_inner_upper"]], points[g["mouth_inner_lower"]], teeth_uncovered(spread))
     render_mesh_into(out, actor.texture, actor.model.uv, points, depth, actor.model.triangles)
     return out

@@ -115,8 +115,8 @@ class TrackerParams:
 @dataclass
 class FrameResult:
     """One frame's output: ``contours`` name -> (N, 2) float64 pixels; ``confidence`` feature ->
-    0..1; ``lost`` features flagged in this frame (a lost brow is reported on its rest shape); ``iterations`` the solver ran;
-    ``motion_ok`` whether the head motion was measured."""
+    0..1; ``lost`` features flagged in this frame (a lost brow is reported on its rest shape);
+    ``iterations`` the solver ran; ``motion_ok`` whether the head motion was measured."""
 
     index: int
     contours: dict[str, np.ndarray]
