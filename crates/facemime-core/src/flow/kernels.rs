@@ -42,7 +42,7 @@ fn sum(a: [f32; LANES]) -> f64 {
 
 /// Fills `out` (`rows` × `cols`) with the grid's samples.
 pub fn sample(g: &Grid, rows: usize, cols: usize, out: &mut [f32]) {
-    assert!(cols % LANES == 0 && out.len() >= rows * cols);
+    assert!(cols.is_multiple_of(LANES) && out.len() >= rows * cols);
     #[cfg(target_arch = "x86_64")]
     if has_avx2() {
         for r in 0..rows {
@@ -78,7 +78,7 @@ pub fn gradients(
 ) -> [f64; 3] {
     let cols = live.len();
     let win = gx.len() / cols;
-    assert!(cols % LANES == 0 && ecols >= cols + 2 && ext.len() >= (win + 2) * ecols);
+    assert!(cols.is_multiple_of(LANES) && ecols >= cols + 2 && ext.len() >= (win + 2) * ecols);
     assert!(gy.len() == gx.len() && gx.len() == win * cols);
     #[cfg(target_arch = "x86_64")]
     if has_avx2() {
@@ -128,7 +128,7 @@ pub fn mismatch(
     cols: usize,
 ) -> [f64; 2] {
     let win = gx.len() / cols;
-    assert!(cols % LANES == 0 && ecols >= cols + 2 && ext.len() >= (win + 2) * ecols);
+    assert!(cols.is_multiple_of(LANES) && ecols >= cols + 2 && ext.len() >= (win + 2) * ecols);
     assert!(gy.len() == gx.len() && gx.len() == win * cols);
     #[cfg(target_arch = "x86_64")]
     if has_avx2() {

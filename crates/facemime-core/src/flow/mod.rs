@@ -115,7 +115,7 @@ pub struct Pyramid {
 impl Pyramid {
     /// An empty pyramid for the odd `window` side (pixels) of the Lucas-Kanade window.
     pub fn new(window: usize) -> Result<Self> {
-        if window < 3 || window % 2 == 0 {
+        if window < 3 || window.is_multiple_of(2) {
             return invalid!("the window must be odd and at least 3 pixels, got {window}");
         }
         Ok(Self {

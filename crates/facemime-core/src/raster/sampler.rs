@@ -34,7 +34,7 @@ pub trait Sampler {
 /// Nearest texel (round half up).
 pub struct Nearest;
 
-/// Bilinear interpolation of the four surrounding texels (12-bit weights).
+/// Bilinear interpolation of the four surrounding texels (16-bit weights, see [`blend`]).
 pub struct Bilinear;
 
 #[inline(always)]
@@ -82,37 +82,32 @@ impl Sampler for Nearest {
     }
 }
 
-/// Bits of the bilinear weights: 12, rounded, so that the four products of a channel sum to at
-/// most 255 · 2^24 + 2^23 < 2^32 and the result is within 0.6 level of exact bilinear.
-const WEIGHT_BITS: u32 = 12;
-
-/// Integer texel (x, y) below-left of (u, v) and the four weights (w00, w01, w10, w11).
+/// Integer texel (x, y) below-left of (u, v) and the fractions (fx, fy) in 0.16 fixed point.
 #[inline(always)]
-fn bilinear_weights(u: i64, v: i64) -> (i64, i64, [u32; 4]) {
-    let shift = FRAC_BITS - WEIGHT_BITS;
-    let one = 1u32 << WEIGHT_BITS;
-    // Fraction rounded to WEIGHT_BITS; it may round up to `one`, which the weights handle.
-    let fx = (((u & (ONE - 1)) + (1 << (shift - 1))) >> shift) as u32;
-    let fy = (((v & (ONE - 1)) + (1 << (shift - 1))) >> shift) as u32;
-    let w = [
-        (one - fx) * (one - fy),
-        fx * (one - fy),
-        (one - fx) * fy,
-        fx * fy,
-    ];
-    (u >> FRAC_BITS, v >> FRAC_BITS, w)
+fn bilinear_weights(u: i64, v: i64) -> (i64, i64, u32, u32) {
+    let frac = |t: i64| (t & (ONE - 1)) as u32;
+    (u >> FRAC_BITS, v >> FRAC_BITS, frac(u), frac(v))
 }
 
-/// Weighted sum of four texels (each C bytes), rounded.
+/// `a + (b - a) · f` for values in 8.8 fixed point and a 0.16 fraction, as two truncated
+/// 16-bit products (weights 1 - f ≈ 0xFFFF - f and f): the arithmetic of the AVX2 sampler's
+/// `mulhi_epu16`, which it must match bit for bit. Never above max(a, b).
 #[inline(always)]
-fn blend<const C: usize>(p: [&[u8]; 4], w: [u32; 4]) -> [u8; C] {
+fn lerp16(a: u32, b: u32, f: u32) -> u32 {
+    ((a * (f ^ 0xFFFF)) >> 16) + ((b * f) >> 16)
+}
+
+/// Bilinear blend of four texels (each C bytes): across in 8.8 fixed point, then down, then
+/// rounded. Each truncated product loses under 1/256 level, so the result is within 0.53 level
+/// of exact bilinear interpolation.
+#[inline(always)]
+fn blend<const C: usize>(p: [&[u8]; 4], fx: u32, fy: u32) -> [u8; C] {
     let mut px = [0u8; C];
     for c in 0..C {
-        let s = p[0][c] as u32 * w[0]
-            + p[1][c] as u32 * w[1]
-            + p[2][c] as u32 * w[2]
-            + p[3][c] as u32 * w[3];
-        px[c] = ((s + (1 << (2 * WEIGHT_BITS - 1))) >> (2 * WEIGHT_BITS)) as u8;
+        let q = |k: usize| (p[k][c] as u32) << 8;
+        let top = lerp16(q(0), q(1), fx);
+        let bottom = lerp16(q(2), q(3), fx);
+        px[c] = ((lerp16(top, bottom, fy) + 128) >> 8) as u8;
     }
     px
 }
@@ -120,11 +115,11 @@ fn blend<const C: usize>(p: [&[u8]; 4], w: [u32; 4]) -> [u8; C] {
 impl Sampler for Bilinear {
     #[inline(always)]
     fn sample<const C: usize>(tex: &ImageRef, u: i64, v: i64) -> [u8; C] {
-        let (xi, yi, w) = bilinear_weights(u, v);
+        let (xi, yi, fx, fy) = bilinear_weights(u, v);
         let (x0, x1) = (clamp_index(xi, tex.width), clamp_index(xi + 1, tex.width));
         let (y0, y1) = (clamp_index(yi, tex.height), clamp_index(yi + 1, tex.height));
         let at = |x: usize, y: usize| &tex.data[(y * tex.width + x) * C..][..C];
-        blend::<C>([at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1)], w)
+        blend::<C>([at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1)], fx, fy)
     }
 
     #[inline(always)]
@@ -143,7 +138,7 @@ impl Sampler for Bilinear {
         out: &mut [u8],
     ) {
         #[cfg(target_arch = "x86_64")]
-        if super::simd::bilinear_span_avx2::<C>(tex, u, v, du, dv, out) > 0 {
+        if super::simd::bilinear_span::<C>(tex, u, v, du, dv, out, super::simd::Kernel::Best) > 0 {
             return;
         }
         for px in out.chunks_exact_mut(C) {
@@ -161,7 +156,7 @@ impl Bilinear {
     /// `Self::in_bounds(tex, u, v)` must hold.
     #[inline(always)]
     unsafe fn sample_unchecked<const C: usize>(tex: &ImageRef, u: i64, v: i64) -> [u8; C] {
-        let (xi, yi, w) = bilinear_weights(u, v);
+        let (xi, yi, fx, fy) = bilinear_weights(u, v);
         let stride = tex.width * C;
         let i00 = yi as usize * stride + xi as usize * C;
         let d = tex.data;
@@ -172,7 +167,8 @@ impl Bilinear {
                 d.get_unchecked(i00 + stride..i00 + stride + C),
                 d.get_unchecked(i00 + stride + C..i00 + stride + 2 * C),
             ],
-            w,
+            fx,
+            fy,
         )
     }
 }

@@ -1,88 +1,154 @@
-//! AVX2 bilinear texture lookup, 8 pixels at a time, bit-identical to the scalar
-//! [`super::sampler::Bilinear`] (same 12-bit rounded weights, same rounding).
+//! SIMD bilinear texture lookups along a span: AVX-512 (BW), 16 pixels at a time, or AVX2, 8 at
+//! a time; both bit-identical to the scalar [`super::sampler::Bilinear`] (the same truncated
+//! 16-bit products, the same rounding).
+//!
+//! Both kernels gather each pixel's texel pair (a texel and its right neighbour: 8 bytes) from
+//! the top and the bottom row, widen the channels to 8.8 fixed-point words, blend them with
+//! `mulhi_epu16` and pack them back. A 128-bit lane holds the words of two pixels, so the
+//! pixels are gathered in two groups (lanes 0, 1 and lanes 2, 3 of every four) that `packus`
+//! interleaves back into order.
 
 use std::arch::x86_64::*;
 
 use super::image::ImageRef;
 use super::sampler::FRAC_BITS;
 
-/// Samples a whole span with AVX2 when the CPU has it and returns how many pixels it wrote:
-/// all of them, or 0 when it cannot (no AVX2, unsupported channels, footprint too near the
-/// texture's last row) and the caller must do the work.
+/// A byte shuffle index that writes zero.
+const Z: u8 = 0x80;
+
+/// Per 128-bit lane: the 16-bit fraction of 32-bit lane `a` repeated over the four channel
+/// words of the first pixel, that of lane `a + 1` over the second's.
+const fn spread(a: u8) -> [u8; 16] {
+    let mut p = [0u8; 16];
+    let mut i = 0;
+    while i < 16 {
+        p[i] = 4 * (a + (i / 8) as u8) + (i % 2) as u8;
+        i += 1;
+    }
+    p
+}
+
+/// Per 128-bit lane (two 8-byte texel pairs): the C channels of the texel at byte `at` of each
+/// pair as four 8.8 fixed-point words (the byte high, zero low).
+const fn widen(at: u8) -> [u8; 16] {
+    let mut p = [Z; 16];
+    let mut k = 0;
+    while k < 8 {
+        p[2 * k + 1] = 8 * (k / 4) as u8 + at + (k % 4) as u8;
+        k += 1;
+    }
+    p
+}
+
+/// Per 128-bit lane: the first three bytes of each 32-bit lane, side by side.
+const PACK3: [u8; 16] = [0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, Z, Z, Z, Z];
+
+/// Which kernel [`bilinear_span`] may use.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub enum Kernel {
+    /// The widest the CPU has.
+    Best,
+    /// AVX2 even where AVX-512 exists, so that tests check both.
+    #[cfg(test)]
+    Avx2,
+}
+
+/// Samples a whole span with SIMD when the CPU can and returns how many pixels it wrote: all
+/// of them, or 0 when it cannot (no AVX2, unsupported channels, texture rows over 32767 bytes,
+/// footprint too near the texture's last row) and the caller must do the work.
 ///
 /// # Safety
 /// The bilinear footprint of the first and the last pixel of `out` must lie inside the texture
 /// (`Bilinear::in_bounds`), and `out` must hold whole pixels of C bytes.
 #[inline(always)]
-pub unsafe fn bilinear_span_avx2<const C: usize>(
+pub unsafe fn bilinear_span<const C: usize>(
     tex: &ImageRef,
     u: i64,
     v: i64,
     du: i64,
     dv: i64,
     out: &mut [u8],
+    kernel: Kernel,
 ) -> usize {
     let n = out.len() / C;
-    // Each 4-byte gather may read one byte past a 3-byte texel: keep the footprint off the
-    // texture's last row so that byte always exists. Coordinates must fit in i32 lanes.
+    // Each 8-byte gather may read two bytes past a texel pair: keep the footprint off the
+    // texture's last row so that they always exist. Texel offsets are computed from 16-bit
+    // (x, y) and row lengths, and positions must fit in i32 lanes.
     let last_row = |vv: i64| (vv >> FRAC_BITS) + 2 < tex.height as i64;
     let fits = |a: i64| a.abs() < (1 << 30);
     let (u1, v1) = (u + du * (n as i64 - 1), v + dv * (n as i64 - 1));
     if !(C == 3 || C == 4)
         || n == 0
+        || tex.width * C > i16::MAX as usize
+        || tex.height > i16::MAX as usize
         || !last_row(v)
         || !last_row(v1)
         || !(fits(u) && fits(v) && fits(u1) && fits(v1))
     {
         return 0;
     }
-    if !std::arch::is_x86_feature_detected!("avx2") {
+    // Positions wrap in i32 lanes like the casts below: exact wherever they are used.
+    let span = Span {
+        u: u as i32,
+        v: v as i32,
+        du: du as i32,
+        dv: dv as i32,
+        last_u: u1 as i32,
+        last_v: v1 as i32,
+        row: (tex.width * C) as i32,
+        base: tex.data.as_ptr() as *const i64,
+    };
+    if kernel == Kernel::Best
+        && std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512bw")
+    {
+        span_avx512::<C>(&span, out, n);
+    } else if std::arch::is_x86_feature_detected!("avx2") {
+        span_avx2::<C>(&span, out, n);
+    } else {
         return 0;
     }
-    span_avx2::<C>(tex, u as i32, v as i32, du as i32, dv as i32, out, n)
+    n
 }
 
-#[target_feature(enable = "avx2")]
-unsafe fn span_avx2<const C: usize>(
-    tex: &ImageRef,
+/// A span's texture walk in i32 lanes: start, step per pixel, last pixel (16.16 fixed point),
+/// and the texture's row length (bytes) and data.
+struct Span {
     u: i32,
     v: i32,
     du: i32,
     dv: i32,
-    out: &mut [u8],
-    n: usize,
-) -> usize {
-    const WB: i32 = 12; // weight bits, as the scalar sampler
-    let frac = _mm256_set1_epi32((1 << FRAC_BITS) - 1);
-    let half = _mm256_set1_epi32(1 << (FRAC_BITS as i32 - WB - 1));
-    let one = _mm256_set1_epi32(1 << WB);
-    let round = _mm256_set1_epi32(1 << (2 * WB - 1));
-    let stride = _mm256_set1_epi32((tex.width * C) as i32);
-    // Byte c of every 32-bit lane to the lane's low 16 bits (`low`) or its high 16 bits
-    // (`high`), the rest zero: with both, one lane holds a texel pair (t0 | t1 << 16) of
-    // channel c, ready for a 16-bit multiply-add with the weight pair (1 - f | f << 16).
-    let pick = |c: i8, at: i8| {
-        let z = -128i8; // 0x80: a zero byte
-        let lane = |k: i8| {
-            let mut b = [z; 4];
-            b[at as usize] = 4 * k + c;
-            b
-        };
-        let [a, b, cc, d] = [lane(0), lane(1), lane(2), lane(3)];
-        _mm256_setr_epi8(
-            a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3], cc[0], cc[1], cc[2], cc[3], d[0], d[1],
-            d[2], d[3], a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3], cc[0], cc[1], cc[2], cc[3],
-            d[0], d[1], d[2], d[3],
-        )
-    };
-    let low: [__m256i; 4] = std::array::from_fn(|c| pick(c as i8, 0));
-    let high: [__m256i; 4] = std::array::from_fn(|c| pick(c as i8, 2));
-    let base = tex.data.as_ptr() as *const i32;
+    last_u: i32,
+    last_v: i32,
+    row: i32,
+    base: *const i64,
+}
+
+#[target_feature(enable = "avx2")]
+unsafe fn load_pattern_256(p: &[u8; 16]) -> __m256i {
+    _mm256_broadcastsi128_si256(_mm_loadu_si128(p.as_ptr() as *const __m128i))
+}
+
+#[target_feature(enable = "avx2")]
+unsafe fn span_avx2<const C: usize>(s: &Span, out: &mut [u8], n: usize) {
+    let all_ones = _mm256_set1_epi16(-1);
+    let half = _mm256_set1_epi16(128);
+    // (C, row length) as a pair of i16: `madd` with (x, y) gives the texel's byte offset.
+    let to_offset = _mm256_set1_epi32((s.row << 16) | C as i32);
+    let row = _mm_set1_epi32(s.row);
+    let (spread_lo, spread_hi) = (load_pattern_256(&spread(0)), load_pattern_256(&spread(2)));
+    let (widen_left, widen_right) = (
+        load_pattern_256(&widen(0)),
+        load_pattern_256(&widen(C as u8)),
+    );
+    let pack3 = load_pattern_256(&PACK3);
+    let keep6 = _mm256_setr_epi32(0, 1, 2, 4, 5, 6, 7, 7);
     let lanes = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-    let (du_v, dv_v) = (_mm256_set1_epi32(du), _mm256_set1_epi32(dv));
+    let (du_v, dv_v) = (_mm256_set1_epi32(s.du), _mm256_set1_epi32(s.dv));
+    let (last_u, last_v) = (_mm256_set1_epi32(s.last_u), _mm256_set1_epi32(s.last_v));
     // Positions of the chunk's eight pixels, stepped by eight pixels per chunk.
-    let mut uu = _mm256_add_epi32(_mm256_set1_epi32(u), _mm256_mullo_epi32(lanes, du_v));
-    let mut vv = _mm256_add_epi32(_mm256_set1_epi32(v), _mm256_mullo_epi32(lanes, dv_v));
+    let mut uu = _mm256_add_epi32(_mm256_set1_epi32(s.u), _mm256_mullo_epi32(lanes, du_v));
+    let mut vv = _mm256_add_epi32(_mm256_set1_epi32(s.v), _mm256_mullo_epi32(lanes, dv_v));
     let (du8, dv8) = (_mm256_slli_epi32::<3>(du_v), _mm256_slli_epi32::<3>(dv_v));
     let mut done = 0;
     let mut buf = [0u32; 8];
@@ -90,71 +156,49 @@ unsafe fn span_avx2<const C: usize>(
         let m = (n - done).min(8);
         let (mut cu, mut cv) = (uu, vv);
         if m < 8 {
-            // Lanes past the span's end step back to its last pixel, so every gather stays
-            // in bounds.
-            let back = _mm256_sub_epi32(
-                _mm256_min_epi32(lanes, _mm256_set1_epi32(m as i32 - 1)),
-                lanes,
-            );
-            cu = _mm256_add_epi32(uu, _mm256_mullo_epi32(back, du_v));
-            cv = _mm256_add_epi32(vv, _mm256_mullo_epi32(back, dv_v));
+            // Lanes past the span's end take its last pixel, so every gather stays in bounds.
+            let valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(m as i32), lanes);
+            cu = _mm256_blendv_epi8(last_u, cu, valid);
+            cv = _mm256_blendv_epi8(last_v, cv, valid);
         }
-        let fx = _mm256_srli_epi32::<{ FRAC_BITS as i32 - WB }>(_mm256_add_epi32(
-            _mm256_and_si256(cu, frac),
-            half,
-        ));
-        let fy = _mm256_srli_epi32::<{ FRAC_BITS as i32 - WB }>(_mm256_add_epi32(
-            _mm256_and_si256(cv, frac),
-            half,
-        ));
-        // Weight pairs (1 - fx | fx << 16) across; 1 - fy and fy down, as 32-bit lanes.
-        let wx = _mm256_or_si256(_mm256_sub_epi32(one, fx), _mm256_slli_epi32::<16>(fx));
-        let gy = _mm256_sub_epi32(one, fy);
-        let x = _mm256_srai_epi32::<{ FRAC_BITS as i32 }>(cu);
-        let y = _mm256_srai_epi32::<{ FRAC_BITS as i32 }>(cv);
-        let xc = if C == 4 {
-            _mm256_slli_epi32::<2>(x)
-        } else {
-            _mm256_add_epi32(_mm256_slli_epi32::<1>(x), x)
-        };
-        let o00 = _mm256_add_epi32(_mm256_mullo_epi32(y, stride), xc);
-        let o01 = _mm256_add_epi32(o00, _mm256_set1_epi32(C as i32));
-        let (o10, o11) = (_mm256_add_epi32(o00, stride), _mm256_add_epi32(o01, stride));
-        let t00 = _mm256_i32gather_epi32::<1>(base, o00);
-        let t01 = _mm256_i32gather_epi32::<1>(base, o01);
-        let t10 = _mm256_i32gather_epi32::<1>(base, o10);
-        let t11 = _mm256_i32gather_epi32::<1>(base, o11);
-        let mut px = _mm256_setzero_si256();
-        for c in 0..C.min(4) {
-            let pair = |a: __m256i, b: __m256i| {
-                _mm256_or_si256(
-                    _mm256_shuffle_epi8(a, low[c]),
-                    _mm256_shuffle_epi8(b, high[c]),
-                )
+        // (x, y) = the integer parts as 16-bit pairs; the fractions are the low 16 bits.
+        let xy = _mm256_blend_epi16::<0b1010_1010>(_mm256_srli_epi32::<16>(cu), cv);
+        let o = _mm256_madd_epi16(xy, to_offset);
+        // Pixels 0, 1, 4, 5 in one group, 2, 3, 6, 7 in the other.
+        let o = _mm256_permute4x64_epi64::<0b11_01_10_00>(o);
+        let (o_lo, o_hi) = (_mm256_castsi256_si128(o), _mm256_extracti128_si256::<1>(o));
+        let gather = |at: __m128i| _mm256_i32gather_epi64::<1>(s.base, at);
+        let group = |at: __m128i, pick: __m256i| {
+            let (top, bottom) = (gather(at), gather(_mm_add_epi32(at, row)));
+            let (fx, fy) = (_mm256_shuffle_epi8(cu, pick), _mm256_shuffle_epi8(cv, pick));
+            let (gx, gy) = (
+                _mm256_xor_si256(fx, all_ones),
+                _mm256_xor_si256(fy, all_ones),
+            );
+            let lerp = |a: __m256i, b: __m256i, g: __m256i, f: __m256i| {
+                _mm256_add_epi16(_mm256_mulhi_epu16(a, g), _mm256_mulhi_epu16(b, f))
             };
-            // Across, exact in 32 bits (< 2^20); then down, the same sum as the scalar
-            // sampler's four products (< 2^32).
-            let top = _mm256_madd_epi16(pair(t00, t01), wx);
-            let bottom = _mm256_madd_epi16(pair(t10, t11), wx);
-            let s = _mm256_add_epi32(
-                _mm256_add_epi32(_mm256_mullo_epi32(top, gy), _mm256_mullo_epi32(bottom, fy)),
-                round,
-            );
-            px = _mm256_or_si256(
-                px,
-                _mm256_sll_epi32(
-                    _mm256_srli_epi32::<{ 2 * WB }>(s),
-                    _mm_cvtsi32_si128(8 * c as i32),
-                ),
-            );
-        }
-        _mm256_storeu_si256(buf.as_mut_ptr() as *mut __m256i, px);
+            let across = |pair: __m256i| {
+                let left = _mm256_shuffle_epi8(pair, widen_left);
+                lerp(left, _mm256_shuffle_epi8(pair, widen_right), gx, fx)
+            };
+            let blended = lerp(across(top), across(bottom), gy, fy);
+            _mm256_srli_epi16::<8>(_mm256_add_epi16(blended, half))
+        };
+        let px = _mm256_packus_epi16(group(o_lo, spread_lo), group(o_hi, spread_hi));
         let dst = out.as_mut_ptr().add(done * C);
-        for (k, p) in buf[..m].iter().enumerate() {
-            if done + k + 1 < n {
-                // 4-byte store; for C = 3 its last byte lands on the next pixel, rewritten next.
-                std::ptr::write_unaligned(dst.add(k * C) as *mut u32, *p);
+        if (n - done) * C >= 32 {
+            // A whole register fits in the span: the pixels packed to C bytes each (for C = 3
+            // its last 8 bytes land on pixels that the next chunk rewrites).
+            let packed = if C == 3 {
+                _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(px, pack3), keep6)
             } else {
+                px
+            };
+            _mm256_storeu_si256(dst as *mut __m256i, packed);
+        } else {
+            _mm256_storeu_si256(buf.as_mut_ptr() as *mut __m256i, px);
+            for (k, p) in buf[..m].iter().enumerate() {
                 std::ptr::copy_nonoverlapping(p.to_le_bytes().as_ptr(), dst.add(k * C), C);
             }
         }
@@ -162,7 +206,73 @@ unsafe fn span_avx2<const C: usize>(
         uu = _mm256_add_epi32(uu, du8);
         vv = _mm256_add_epi32(vv, dv8);
     }
-    done
+}
+
+#[target_feature(enable = "avx512f,avx512bw")]
+unsafe fn load_pattern_512(p: &[u8; 16]) -> __m512i {
+    _mm512_broadcast_i32x4(_mm_loadu_si128(p.as_ptr() as *const __m128i))
+}
+
+#[target_feature(enable = "avx512f,avx512bw")]
+unsafe fn span_avx512<const C: usize>(s: &Span, out: &mut [u8], n: usize) {
+    let all_ones = _mm512_set1_epi16(-1);
+    let half = _mm512_set1_epi16(128);
+    let to_offset = _mm512_set1_epi32((s.row << 16) | C as i32);
+    let row = _mm256_set1_epi32(s.row);
+    let (spread_lo, spread_hi) = (load_pattern_512(&spread(0)), load_pattern_512(&spread(2)));
+    let (widen_left, widen_right) = (
+        load_pattern_512(&widen(0)),
+        load_pattern_512(&widen(C as u8)),
+    );
+    let pack3 = load_pattern_512(&PACK3);
+    let keep12 = _mm512_setr_epi32(0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, 15, 15, 15, 15);
+    let groups = _mm512_setr_epi64(0, 2, 4, 6, 1, 3, 5, 7);
+    let lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    let (du_v, dv_v) = (_mm512_set1_epi32(s.du), _mm512_set1_epi32(s.dv));
+    let (last_u, last_v) = (_mm512_set1_epi32(s.last_u), _mm512_set1_epi32(s.last_v));
+    let mut uu = _mm512_add_epi32(_mm512_set1_epi32(s.u), _mm512_mullo_epi32(lanes, du_v));
+    let mut vv = _mm512_add_epi32(_mm512_set1_epi32(s.v), _mm512_mullo_epi32(lanes, dv_v));
+    let (du16, dv16) = (_mm512_slli_epi32::<4>(du_v), _mm512_slli_epi32::<4>(dv_v));
+    let mut done = 0;
+    while done < n {
+        let m = (n - done).min(16);
+        let valid: __mmask16 = (u32::MAX >> (32 - m)) as u16;
+        // Lanes past the span's end take its last pixel, so every gather stays in bounds.
+        let cu = _mm512_mask_blend_epi32(valid, last_u, uu);
+        let cv = _mm512_mask_blend_epi32(valid, last_v, vv);
+        let xy = _mm512_mask_blend_epi16(0xAAAA_AAAA, _mm512_srli_epi32::<16>(cu), cv);
+        let o = _mm512_permutexvar_epi64(groups, _mm512_madd_epi16(xy, to_offset));
+        let (o_lo, o_hi) = (_mm512_castsi512_si256(o), _mm512_extracti64x4_epi64::<1>(o));
+        let gather = |at: __m256i| _mm512_i32gather_epi64::<1>(at, s.base);
+        let group = |at: __m256i, pick: __m512i| {
+            let (top, bottom) = (gather(at), gather(_mm256_add_epi32(at, row)));
+            let (fx, fy) = (_mm512_shuffle_epi8(cu, pick), _mm512_shuffle_epi8(cv, pick));
+            let (gx, gy) = (
+                _mm512_xor_si512(fx, all_ones),
+                _mm512_xor_si512(fy, all_ones),
+            );
+            let lerp = |a: __m512i, b: __m512i, g: __m512i, f: __m512i| {
+                _mm512_add_epi16(_mm512_mulhi_epu16(a, g), _mm512_mulhi_epu16(b, f))
+            };
+            let across = |pair: __m512i| {
+                let left = _mm512_shuffle_epi8(pair, widen_left);
+                lerp(left, _mm512_shuffle_epi8(pair, widen_right), gx, fx)
+            };
+            let blended = lerp(across(top), across(bottom), gy, fy);
+            _mm512_srli_epi16::<8>(_mm512_add_epi16(blended, half))
+        };
+        let px = _mm512_packus_epi16(group(o_lo, spread_lo), group(o_hi, spread_hi));
+        let packed = if C == 3 {
+            _mm512_permutexvar_epi32(keep12, _mm512_shuffle_epi8(px, pack3))
+        } else {
+            px
+        };
+        let bytes: __mmask64 = u64::MAX >> (64 - C * m);
+        _mm512_mask_storeu_epi8(out.as_mut_ptr().add(done * C) as *mut i8, bytes, packed);
+        done += m;
+        uu = _mm512_add_epi32(uu, du16);
+        vv = _mm512_add_epi32(vv, dv16);
+    }
 }
 
 #[cfg(test)]
@@ -183,7 +293,15 @@ mod tests {
             .collect()
     }
 
-    fn check<const C: usize>(u: i64, v: i64, du: i64, dv: i64, n: usize, seed: u64) {
+    fn check<const C: usize>(
+        kernel: Kernel,
+        u: i64,
+        v: i64,
+        du: i64,
+        dv: i64,
+        n: usize,
+        seed: u64,
+    ) {
         let (w, h) = (37, 29);
         let data = noise(w, h, C, seed);
         let tex = ImageRef {
@@ -200,8 +318,8 @@ mod tests {
         }
         // One guard pixel on each side catches a write outside the span.
         let mut out = vec![7u8; (n + 2) * C];
-        let wrote =
-            unsafe { bilinear_span_avx2::<C>(&tex, u, v, du, dv, &mut out[C..(n + 1) * C]) };
+        let span = &mut out[C..(n + 1) * C];
+        let wrote = unsafe { bilinear_span::<C>(&tex, u, v, du, dv, span, kernel) };
         if wrote == 0 {
             return;
         }
@@ -222,13 +340,15 @@ mod tests {
 
     proptest! {
         #[test]
-        fn avx2_span_matches_scalar_lookups(
+        fn simd_spans_match_scalar_lookups(
             u in 0i64..(36 << 16), v in 0i64..(27 << 16),
             du in -(3i64 << 16)..(3 << 16), dv in -(1i64 << 16)..(1 << 16),
             n in 1usize..40, seed in any::<u64>(),
         ) {
-            check::<3>(u, v, du / 16, dv / 16, n, seed);
-            check::<4>(u, v, du / 16, dv / 16, n, seed);
+            for kernel in [Kernel::Best, Kernel::Avx2] {
+                check::<3>(kernel, u, v, du / 16, dv / 16, n, seed);
+                check::<4>(kernel, u, v, du / 16, dv / 16, n, seed);
+            }
         }
     }
 }

@@ -505,7 +505,10 @@ mod tests {
         };
         let alone = solve(vec![((0..5).collect(), p)], 5);
         let joint = solve(
-            vec![((0..5).collect(), p), ((5..10).collect(), curve_params(1.0))],
+            vec![
+                ((0..5).collect(), p),
+                ((5..10).collect(), curve_params(1.0)),
+            ],
             10,
         );
         assert!(
