@@ -3,7 +3,7 @@
 use ndarray::{Array2, ArrayView1, ArrayView2};
 
 use super::image::{check_size, ImageMut, ImageRef};
-use super::sampler::{Bilinear, Nearest, Sampler, ONE};
+use super::sampler::{Bilinear, Nearest, Sampler, SpanStart, ONE};
 use super::span::for_each_span;
 use crate::error::Result;
 use crate::invalid;
@@ -241,6 +241,7 @@ fn draw<S: Sampler, const C: usize>(
         DepthMode::Painter => Vec::new(),
     };
     let width = out.width;
+    let mut batch: Vec<SpanStart> = Vec::new();
     for &(_, f) in &order {
         let tri = triangles.row(f);
         let dst = [
@@ -268,6 +269,8 @@ fn draw<S: Sampler, const C: usize>(
         let (du, dv) = (to_fixed(map.m[0][0]), to_fixed(map.m[1][0]));
         let data = &mut *out.data;
         let zbuf = &mut zbuf;
+        let batch = &mut batch;
+        batch.clear();
         let mut pixels = 0usize;
         for_each_span(dst, out.width, out.height, &mut |y, x0, x1| {
             // Texture position and depth at the span's first pixel centre, then per-pixel steps.
@@ -281,9 +284,14 @@ fn draw<S: Sampler, const C: usize>(
                 if S::in_bounds(texture, u, v)
                     && S::in_bounds(texture, u + du * last, v + dv * last)
                 {
-                    // The footprint is affine along the span: both ends inside means all inside.
-                    // SAFETY: in_bounds holds at both ends, hence at every pixel between.
-                    unsafe { S::fill_span_unchecked::<C>(texture, u, v, du, dv, span) };
+                    // The footprint is affine along the span: both ends inside means all
+                    // inside. Drawn with the triangle's other such spans below.
+                    batch.push(SpanStart {
+                        at: (row + x0) * C,
+                        len: x1 - x0 + 1,
+                        u,
+                        v,
+                    });
                 } else {
                     for px in span.chunks_exact_mut(C) {
                         px.copy_from_slice(&S::sample::<C>(texture, u, v));
@@ -307,6 +315,9 @@ fn draw<S: Sampler, const C: usize>(
                 }
             }
         });
+        // SAFETY: in_bounds holds at both ends of every batched span, hence at every pixel
+        // between, and for_each_span keeps spans inside the image.
+        unsafe { S::fill_spans_unchecked::<C>(texture, du, dv, batch, data) };
         stats.pixels += pixels;
     }
     Ok(stats)

@@ -17,18 +17,40 @@ pub trait Sampler {
     /// clamping.
     fn in_bounds(tex: &ImageRef, u: i64, v: i64) -> bool;
 
-    /// Fills `out` (whole pixels of C bytes) with the samples at (u + k·du, v + k·dv).
+    /// Fills every span of one triangle: pixel k of span `s` takes the sample at
+    /// (s.u + k·du, s.v + k·dv).
     ///
     /// # Safety
-    /// `Self::in_bounds` must hold at the first and the last pixel of the span.
-    unsafe fn fill_span_unchecked<const C: usize>(
+    /// `Self::in_bounds` must hold at the first and the last pixel of every span, and every
+    /// span must lie inside `data`.
+    unsafe fn fill_spans_unchecked<const C: usize>(
         tex: &ImageRef,
-        u: i64,
-        v: i64,
         du: i64,
         dv: i64,
-        out: &mut [u8],
+        spans: &[SpanStart],
+        data: &mut [u8],
     );
+}
+
+/// A run of pixels on one image row: its first byte in the image data, its length in pixels
+/// and the texture position at its first pixel (16.16 fixed point).
+#[derive(Clone, Copy, Debug)]
+pub struct SpanStart {
+    pub at: usize,
+    pub len: usize,
+    pub u: i64,
+    pub v: i64,
+}
+
+impl SpanStart {
+    /// The span's pixels in `data` (C bytes each).
+    ///
+    /// # Safety
+    /// The span must lie inside `data`.
+    #[inline(always)]
+    pub unsafe fn pixels<'a, const C: usize>(&self, data: &'a mut [u8]) -> &'a mut [u8] {
+        data.get_unchecked_mut(self.at..self.at + self.len * C)
+    }
 }
 
 /// Nearest texel (round half up).
@@ -60,24 +82,24 @@ impl Sampler for Nearest {
     }
 
     #[inline(always)]
-    unsafe fn fill_span_unchecked<const C: usize>(
+    unsafe fn fill_spans_unchecked<const C: usize>(
         tex: &ImageRef,
-        mut u: i64,
-        mut v: i64,
         du: i64,
         dv: i64,
-        out: &mut [u8],
+        spans: &[SpanStart],
+        data: &mut [u8],
     ) {
-        // The texture's pointer and row length in locals: the writes to `out` would otherwise
+        // The texture's pointer and row length in locals: the writes to `data` would otherwise
         // make the compiler reload them for every pixel.
-        let (data, stride) = (tex.data.as_ptr(), tex.width * C);
-        u += ONE / 2;
-        v += ONE / 2;
-        for px in out.chunks_exact_mut(C) {
-            let i = (v >> FRAC_BITS) as usize * stride + (u >> FRAC_BITS) as usize * C;
-            px.copy_from_slice(&std::ptr::read_unaligned(data.add(i) as *const [u8; C]));
-            u += du;
-            v += dv;
+        let (texels, stride) = (tex.data.as_ptr(), tex.width * C);
+        for s in spans {
+            let (mut u, mut v) = (s.u + ONE / 2, s.v + ONE / 2);
+            for px in s.pixels::<C>(data).chunks_exact_mut(C) {
+                let i = (v >> FRAC_BITS) as usize * stride + (u >> FRAC_BITS) as usize * C;
+                px.copy_from_slice(&std::ptr::read_unaligned(texels.add(i) as *const [u8; C]));
+                u += du;
+                v += dv;
+            }
         }
     }
 }
@@ -129,7 +151,31 @@ impl Sampler for Bilinear {
     }
 
     #[inline(always)]
-    unsafe fn fill_span_unchecked<const C: usize>(
+    unsafe fn fill_spans_unchecked<const C: usize>(
+        tex: &ImageRef,
+        du: i64,
+        dv: i64,
+        spans: &[SpanStart],
+        data: &mut [u8],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if super::simd::bilinear_spans::<C>(tex, du, dv, spans, data, super::simd::Kernel::Best) {
+            return;
+        }
+        for s in spans {
+            Self::fill_span_scalar::<C>(tex, s.u, s.v, du, dv, s.pixels::<C>(data));
+        }
+    }
+}
+
+impl Bilinear {
+    /// Fills `out` (whole pixels of C bytes) with the samples at (u + k·du, v + k·dv), one
+    /// pixel at a time.
+    ///
+    /// # Safety
+    /// `Self::in_bounds` must hold at the first and the last pixel.
+    #[inline(always)]
+    pub(super) unsafe fn fill_span_scalar<const C: usize>(
         tex: &ImageRef,
         mut u: i64,
         mut v: i64,
@@ -137,19 +183,13 @@ impl Sampler for Bilinear {
         dv: i64,
         out: &mut [u8],
     ) {
-        #[cfg(target_arch = "x86_64")]
-        if super::simd::bilinear_span::<C>(tex, u, v, du, dv, out, super::simd::Kernel::Best) > 0 {
-            return;
-        }
         for px in out.chunks_exact_mut(C) {
             px.copy_from_slice(&Self::sample_unchecked::<C>(tex, u, v));
             u += du;
             v += dv;
         }
     }
-}
 
-impl Bilinear {
     /// Lookup without clamping or bounds checks.
     ///
     /// # Safety

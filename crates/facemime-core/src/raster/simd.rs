@@ -11,7 +11,7 @@
 use std::arch::x86_64::*;
 
 use super::image::ImageRef;
-use super::sampler::FRAC_BITS;
+use super::sampler::{Bilinear, SpanStart, FRAC_BITS};
 
 /// A byte shuffle index that writes zero.
 const Z: u8 = 0x80;
@@ -53,75 +53,49 @@ pub enum Kernel {
     Avx2,
 }
 
-/// Samples a whole span with SIMD when the CPU can and returns how many pixels it wrote: all
-/// of them, or 0 when it cannot (no AVX2, unsupported channels, texture rows over 32767 bytes,
-/// footprint too near the texture's last row) and the caller must do the work.
+/// Fills the spans with SIMD when the CPU can, as [`Sampler::fill_spans_unchecked`], and says
+/// whether it did; false (nothing written) without AVX2, for other than 3 or 4 channels or for
+/// texture rows over 32767 bytes. A span whose footprint touches the texture's last row is
+/// drawn one pixel at a time, as each 8-byte gather may read two bytes past a texel pair.
 ///
 /// # Safety
-/// The bilinear footprint of the first and the last pixel of `out` must lie inside the texture
-/// (`Bilinear::in_bounds`), and `out` must hold whole pixels of C bytes.
+/// As [`Sampler::fill_spans_unchecked`].
 #[inline(always)]
-pub unsafe fn bilinear_span<const C: usize>(
+pub unsafe fn bilinear_spans<const C: usize>(
     tex: &ImageRef,
-    u: i64,
-    v: i64,
     du: i64,
     dv: i64,
-    out: &mut [u8],
+    spans: &[SpanStart],
+    data: &mut [u8],
     kernel: Kernel,
-) -> usize {
-    let n = out.len() / C;
-    // Each 8-byte gather may read two bytes past a texel pair: keep the footprint off the
-    // texture's last row so that they always exist. Texel offsets are computed from 16-bit
-    // (x, y) and row lengths, and positions must fit in i32 lanes.
-    let last_row = |vv: i64| (vv >> FRAC_BITS) + 2 < tex.height as i64;
-    let fits = |a: i64| a.abs() < (1 << 30);
-    let (u1, v1) = (u + du * (n as i64 - 1), v + dv * (n as i64 - 1));
-    if !(C == 3 || C == 4)
-        || n == 0
-        || tex.width * C > i16::MAX as usize
-        || tex.height > i16::MAX as usize
-        || !last_row(v)
-        || !last_row(v1)
-        || !(fits(u) && fits(v) && fits(u1) && fits(v1))
-    {
-        return 0;
+) -> bool {
+    // Texel offsets are computed from 16-bit (x, y) and row lengths.
+    if !(C == 3 || C == 4) || tex.width * C > i16::MAX as usize || tex.height > i16::MAX as usize {
+        return false;
     }
-    // Positions wrap in i32 lanes like the casts below: exact wherever they are used.
-    let span = Span {
-        u: u as i32,
-        v: v as i32,
-        du: du as i32,
-        dv: dv as i32,
-        last_u: u1 as i32,
-        last_v: v1 as i32,
-        row: (tex.width * C) as i32,
-        base: tex.data.as_ptr() as *const i64,
-    };
     if kernel == Kernel::Best
         && std::arch::is_x86_feature_detected!("avx512f")
         && std::arch::is_x86_feature_detected!("avx512bw")
     {
-        span_avx512::<C>(&span, out, n);
+        spans_avx512::<C>(tex, du, dv, spans, data);
     } else if std::arch::is_x86_feature_detected!("avx2") {
-        span_avx2::<C>(&span, out, n);
+        spans_avx2::<C>(tex, du, dv, spans, data);
     } else {
-        return 0;
+        return false;
     }
-    n
+    true
 }
 
-/// A span's texture walk in i32 lanes: start, step per pixel, last pixel (16.16 fixed point),
-/// and the texture's row length (bytes) and data.
-struct Span {
-    u: i32,
-    v: i32,
-    du: i32,
-    dv: i32,
-    last_u: i32,
-    last_v: i32,
-    row: i32,
-    base: *const i64,
+/// A span's texture walk in i32 lanes (16.16 fixed point): first and last position, or None
+/// when the span must be drawn by the scalar sampler (footprint on the texture's last row, or
+/// positions beyond i32). Positions wrap in i32 like the casts: exact wherever they are used.
+#[inline(always)]
+fn walk(tex: &ImageRef, s: &SpanStart, du: i64, dv: i64) -> Option<[i32; 4]> {
+    let last_row = |vv: i64| (vv >> FRAC_BITS) + 2 < tex.height as i64;
+    let fits = |a: i64| a.abs() < (1 << 30);
+    let (u1, v1) = (s.u + du * (s.len as i64 - 1), s.v + dv * (s.len as i64 - 1));
+    let ok = last_row(s.v) && last_row(v1) && fits(s.u) && fits(s.v) && fits(u1) && fits(v1);
+    ok.then_some([s.u as i32, s.v as i32, u1 as i32, v1 as i32])
 }
 
 #[target_feature(enable = "avx2")]
@@ -130,12 +104,20 @@ unsafe fn load_pattern_256(p: &[u8; 16]) -> __m256i {
 }
 
 #[target_feature(enable = "avx2")]
-unsafe fn span_avx2<const C: usize>(s: &Span, out: &mut [u8], n: usize) {
+unsafe fn spans_avx2<const C: usize>(
+    tex: &ImageRef,
+    du: i64,
+    dv: i64,
+    spans: &[SpanStart],
+    data: &mut [u8],
+) {
+    let base = tex.data.as_ptr() as *const i64;
+    let row_len = (tex.width * C) as i32;
     let all_ones = _mm256_set1_epi16(-1);
     let half = _mm256_set1_epi16(128);
     // (C, row length) as a pair of i16: `madd` with (x, y) gives the texel's byte offset.
-    let to_offset = _mm256_set1_epi32((s.row << 16) | C as i32);
-    let row = _mm_set1_epi32(s.row);
+    let to_offset = _mm256_set1_epi32((row_len << 16) | C as i32);
+    let row = _mm_set1_epi32(row_len);
     let (spread_lo, spread_hi) = (load_pattern_256(&spread(0)), load_pattern_256(&spread(2)));
     let (widen_left, widen_right) = (
         load_pattern_256(&widen(0)),
@@ -144,67 +126,78 @@ unsafe fn span_avx2<const C: usize>(s: &Span, out: &mut [u8], n: usize) {
     let pack3 = load_pattern_256(&PACK3);
     let keep6 = _mm256_setr_epi32(0, 1, 2, 4, 5, 6, 7, 7);
     let lanes = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-    let (du_v, dv_v) = (_mm256_set1_epi32(s.du), _mm256_set1_epi32(s.dv));
-    let (last_u, last_v) = (_mm256_set1_epi32(s.last_u), _mm256_set1_epi32(s.last_v));
-    // Positions of the chunk's eight pixels, stepped by eight pixels per chunk.
-    let mut uu = _mm256_add_epi32(_mm256_set1_epi32(s.u), _mm256_mullo_epi32(lanes, du_v));
-    let mut vv = _mm256_add_epi32(_mm256_set1_epi32(s.v), _mm256_mullo_epi32(lanes, dv_v));
+    let (du_v, dv_v) = (_mm256_set1_epi32(du as i32), _mm256_set1_epi32(dv as i32));
+    // Each lane's offset from the chunk's first pixel, and the step from chunk to chunk.
+    let (lane_du, lane_dv) = (
+        _mm256_mullo_epi32(lanes, du_v),
+        _mm256_mullo_epi32(lanes, dv_v),
+    );
     let (du8, dv8) = (_mm256_slli_epi32::<3>(du_v), _mm256_slli_epi32::<3>(dv_v));
-    let mut done = 0;
     let mut buf = [0u32; 8];
-    while done < n {
-        let m = (n - done).min(8);
-        let (mut cu, mut cv) = (uu, vv);
-        if m < 8 {
-            // Lanes past the span's end take its last pixel, so every gather stays in bounds.
-            let valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(m as i32), lanes);
-            cu = _mm256_blendv_epi8(last_u, cu, valid);
-            cv = _mm256_blendv_epi8(last_v, cv, valid);
-        }
-        // (x, y) = the integer parts as 16-bit pairs; the fractions are the low 16 bits.
-        let xy = _mm256_blend_epi16::<0b1010_1010>(_mm256_srli_epi32::<16>(cu), cv);
-        let o = _mm256_madd_epi16(xy, to_offset);
-        // Pixels 0, 1, 4, 5 in one group, 2, 3, 6, 7 in the other.
-        let o = _mm256_permute4x64_epi64::<0b11_01_10_00>(o);
-        let (o_lo, o_hi) = (_mm256_castsi256_si128(o), _mm256_extracti128_si256::<1>(o));
-        let gather = |at: __m128i| _mm256_i32gather_epi64::<1>(s.base, at);
-        let group = |at: __m128i, pick: __m256i| {
-            let (top, bottom) = (gather(at), gather(_mm_add_epi32(at, row)));
-            let (fx, fy) = (_mm256_shuffle_epi8(cu, pick), _mm256_shuffle_epi8(cv, pick));
-            let (gx, gy) = (
-                _mm256_xor_si256(fx, all_ones),
-                _mm256_xor_si256(fy, all_ones),
-            );
-            let lerp = |a: __m256i, b: __m256i, g: __m256i, f: __m256i| {
-                _mm256_add_epi16(_mm256_mulhi_epu16(a, g), _mm256_mulhi_epu16(b, f))
-            };
-            let across = |pair: __m256i| {
-                let left = _mm256_shuffle_epi8(pair, widen_left);
-                lerp(left, _mm256_shuffle_epi8(pair, widen_right), gx, fx)
-            };
-            let blended = lerp(across(top), across(bottom), gy, fy);
-            _mm256_srli_epi16::<8>(_mm256_add_epi16(blended, half))
+    for s in spans {
+        let Some([u, v, u1, v1]) = walk(tex, s, du, dv) else {
+            Bilinear::fill_span_scalar::<C>(tex, s.u, s.v, du, dv, s.pixels::<C>(data));
+            continue;
         };
-        let px = _mm256_packus_epi16(group(o_lo, spread_lo), group(o_hi, spread_hi));
-        let dst = out.as_mut_ptr().add(done * C);
-        if (n - done) * C >= 32 {
-            // A whole register fits in the span: the pixels packed to C bytes each (for C = 3
-            // its last 8 bytes land on pixels that the next chunk rewrites).
-            let packed = if C == 3 {
-                _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(px, pack3), keep6)
-            } else {
-                px
-            };
-            _mm256_storeu_si256(dst as *mut __m256i, packed);
-        } else {
-            _mm256_storeu_si256(buf.as_mut_ptr() as *mut __m256i, px);
-            for (k, p) in buf[..m].iter().enumerate() {
-                std::ptr::copy_nonoverlapping(p.to_le_bytes().as_ptr(), dst.add(k * C), C);
+        let (n, out) = (s.len, s.pixels::<C>(data));
+        let (last_u, last_v) = (_mm256_set1_epi32(u1), _mm256_set1_epi32(v1));
+        let mut uu = _mm256_add_epi32(_mm256_set1_epi32(u), lane_du);
+        let mut vv = _mm256_add_epi32(_mm256_set1_epi32(v), lane_dv);
+        let mut done = 0;
+        while done < n {
+            let m = (n - done).min(8);
+            let (mut cu, mut cv) = (uu, vv);
+            if m < 8 {
+                // Lanes past the span's end take its last pixel, so every gather stays in bounds.
+                let valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(m as i32), lanes);
+                cu = _mm256_blendv_epi8(last_u, cu, valid);
+                cv = _mm256_blendv_epi8(last_v, cv, valid);
             }
+            // (x, y) = the integer parts as 16-bit pairs; the fractions are the low 16 bits.
+            let xy = _mm256_blend_epi16::<0b1010_1010>(_mm256_srli_epi32::<16>(cu), cv);
+            let o = _mm256_madd_epi16(xy, to_offset);
+            // Pixels 0, 1, 4, 5 in one group, 2, 3, 6, 7 in the other.
+            let o = _mm256_permute4x64_epi64::<0b11_01_10_00>(o);
+            let (o_lo, o_hi) = (_mm256_castsi256_si128(o), _mm256_extracti128_si256::<1>(o));
+            let gather = |at: __m128i| _mm256_i32gather_epi64::<1>(base, at);
+            let group = |at: __m128i, pick: __m256i| {
+                let (top, bottom) = (gather(at), gather(_mm_add_epi32(at, row)));
+                let (fx, fy) = (_mm256_shuffle_epi8(cu, pick), _mm256_shuffle_epi8(cv, pick));
+                let (gx, gy) = (
+                    _mm256_xor_si256(fx, all_ones),
+                    _mm256_xor_si256(fy, all_ones),
+                );
+                let lerp = |a: __m256i, b: __m256i, g: __m256i, f: __m256i| {
+                    _mm256_add_epi16(_mm256_mulhi_epu16(a, g), _mm256_mulhi_epu16(b, f))
+                };
+                let across = |pair: __m256i| {
+                    let left = _mm256_shuffle_epi8(pair, widen_left);
+                    lerp(left, _mm256_shuffle_epi8(pair, widen_right), gx, fx)
+                };
+                let blended = lerp(across(top), across(bottom), gy, fy);
+                _mm256_srli_epi16::<8>(_mm256_add_epi16(blended, half))
+            };
+            let px = _mm256_packus_epi16(group(o_lo, spread_lo), group(o_hi, spread_hi));
+            let dst = out.as_mut_ptr().add(done * C);
+            if (n - done) * C >= 32 {
+                // A whole register fits in the span: the pixels packed to C bytes each (for C = 3
+                // its last 8 bytes land on pixels that the next chunk rewrites).
+                let packed = if C == 3 {
+                    _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(px, pack3), keep6)
+                } else {
+                    px
+                };
+                _mm256_storeu_si256(dst as *mut __m256i, packed);
+            } else {
+                _mm256_storeu_si256(buf.as_mut_ptr() as *mut __m256i, px);
+                for (k, p) in buf[..m].iter().enumerate() {
+                    std::ptr::copy_nonoverlapping(p.to_le_bytes().as_ptr(), dst.add(k * C), C);
+                }
+            }
+            done += m;
+            uu = _mm256_add_epi32(uu, du8);
+            vv = _mm256_add_epi32(vv, dv8);
         }
-        done += m;
-        uu = _mm256_add_epi32(uu, du8);
-        vv = _mm256_add_epi32(vv, dv8);
     }
 }
 
@@ -214,11 +207,19 @@ unsafe fn load_pattern_512(p: &[u8; 16]) -> __m512i {
 }
 
 #[target_feature(enable = "avx512f,avx512bw")]
-unsafe fn span_avx512<const C: usize>(s: &Span, out: &mut [u8], n: usize) {
+unsafe fn spans_avx512<const C: usize>(
+    tex: &ImageRef,
+    du: i64,
+    dv: i64,
+    spans: &[SpanStart],
+    data: &mut [u8],
+) {
+    let base = tex.data.as_ptr() as *const i64;
+    let row_len = (tex.width * C) as i32;
     let all_ones = _mm512_set1_epi16(-1);
     let half = _mm512_set1_epi16(128);
-    let to_offset = _mm512_set1_epi32((s.row << 16) | C as i32);
-    let row = _mm256_set1_epi32(s.row);
+    let to_offset = _mm512_set1_epi32((row_len << 16) | C as i32);
+    let row = _mm256_set1_epi32(row_len);
     let (spread_lo, spread_hi) = (load_pattern_512(&spread(0)), load_pattern_512(&spread(2)));
     let (widen_left, widen_right) = (
         load_pattern_512(&widen(0)),
@@ -228,50 +229,61 @@ unsafe fn span_avx512<const C: usize>(s: &Span, out: &mut [u8], n: usize) {
     let keep12 = _mm512_setr_epi32(0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, 15, 15, 15, 15);
     let groups = _mm512_setr_epi64(0, 2, 4, 6, 1, 3, 5, 7);
     let lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-    let (du_v, dv_v) = (_mm512_set1_epi32(s.du), _mm512_set1_epi32(s.dv));
-    let (last_u, last_v) = (_mm512_set1_epi32(s.last_u), _mm512_set1_epi32(s.last_v));
-    let mut uu = _mm512_add_epi32(_mm512_set1_epi32(s.u), _mm512_mullo_epi32(lanes, du_v));
-    let mut vv = _mm512_add_epi32(_mm512_set1_epi32(s.v), _mm512_mullo_epi32(lanes, dv_v));
+    let (du_v, dv_v) = (_mm512_set1_epi32(du as i32), _mm512_set1_epi32(dv as i32));
+    let (lane_du, lane_dv) = (
+        _mm512_mullo_epi32(lanes, du_v),
+        _mm512_mullo_epi32(lanes, dv_v),
+    );
     let (du16, dv16) = (_mm512_slli_epi32::<4>(du_v), _mm512_slli_epi32::<4>(dv_v));
-    let mut done = 0;
-    while done < n {
-        let m = (n - done).min(16);
-        let valid: __mmask16 = (u32::MAX >> (32 - m)) as u16;
-        // Lanes past the span's end take its last pixel, so every gather stays in bounds.
-        let cu = _mm512_mask_blend_epi32(valid, last_u, uu);
-        let cv = _mm512_mask_blend_epi32(valid, last_v, vv);
-        let xy = _mm512_mask_blend_epi16(0xAAAA_AAAA, _mm512_srli_epi32::<16>(cu), cv);
-        let o = _mm512_permutexvar_epi64(groups, _mm512_madd_epi16(xy, to_offset));
-        let (o_lo, o_hi) = (_mm512_castsi512_si256(o), _mm512_extracti64x4_epi64::<1>(o));
-        let gather = |at: __m256i| _mm512_i32gather_epi64::<1>(at, s.base);
-        let group = |at: __m256i, pick: __m512i| {
-            let (top, bottom) = (gather(at), gather(_mm256_add_epi32(at, row)));
-            let (fx, fy) = (_mm512_shuffle_epi8(cu, pick), _mm512_shuffle_epi8(cv, pick));
-            let (gx, gy) = (
-                _mm512_xor_si512(fx, all_ones),
-                _mm512_xor_si512(fy, all_ones),
-            );
-            let lerp = |a: __m512i, b: __m512i, g: __m512i, f: __m512i| {
-                _mm512_add_epi16(_mm512_mulhi_epu16(a, g), _mm512_mulhi_epu16(b, f))
-            };
-            let across = |pair: __m512i| {
-                let left = _mm512_shuffle_epi8(pair, widen_left);
-                lerp(left, _mm512_shuffle_epi8(pair, widen_right), gx, fx)
-            };
-            let blended = lerp(across(top), across(bottom), gy, fy);
-            _mm512_srli_epi16::<8>(_mm512_add_epi16(blended, half))
+    for s in spans {
+        let Some([u, v, u1, v1]) = walk(tex, s, du, dv) else {
+            Bilinear::fill_span_scalar::<C>(tex, s.u, s.v, du, dv, s.pixels::<C>(data));
+            continue;
         };
-        let px = _mm512_packus_epi16(group(o_lo, spread_lo), group(o_hi, spread_hi));
-        let packed = if C == 3 {
-            _mm512_permutexvar_epi32(keep12, _mm512_shuffle_epi8(px, pack3))
-        } else {
-            px
-        };
-        let bytes: __mmask64 = u64::MAX >> (64 - C * m);
-        _mm512_mask_storeu_epi8(out.as_mut_ptr().add(done * C) as *mut i8, bytes, packed);
-        done += m;
-        uu = _mm512_add_epi32(uu, du16);
-        vv = _mm512_add_epi32(vv, dv16);
+        let (n, out) = (s.len, s.pixels::<C>(data));
+        let (last_u, last_v) = (_mm512_set1_epi32(u1), _mm512_set1_epi32(v1));
+        let mut uu = _mm512_add_epi32(_mm512_set1_epi32(u), lane_du);
+        let mut vv = _mm512_add_epi32(_mm512_set1_epi32(v), lane_dv);
+        let mut done = 0;
+        while done < n {
+            let m = (n - done).min(16);
+            let valid: __mmask16 = (u32::MAX >> (32 - m)) as u16;
+            // Lanes past the span's end take its last pixel, so every gather stays in bounds.
+            let cu = _mm512_mask_blend_epi32(valid, last_u, uu);
+            let cv = _mm512_mask_blend_epi32(valid, last_v, vv);
+            let xy = _mm512_mask_blend_epi16(0xAAAA_AAAA, _mm512_srli_epi32::<16>(cu), cv);
+            let o = _mm512_permutexvar_epi64(groups, _mm512_madd_epi16(xy, to_offset));
+            let (o_lo, o_hi) = (_mm512_castsi512_si256(o), _mm512_extracti64x4_epi64::<1>(o));
+            let gather = |at: __m256i| _mm512_i32gather_epi64::<1>(at, base);
+            let group = |at: __m256i, pick: __m512i| {
+                let (top, bottom) = (gather(at), gather(_mm256_add_epi32(at, row)));
+                let (fx, fy) = (_mm512_shuffle_epi8(cu, pick), _mm512_shuffle_epi8(cv, pick));
+                let (gx, gy) = (
+                    _mm512_xor_si512(fx, all_ones),
+                    _mm512_xor_si512(fy, all_ones),
+                );
+                let lerp = |a: __m512i, b: __m512i, g: __m512i, f: __m512i| {
+                    _mm512_add_epi16(_mm512_mulhi_epu16(a, g), _mm512_mulhi_epu16(b, f))
+                };
+                let across = |pair: __m512i| {
+                    let left = _mm512_shuffle_epi8(pair, widen_left);
+                    lerp(left, _mm512_shuffle_epi8(pair, widen_right), gx, fx)
+                };
+                let blended = lerp(across(top), across(bottom), gy, fy);
+                _mm512_srli_epi16::<8>(_mm512_add_epi16(blended, half))
+            };
+            let px = _mm512_packus_epi16(group(o_lo, spread_lo), group(o_hi, spread_hi));
+            let packed = if C == 3 {
+                _mm512_permutexvar_epi32(keep12, _mm512_shuffle_epi8(px, pack3))
+            } else {
+                px
+            };
+            let bytes: __mmask64 = u64::MAX >> (64 - C * m);
+            _mm512_mask_storeu_epi8(out.as_mut_ptr().add(done * C) as *mut i8, bytes, packed);
+            done += m;
+            uu = _mm512_add_epi32(uu, du16);
+            vv = _mm512_add_epi32(vv, dv16);
+        }
     }
 }
 
@@ -316,25 +328,30 @@ mod tests {
         {
             return;
         }
-        // One guard pixel on each side catches a write outside the span.
-        let mut out = vec![7u8; (n + 2) * C];
-        let span = &mut out[C..(n + 1) * C];
-        let wrote = unsafe { bilinear_span::<C>(&tex, u, v, du, dv, span, kernel) };
-        if wrote == 0 {
-            return;
+        // Two spans with the same walk, one guard pixel before, between and after them to
+        // catch a write outside.
+        let mut out = vec![7u8; (2 * n + 3) * C];
+        let spans = [1, n + 2].map(|first| SpanStart {
+            at: first * C,
+            len: n,
+            u,
+            v,
+        });
+        if !unsafe { bilinear_spans::<C>(&tex, du, dv, &spans, &mut out, kernel) } {
+            return; // no SIMD here
         }
-        assert_eq!(wrote, n);
-        assert!(
-            out[..C].iter().chain(&out[(n + 1) * C..]).all(|&b| b == 7),
-            "wrote outside the span"
-        );
-        for k in 0..n {
-            let want = Bilinear::sample::<C>(&tex, u + du * k as i64, v + dv * k as i64);
-            assert_eq!(
-                &out[(k + 1) * C..(k + 2) * C],
-                &want[..],
-                "pixel {k} of {n}"
+        for guard in [0, n + 1, 2 * n + 2] {
+            assert!(
+                out[guard * C..(guard + 1) * C].iter().all(|&b| b == 7),
+                "wrote outside the spans"
             );
+        }
+        for s in &spans {
+            for k in 0..n {
+                let want = Bilinear::sample::<C>(&tex, u + du * k as i64, v + dv * k as i64);
+                let at = s.at + k * C;
+                assert_eq!(&out[at..at + C], &want[..], "pixel {k} of {n}");
+            }
         }
     }
 
