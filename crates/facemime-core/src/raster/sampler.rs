@@ -56,7 +56,8 @@ impl SpanStart {
 /// Nearest texel (round half up).
 pub struct Nearest;
 
-/// Bilinear interpolation of the four surrounding texels (16-bit weights, see [`blend`]).
+/// Bilinear interpolation of the four surrounding texels: 16-bit weights, within 0.53 level of
+/// exact.
 pub struct Bilinear;
 
 #[inline(always)]

@@ -1,4 +1,4 @@
-//! SIMD bilinear texture lookups along a span: AVX-512 (BW), 16 pixels at a time, or AVX2, 8 at
+//! SIMD bilinear texture lookups along spans: AVX-512 (BW), 16 pixels at a time, or AVX2, 8 at
 //! a time; both bit-identical to the scalar [`super::sampler::Bilinear`] (the same truncated
 //! 16-bit products, the same rounding).
 //!
@@ -43,7 +43,7 @@ const fn widen(at: u8) -> [u8; 16] {
 /// Per 128-bit lane: the first three bytes of each 32-bit lane, side by side.
 const PACK3: [u8; 16] = [0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, Z, Z, Z, Z];
 
-/// Which kernel [`bilinear_span`] may use.
+/// Which kernel [`bilinear_spans`] may use.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub enum Kernel {
     /// The widest the CPU has.
@@ -53,13 +53,13 @@ pub enum Kernel {
     Avx2,
 }
 
-/// Fills the spans with SIMD when the CPU can, as [`Sampler::fill_spans_unchecked`], and says
+/// Fills the spans with SIMD when the CPU can, as [`super::sampler::Sampler::fill_spans_unchecked`], and says
 /// whether it did; false (nothing written) without AVX2, for other than 3 or 4 channels or for
 /// texture rows over 32767 bytes. A span whose footprint touches the texture's last row is
 /// drawn one pixel at a time, as each 8-byte gather may read two bytes past a texel pair.
 ///
 /// # Safety
-/// As [`Sampler::fill_spans_unchecked`].
+/// As [`super::sampler::Sampler::fill_spans_unchecked`].
 #[inline(always)]
 pub unsafe fn bilinear_spans<const C: usize>(
     tex: &ImageRef,
