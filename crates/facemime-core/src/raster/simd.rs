@@ -179,20 +179,28 @@ unsafe fn spans_avx2<const C: usize>(
             };
             let px = _mm256_packus_epi16(group(o_lo, spread_lo), group(o_hi, spread_hi));
             let dst = out.as_mut_ptr().add(done * C);
+            // The pixels packed to C bytes each, from the register's start.
+            let packed = if C == 3 {
+                _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(px, pack3), keep6)
+            } else {
+                px
+            };
             if (n - done) * C >= 32 {
-                // A whole register fits in the span: the pixels packed to C bytes each (for C = 3
-                // its last 8 bytes land on pixels that the next chunk rewrites).
-                let packed = if C == 3 {
-                    _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(px, pack3), keep6)
-                } else {
-                    px
-                };
+                // A whole register fits in the span (for C = 3 its last 8 bytes land on pixels
+                // that the next chunk rewrites).
                 _mm256_storeu_si256(dst as *mut __m256i, packed);
             } else {
-                _mm256_storeu_si256(buf.as_mut_ptr() as *mut __m256i, px);
-                for (k, p) in buf[..m].iter().enumerate() {
-                    std::ptr::copy_nonoverlapping(p.to_le_bytes().as_ptr(), dst.add(k * C), C);
-                }
+                // The whole 32-bit words of the chunk's bytes, then the last one to three.
+                let bytes = m * C;
+                let words = _mm256_cmpgt_epi32(_mm256_set1_epi32((bytes / 4) as i32), lanes);
+                _mm256_maskstore_epi32(dst as *mut i32, words, packed);
+                _mm256_storeu_si256(buf.as_mut_ptr() as *mut __m256i, packed);
+                let tail = bytes / 4 * 4;
+                std::ptr::copy_nonoverlapping(
+                    (buf.as_ptr() as *const u8).add(tail),
+                    dst.add(tail),
+                    bytes - tail,
+                );
             }
             done += m;
             uu = _mm256_add_epi32(uu, du8);
