@@ -113,8 +113,8 @@ fn bilinear_weights(u: i64, v: i64) -> (i64, i64, u32, u32) {
 }
 
 /// `a + (b - a) · f` for values in 8.8 fixed point and a 0.16 fraction, as two truncated
-/// 16-bit products (weights 1 - f ≈ 0xFFFF - f and f): the arithmetic of the AVX2 sampler's
-/// `mulhi_epu16`, which it must match bit for bit. Never above max(a, b).
+/// 16-bit products (weights 1 - f ≈ 0xFFFF - f and f): the arithmetic of the SIMD samplers'
+/// `mulhi_epu16`, which they must match bit for bit. Never above max(a, b).
 #[inline(always)]
 fn lerp16(a: u32, b: u32, f: u32) -> u32 {
     ((a * (f ^ 0xFFFF)) >> 16) + ((b * f) >> 16)
