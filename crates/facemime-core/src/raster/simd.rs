@@ -364,9 +364,11 @@ mod tests {
     }
 
     proptest! {
+        /// Both kernels, spans of any length and direction; footprints on the texture's last
+        /// rows (v >= 27 of 29) take the scalar fallback inside the same call.
         #[test]
         fn simd_spans_match_scalar_lookups(
-            u in 0i64..(36 << 16), v in 0i64..(27 << 16),
+            u in 0i64..(36 << 16), v in 0i64..(28 << 16),
             du in -(3i64 << 16)..(3 << 16), dv in -(1i64 << 16)..(1 << 16),
             n in 1usize..40, seed in any::<u64>(),
         ) {
