@@ -74,7 +74,9 @@ def brow_similarity(src: Mapping[str, np.ndarray], dst: Mapping[str, np.ndarray]
 
 def compose(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The 2×3 transform ``a ∘ b`` (apply ``b`` first)."""
-    return (np.vstack([a, [0, 0, 1]]) @ np.vstack([b, [0, 0, 1]]))[:2]
+    m = a[:, :2] @ b
+    m[:, 2] += a[:, 2]
+    return m
 
 
 def apply(m: np.ndarray, pts: np.ndarray) -> np.ndarray:
@@ -142,13 +144,11 @@ class HeadMotion:
 
     def _inside(self, pts: np.ndarray) -> np.ndarray:
         """Which of ``pts`` (N, 2) lie in a zone (convex quadrilaterals, either winding)."""
-        inside = np.zeros(len(pts), bool)
-        for poly in self._zones:
-            edges = poly[NEXT_CORNER] - poly
-            rel = pts[:, None, :] - poly[None]
-            cross = edges[None, :, 0] * rel[..., 1] - edges[None, :, 1] * rel[..., 0]
-            inside |= (cross >= 0).all(axis=1) | (cross <= 0).all(axis=1)
-        return inside
+        polys = np.stack(self._zones)  # (Z, 4, 2)
+        edges = polys[:, NEXT_CORNER] - polys
+        rel = pts[:, None, None, :] - polys[None]  # (N, Z, 4, 2)
+        cross = edges[..., 0] * rel[..., 1] - edges[..., 1] * rel[..., 0]
+        return ((cross >= 0).all(axis=2) | (cross <= 0).all(axis=2)).any(axis=1)
 
     def _crop_box(self, shape: tuple[int, ...], extra: np.ndarray) -> tuple[int, int, int, int]:
         """The part of the frame the flow uses: the zones, points and ``extra`` with room for
@@ -206,8 +206,8 @@ class HeadMotion:
             p0 = np.concatenate([self.points, extra_pts])
             p1, ok1 = self._flow.track(p0)
             pb, ok2 = self._flow.track(p1, backward=True)
-            with np.errstate(invalid="ignore"):
-                good = ok1 & ok2 & (np.linalg.norm(pb - p0, axis=1) < FB_LIMIT)
+            back = pb - p0  # NaN where lost, which fails the test
+            good = ok1 & ok2 & ((back * back).sum(axis=1) < FB_LIMIT**2)
             n = len(self.points)
             if moved is not None:
                 moved[good[n:]] = p1[n:][good[n:]]

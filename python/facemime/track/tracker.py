@@ -216,7 +216,7 @@ class Tracker:
         self._mouth_knots = np.unique(np.concatenate([self._features["mouth_outer"], self._features["mouth_inner"]]))
         self._bands = (self._mouth_knots, np.unique(np.concatenate([self._features["brow_left"], self._features["brow_right"]])))
         self._mouth_rows = [i for i, n in enumerate(CONTOUR_NAMES) if n.startswith("mouth")]
-        self._feature_rows = {f: [CONTOUR_NAMES.index(n) for n in names] for f, names in FEATURES.items()}
+        self._feature_rows = {f: np.array([CONTOUR_NAMES.index(n) for n in names]) for f, names in FEATURES.items()}
         self._solver, self._targets0 = self._build_solver()
         gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
         self._motion = motion.HeadMotion(gray, contours) if p.motion else None
@@ -313,10 +313,9 @@ class Tracker:
             gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
             step, ok, flow = self._motion.update(gray, self._reported, self._knots if p.knot_flow else None)
         total = self._motion.total if self._motion is not None else motion.IDENTITY
-        scale = float(np.sqrt(abs(np.linalg.det(total[:, :2]))))
-        rot = total[:, :2] / max(scale, 1e-9)
-        down = rot @ self._down0
-        down /= np.linalg.norm(down)
+        scale = math.sqrt(abs(total[0, 0] * total[1, 1] - total[0, 1] * total[1, 0]))
+        down = total[:, :2] @ self._down0
+        down /= _length(down)
         bounds_hi = np.array([self.width - 1.0, self.height - 1.0])
         start = motion.apply(step, self._knots)
         if flow is not None:
@@ -339,9 +338,9 @@ class Tracker:
             iters += more
         self._centre_inner(knots, rest, down)
         confidence, lost = {}, []
+        ratio = np.clip(resp / self._response0, 0.0, 1.0)
         for feature, names in FEATURES.items():
-            rows = self._feature_rows[feature]
-            conf = float(np.minimum(np.maximum(resp[rows] / self._response0[rows], 0.0), 1.0).mean())
+            conf = float(ratio[self._feature_rows[feature]].mean())
             confidence[feature] = conf
             if conf < p.lost_response or not self._shape_ok(knots, carried, names):
                 lost.append(feature)
@@ -382,9 +381,17 @@ class Tracker:
         amount = self.params.mouth_affine
         rest = carried.copy()
         for idx in (self._features["mouth_outer"], self._features["mouth_inner"]):
-            src = np.column_stack([carried[idx], np.ones(len(idx))])
-            fit, *_ = np.linalg.lstsq(src, start[idx], rcond=None)
-            rest[idx] += amount * (src @ fit - carried[idx])
+            # Least squares about the centroids: the linear part from the centred points (by
+            # the normal equations, or lstsq's minimum-norm answer when they are singular).
+            a, b = carried[idx], start[idx]
+            ca, cb = a.mean(axis=0), b.mean(axis=0)
+            d = a - ca
+            gram = d.T @ d
+            if gram[0, 0] * gram[1, 1] - gram[0, 1] ** 2 > 1e-9 * (gram[0, 0] + gram[1, 1]) ** 2:
+                linear = np.linalg.solve(gram, d.T @ (b - cb))
+            else:
+                linear = np.linalg.lstsq(d, b - cb, rcond=None)[0]
+            rest[idx] += amount * (d @ linear + cb - a)
         return rest
 
     def _shape_ok(self, knots: np.ndarray, rest: np.ndarray, names: tuple[str, str]) -> bool:
