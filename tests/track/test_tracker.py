@@ -102,6 +102,22 @@ def test_confidence_and_lost_flag_when_the_face_disappears():
     assert sorted(gone.lost) == sorted(FEATURES) and max(gone.confidence.values()) < 0.1
 
 
+def test_a_mouth_drawn_as_one_straight_line_is_tracked():
+    # A closed mouth drawn flat (all four lip curves on one line), taken as given (no
+    # calibration on the image edges), leaves the rest shape's affine fit without a vertical
+    # extent: the tracker still follows the face.
+    frame0, truth0 = band_face()
+    flat = {n: c.copy() for n, c in truth0.items()}
+    line = np.mean([c[:, 1].mean() for n, c in flat.items() if n.startswith("mouth")])
+    for n in flat:
+        if n.startswith("mouth"):
+            flat[n][:, 1] = line
+    tracker = Tracker(frame0, flat, TrackerParams(calibration_passes=0))
+    for frame, _ in sequence(3, shift=(0.5, 0.0)):
+        result = tracker.update(frame)
+        assert all(np.isfinite(c).all() for c in result.contours.values())
+
+
 def test_editing_a_result_does_not_change_the_track():
     frame0, truth0 = band_face()
     frames = [band_face(shift=(0.7 * k, 0.3 * k))[0] for k in range(1, 4)]
