@@ -72,6 +72,9 @@ class Deformer:
         self._members = np.concatenate([g[n] for n in CONTOUR_GROUPS])
         self._member_slots = np.array([self._slot[int(i)] for i in self._members])
         self._member_counts = np.bincount(self._member_slots, minlength=len(self.knots)).astype(np.float64)
+        # the inner lips' knots between the corners, and their slots (see sealed)
+        self._inner = (g["mouth_inner_upper"][1:-1], g["mouth_inner_lower"][1:-1])
+        self._inner_slots = tuple(np.array([self._slot[int(i)] for i in idx], np.int64) for idx in self._inner)
         self.weights = self._spread()
 
     def _spread(self) -> np.ndarray:
@@ -132,7 +135,7 @@ class Deformer:
         opening never jumps. The inner-lip knots meet halfway and the other vertices follow
         them like offsets (:meth:`vertices`)."""
         g = self.model.groups
-        upper, lower = g["mouth_inner_upper"][1:-1], g["mouth_inner_lower"][1:-1]
+        upper, lower = self._inner
         corners = g["mouth_outer_upper"][[0, -1]]
         along = vertices[corners[1], :2] - vertices[corners[0], :2]
         width = mouth_width(self.model, vertices)
@@ -144,8 +147,8 @@ class Deformer:
         shown = np.where(gap < limit, 0.0, np.where(gap < 2.0 * limit, 2.0 * (gap - limit), gap))
         close = np.zeros((len(self.knots), 2))
         half = 0.5 * (gap - shown)[:, None] * up
-        close[[self._slot[int(i)] for i in upper]] = -half
-        close[[self._slot[int(i)] for i in lower]] = half
+        close[self._inner_slots[0]] = -half
+        close[self._inner_slots[1]] = half
         out = vertices.copy()
         out[:, :2] += self.weights @ close
         return out
