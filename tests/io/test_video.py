@@ -4,6 +4,7 @@ import pytest
 
 from facemime.errors import InvalidInputError
 from facemime.io import VideoWriter, check_outputs
+from facemime.io.video import VideoReader
 from facemime.io.outputs import OutputExistsError
 
 
@@ -21,6 +22,22 @@ def test_written_video_plays_back(tmp_path, suffix, codec):
     assert len(decoded) == 8 and decoded[0].shape == (32, 46, 3)
     assert abs(int(decoded[5][10, 10, 0]) - 125) <= 3
     assert [p.name for p in tmp_path.iterdir()] == [path.name]  # no temporary file left
+
+
+@pytest.mark.parametrize("suffix", [".mp4", ".webm"])
+def test_colours_survive_writing_and_reading(tmp_path, suffix):
+    """Red, green, blue, skin and grey blocks come back as themselves (the encoder's colour
+    conversion is RGB, not BGR, and of FFmpeg's range)."""
+    colours = np.array([[230, 40, 40], [40, 200, 60], [50, 60, 220], [224, 172, 140], [128, 128, 128]], np.uint8)
+    frame = np.repeat(np.repeat(colours[None], 32, axis=0), 32, axis=1)  # 32 x 160, one block per colour
+    with VideoWriter(tmp_path / f"c{suffix}", fps=25) as w:
+        for _ in range(3):
+            w.write(frame)
+    with VideoReader(tmp_path / f"c{suffix}") as r:
+        back = list(r)
+    assert len(back) == 3
+    centres = back[-1][16, 16::32].astype(int)
+    assert np.abs(centres - colours).max() <= 6, centres.tolist()
 
 
 def test_failed_write_leaves_nothing(tmp_path):
