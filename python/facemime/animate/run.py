@@ -115,7 +115,10 @@ def run_video(video: str | Path, out: str | Path, actor: str | Path | Actor | No
             fill(synth, BACKGROUND)
             puppet.render(motion.pose, motion.offsets, size, user, out=synth)
             t2 = time.perf_counter()
-            canvas[:, :reader.width] = draw_contours(frame, motion.contours, motion.lost) if motion.face else frame
+            if motion.face:
+                draw_contours(frame, motion.contours, motion.lost, out=canvas[:, :reader.width])
+            else:
+                canvas[:, :reader.width] = frame
             canvas[:, reader.width:] = synth if motion.face else (synth * NO_FACE_DIM).astype(np.uint8)
             frames.append({"index": len(frames), "contours": motion.contours, "confidence": motion.confidence,
                            "lost": motion.lost, "face": motion.face, "pose": pose_dict(motion.pose),

@@ -16,10 +16,14 @@ SHIFT = 4  # sub-pixel bits for cv2 drawing
 
 
 def draw_contours(frame: np.ndarray, contours: Mapping[str, np.ndarray], lost: Iterable[str] = (),
-                  thickness: int | None = None) -> np.ndarray:
-    """A copy of ``frame`` (H, W, 3) uint8 RGB with the contours drawn as anti-aliased polylines,
-    knots as dots; curves of ``lost`` features in magenta."""
-    out = np.ascontiguousarray(frame).copy()
+                  thickness: int | None = None, out: np.ndarray | None = None) -> np.ndarray:
+    """``frame`` (H, W, 3) uint8 RGB with the contours drawn as anti-aliased polylines, knots as
+    dots; curves of ``lost`` features in magenta. Drawn on a copy, or on ``out`` (an (H, W, 3)
+    uint8 array or view, e.g. half of a side-by-side canvas) after ``frame`` is copied into it."""
+    if out is None:
+        out = np.ascontiguousarray(frame).copy()
+    else:
+        out[...] = frame
     lost = set(lost)
     t = thickness or max(1, round(min(frame.shape[:2]) / 400))
     for feature, names in FEATURES.items():
@@ -29,6 +33,6 @@ def draw_contours(frame: np.ndarray, contours: Mapping[str, np.ndarray], lost: I
                 continue
             pts = np.round(np.asarray(contours[name], float) * (1 << SHIFT)).astype(np.int32)
             cv2.polylines(out, [pts.reshape(-1, 1, 2)], False, colour, t, cv2.LINE_AA, SHIFT)
-            for p in pts:
-                cv2.circle(out, tuple(int(v) for v in p), (t + 1) << SHIFT, colour, -1, cv2.LINE_AA, SHIFT)
+            for p in pts.tolist():
+                cv2.circle(out, p, (t + 1) << SHIFT, colour, -1, cv2.LINE_AA, SHIFT)
     return out
