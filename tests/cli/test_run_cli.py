@@ -7,10 +7,14 @@ import av
 import numpy as np
 import pytest
 
+from facemime.animate.run import SideBySide
+from facemime.animate.synth import BACKGROUND
+from facemime.errors import InputFileError
 from facemime.io.contours_json import read_motion
 from facemime.io.video import VideoReader, VideoWriter
 from facemime.metrics import group_nme
 from facemime.track.contours import GROUPS, from_face_mesh
+from facemime.track.overlay import draw_contours
 
 from .test_cli import first_frames, run
 
@@ -60,6 +64,28 @@ def test_run_writes_a_side_by_side_video_and_the_motion(own, shared):
     # The grin (frames 20-45) widens the mouth: the corner knots move apart in the head frame.
     width = [m["offsets"][10, 0] - m["offsets"][0, 0] for m in motion]
     assert max(width[20:45]) > 4.0 and abs(width[1]) < 1.0
+
+
+def test_the_per_frame_work_composes_every_frame_without_encoding(clip):
+    """SideBySide, run's work without the encoder (what the speed benchmark times): one canvas
+    per frame, the frame with its recorded contours | a synthesised face."""
+    frames = list(VideoReader(clip))[:6]
+    work = SideBySide(frames, "clip")
+    canvases = [c.copy() for c in work]
+    assert len(canvases) == len(work.records) == 6
+    for frame, canvas, record in zip(frames, canvases, work.records):
+        assert canvas.shape == (512, 1024, 3)
+        assert np.array_equal(canvas[:, :512], draw_contours(frame, record["contours"], record["lost"]))
+        assert (canvas[:, 512:] != BACKGROUND).any(axis=2).mean() > 0.1  # the face: a fifth of the frame
+    result = work.result([])
+    assert result.frames == 6 and result.fps > 0 and result.seconds["track"] > 0
+
+
+def test_the_per_frame_work_of_no_frames_says_so():
+    work = SideBySide([], "empty.mp4")
+    assert list(work) == []
+    with pytest.raises(InputFileError, match="video empty.mp4 has no frames"):
+        work.result([])
 
 
 def test_run_drives_another_actor(own, clip, astronaut, tmp_path, capsys):

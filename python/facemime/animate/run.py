@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -67,6 +68,75 @@ def pose_dict(pose: Pose) -> dict[str, float]:
     return {k: getattr(pose, k) for k in POSE_FIELDS}
 
 
+class SideBySide:
+    """The per-frame work of ``run`` without the video encoding: each frame analysed,
+    re-synthesised on the driven actor and composed side by side (the original with the tracked
+    contours | the synthesised face). Iterating yields each frame's (H, 2W, 3) uint8 canvas, one
+    buffer overwritten frame after frame.
+
+    ``frames``: RGB uint8 (H, W, 3) frames of one size; ``name`` names the video in messages;
+    ``target``: the actor to drive (default: the actor fitted on the first frame). While it
+    runs, ``records`` gathers the track file's per-frame entries and ``seconds`` the time per
+    stage (``decode``: waiting for the next frame; ``track``, ``pose``, ``fit``; ``synth``;
+    ``compose``). ``analysis`` is None until the first frame."""
+
+    def __init__(self, frames: Iterable[np.ndarray], name: str, target: Actor | None = None,
+                 user: UserMotion = UserMotion(), params: TrackerParams | None = None):
+        self._frames, self._name, self._target, self._user, self._params = frames, name, target, user, params
+        self.records: list[dict] = []
+        self.seconds = dict.fromkeys(("decode", "track", "pose", "synth", "compose"), 0.0)
+        self.analysis: Analysis | None = None
+
+    def __iter__(self) -> Iterator[np.ndarray]:
+        seconds, canvas, synth, puppet = self.seconds, None, None, None
+        stream = iter(self._frames)
+        while True:
+            t0 = time.perf_counter()
+            frame = next(stream, None)
+            seconds["decode"] += time.perf_counter() - t0
+            if frame is None:
+                break
+            h, w = frame.shape[:2]
+            if self.analysis is None:
+                try:
+                    self.analysis = Analysis(frame, f"the first frame of {self._name}", self._params)
+                except NoFaceError as e:
+                    raise NoFaceError(f"{e}; the video must start with a frontal face") from None
+                actor = self.analysis.actor
+                puppet = Puppet(self._target or actor, self.analysis.deformer.feature_sizes(), model_iod(actor.model))
+                canvas = np.empty((h, 2 * w, 3), np.uint8)
+                synth = np.empty((h, w, 3), np.uint8)
+                motion = self.analysis.last
+            else:
+                motion = self.analysis.update(frame)
+            t1 = time.perf_counter()
+            fill(synth, BACKGROUND)
+            puppet.render(motion.pose, motion.offsets, (w, h), self._user, out=synth)
+            t2 = time.perf_counter()
+            if motion.face:
+                draw_contours(frame, motion.contours, motion.lost, out=canvas[:, :w])
+            else:
+                canvas[:, :w] = frame
+            canvas[:, w:] = synth if motion.face else (synth * NO_FACE_DIM).astype(np.uint8)
+            self.records.append({"index": len(self.records), "contours": motion.contours, "confidence": motion.confidence,
+                                 "lost": motion.lost, "face": motion.face, "pose": pose_dict(motion.pose),
+                                 "offsets": motion.offsets})
+            seconds["synth"] += t2 - t1
+            seconds["compose"] += time.perf_counter() - t2
+            yield canvas
+        if self.analysis is not None:
+            t = self.analysis.timings
+            seconds.update(track=t.track, pose=t.pose, fit=t.fit)
+
+    def result(self, files: list[Path], encode_seconds: float = 0.0) -> RunResult:
+        """What the run did, once iterated to the end (``encode_seconds``: the time the caller
+        spent encoding)."""
+        if self.analysis is None:
+            raise InputFileError(f"video {self._name} has no frames")
+        return RunResult(len(self.records), self.analysis.frames_without_face, files, list(self.analysis.warnings),
+                         {**self.seconds, "encode": encode_seconds})
+
+
 def run_video(video: str | Path, out: str | Path, actor: str | Path | Actor | None = None,
               track: str | Path | None = None, user: UserMotion = UserMotion(), force: bool = False,
               params: TrackerParams | None = None) -> RunResult:
@@ -84,55 +154,17 @@ def run_video(video: str | Path, out: str | Path, actor: str | Path | Actor | No
         raise InvalidInputError("the output video and the track file must be different files")
     check_outputs([out, track], force)
     target = load_actor(actor) if isinstance(actor, (str, Path)) else actor
-    seconds = dict.fromkeys(("decode", "track", "pose", "synth", "compose", "encode"), 0.0)
-    frames: list[dict] = []
-    warnings: list[str] = []
-    analysis: Analysis | None = None
-    puppet: Puppet | None = None
+    encode = 0.0
     with VideoReader(video) as reader, VideoWriter(out, reader.fps) as writer:
-        size = (reader.width, reader.height)
-        canvas = np.empty((reader.height, 2 * reader.width, 3), np.uint8)
-        synth = np.empty((reader.height, reader.width, 3), np.uint8)
-        stream = iter(progress(reader, reader.frames or None, "running"))
-        while True:
+        work = SideBySide(progress(reader, reader.frames or None, "running"), str(video), target, user, params)
+        for canvas in work:
             t0 = time.perf_counter()
-            frame = next(stream, None)
-            seconds["decode"] += time.perf_counter() - t0
-            if frame is None:
-                break
-            if analysis is None:
-                try:
-                    analysis = Analysis(frame, f"the first frame of {video}", params)
-                except NoFaceError as e:
-                    raise NoFaceError(f"{e}; the video must start with a frontal face") from None
-                warnings += analysis.warnings
-                driven = analysis.actor if target is None else target
-                puppet = Puppet(driven, analysis.deformer.feature_sizes(), model_iod(analysis.actor.model))
-                motion = analysis.last
-            else:
-                motion = analysis.update(frame)
-            t1 = time.perf_counter()
-            fill(synth, BACKGROUND)
-            puppet.render(motion.pose, motion.offsets, size, user, out=synth)
-            t2 = time.perf_counter()
-            if motion.face:
-                draw_contours(frame, motion.contours, motion.lost, out=canvas[:, :reader.width])
-            else:
-                canvas[:, :reader.width] = frame
-            canvas[:, reader.width:] = synth if motion.face else (synth * NO_FACE_DIM).astype(np.uint8)
-            frames.append({"index": len(frames), "contours": motion.contours, "confidence": motion.confidence,
-                           "lost": motion.lost, "face": motion.face, "pose": pose_dict(motion.pose),
-                           "offsets": motion.offsets})
-            t3 = time.perf_counter()
             writer.write(canvas)
-            seconds["synth"] += t2 - t1
-            seconds["compose"] += t3 - t2
-            seconds["encode"] += time.perf_counter() - t3
-        if analysis is None:
-            raise InputFileError(f"video {video} has no frames")
-        seconds.update(track=analysis.timings.track, pose=analysis.timings.pose, fit=analysis.timings.fit)
-        info = {"width": reader.width, "height": reader.height, "fps": reader.fps, "frames": len(frames)}
-        busy = sum(v for k, v in seconds.items() if k not in ("encode", "fit", "decode"))
-        write_json(track, track_document(info, frames, {"processing_seconds": round(busy, 4), "frames_processed": len(frames)},
-                                         analysis.model_block))
-    return RunResult(len(frames), analysis.frames_without_face, [out, track], warnings, seconds)
+            encode += time.perf_counter() - t0
+        result = work.result([out, track], encode)
+        info = {"width": reader.width, "height": reader.height, "fps": reader.fps, "frames": result.frames}
+        busy = sum(v for k, v in result.seconds.items() if k not in ("encode", "fit", "decode"))
+        write_json(track, track_document(info, work.records, {"processing_seconds": round(busy, 4),
+                                                              "frames_processed": result.frames},
+                                         work.analysis.model_block))
+    return result
