@@ -45,12 +45,8 @@ pub fn sample(g: &Grid, rows: usize, cols: usize, out: &mut [f32]) {
     assert!(cols.is_multiple_of(LANES) && out.len() >= rows * cols);
     #[cfg(target_arch = "x86_64")]
     if has_avx2() {
-        for r in 0..rows {
-            let (t, b) = g.rows(r, cols);
-            // SAFETY: AVX2 is present; `t`, `b` hold cols + 1 values and the row of `out` cols.
-            unsafe { sample_row_avx2(t, b, g.w, &mut out[r * cols..][..cols]) };
-        }
-        return;
+        // SAFETY: AVX2 is present and the sizes are checked above.
+        return unsafe { sample_avx2(g, rows, cols, out) };
     }
     sample_portable(g, rows, cols, out)
 }
@@ -194,14 +190,18 @@ mod avx2 {
 }
 
 /// # Safety
-/// AVX2 must be present; `t`, `b` must hold `out.len()` + 1 values, `out.len()` % LANES == 0.
+/// AVX2 must be present and the sizes those [`sample`] checks.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn sample_row_avx2(t: &[f32], b: &[f32], w: [f32; 4], out: &mut [f32]) {
-    let w = avx2::weights(w);
-    for k in (0..out.len()).step_by(LANES) {
-        let v = avx2::bilinear(t.as_ptr().add(k), b.as_ptr().add(k), &w);
-        _mm256_storeu_ps(out.as_mut_ptr().add(k), v);
+unsafe fn sample_avx2(g: &Grid, rows: usize, cols: usize, out: &mut [f32]) {
+    let w = avx2::weights(g.w);
+    for r in 0..rows {
+        let (t, b) = g.rows(r, cols);
+        let row = &mut out[r * cols..][..cols];
+        for k in (0..cols).step_by(LANES) {
+            let v = avx2::bilinear(t.as_ptr().add(k), b.as_ptr().add(k), &w);
+            _mm256_storeu_ps(row.as_mut_ptr().add(k), v);
+        }
     }
 }
 
