@@ -39,10 +39,12 @@ def head_plane(points: np.ndarray, depth: np.ndarray, pose: Pose) -> np.ndarray:
     """Model-space (x, y) of image ``points`` (K, 2) px seen in ``pose``, each at its model
     depth ``depth`` (K,): the inverse of the orthographic projection for points of known z."""
     r = rotation_matrix(pose.yaw, pose.pitch, pose.roll)
-    a = np.array([[r[0, 0], r[0, 1]], [-r[1, 0], -r[1, 1]]]) * pose.scale
+    # (u - tx - s·r02·z, v - ty + s·r12·z) = s·[[r00, r01], [-r10, -r11]] (x, y), inverted.
+    det = pose.scale * (r[1, 0] * r[0, 1] - r[0, 0] * r[1, 1])
+    inverse = np.array([[-r[1, 1], -r[0, 1]], [r[1, 0], r[0, 0]]]) / det
     rhs = np.column_stack([points[:, 0] - pose.tx - pose.scale * r[0, 2] * depth,
                            points[:, 1] - pose.ty + pose.scale * r[1, 2] * depth])
-    return np.linalg.solve(a, rhs.T).T
+    return rhs @ inverse.T
 
 
 def mouth_width(model: HeadModel, vertices: np.ndarray) -> float:
@@ -112,7 +114,7 @@ class Deformer:
             idx = g[name]
             c = np.asarray(contours[name], np.float64)
             c = c if len(c) == len(idx) else resample(c, len(idx))
-            if np.linalg.norm(c[0] - c[-1]) > 0 and (c[-1, 0] - c[0, 0]) * (v[idx[-1], 0] - v[idx[0], 0]) < 0:
+            if (c[-1, 0] - c[0, 0]) * (v[idx[-1], 0] - v[idx[0], 0]) < 0:
                 c = c[::-1]  # the model's groups run image-left to image-right in a frontal view
             points.append(c)
         # one inverse projection for all points; knots on two curves (the mouth corners) average

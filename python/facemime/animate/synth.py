@@ -7,6 +7,8 @@ Images are (H, W, 3) uint8 RGB; points are (x, y) pixels, y down.
 
 from __future__ import annotations
 
+import functools
+import math
 from dataclasses import dataclass, replace
 
 import cv2
@@ -58,6 +60,16 @@ def teeth_uncovered(spread: float) -> float:
     return float(np.clip((spread - lo) / (hi - lo), 0.0, 1.0))
 
 
+@functools.cache
+def _teeth_span(knots: int) -> np.ndarray:
+    """Which of a lip curve's ``knots`` (evenly spread from corner to corner) the teeth span
+    (:data:`TEETH_SPAN`); all of them when that leaves fewer than two."""
+    keep = np.abs(np.linspace(-1.0, 1.0, knots)) <= TEETH_SPAN
+    keep = keep if keep.sum() >= 2 else np.ones(knots, bool)
+    keep.flags.writeable = False
+    return keep
+
+
 def draw_mouth_interior(out: np.ndarray, upper: np.ndarray, lower: np.ndarray, uncovered: float = 1.0) -> None:
     """Paint the mouth opening bounded by the inner-lip curves ``upper`` and ``lower`` (each
     (K, 2) px, corner to corner, sharing the corners) into ``out`` in place: the cavity, and the
@@ -77,11 +89,9 @@ def draw_mouth_interior(out: np.ndarray, upper: np.ndarray, lower: np.ndarray, u
         return
     paint = fill(np.empty((y1 - y0, x1 - x0, 3), np.uint8), CAVITY)
     along = upper[-1] - upper[0]
-    width = float(np.linalg.norm(along))
+    width = math.hypot(*along)
     down = np.array([-along[1], along[0]]) / max(width, 1e-9)
-    keep = np.abs(np.linspace(-1.0, 1.0, len(upper))) <= TEETH_SPAN
-    if len(upper) != len(lower) or keep.sum() < 2:
-        keep[:] = True
+    keep = _teeth_span(len(upper)) if len(upper) == len(lower) else slice(None)
     opening = (lower - upper) @ down if len(upper) == len(lower) else np.full(len(upper), width)
     # teeth grow from nothing at TEETH_FROM to their full share of the opening at twice it
     opening = (opening * np.clip(opening / (TEETH_FROM * width) - 1.0, 0.0, 1.0))[keep]
@@ -97,12 +107,11 @@ def draw_mouth_interior(out: np.ndarray, upper: np.ndarray, lower: np.ndarray, u
         for a, b in zip(fix(edge[1:-1]).reshape(-1, 2).tolist(), fix(tips[1:-1]).reshape(-1, 2).tolist()):
             cv2.line(paint, a, b, GAPS, 1, cv2.LINE_AA, SHIFT)  # gaps between the teeth
     # shade the far corners of the cavity and the teeth towards dark
-    cx = (np.arange(x0, x1) - (upper[0, 0] + upper[-1, 0]) / 2.0) / max(width / 2.0, 1.0)
-    shade = np.clip(1.15 - 0.6 * cx ** 2, 0.35, 1.0)[None, :, None]
-    paint = (paint * shade).astype(np.uint8)
-    alpha = (mask.astype(np.float32) / 255.0)[:, :, None]
+    cx = (np.arange(x0, x1, dtype=np.float32) - (upper[0, 0] + upper[-1, 0]) / 2.0) / max(width / 2.0, 1.0)
+    shade = np.clip(1.15 - 0.6 * cx ** 2, 0.35, 1.0).astype(np.float32)[None, :, None]
+    alpha = (mask * np.float32(1.0 / 255.0))[:, :, None]
     roi = out[y0:y1, x0:x1]
-    roi[:] = (roi * (1.0 - alpha) + paint * alpha).astype(np.uint8)
+    roi[:] = roi + alpha * (paint * shade - roi)
 
 
 def synthesize(actor: Actor, vertices: np.ndarray, pose: Pose, size: tuple[int, int],
