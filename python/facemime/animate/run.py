@@ -8,8 +8,8 @@ frame. Outputs appear only when complete.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
 from collections.abc import Iterable, Iterator
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -103,7 +103,8 @@ class SideBySide:
                 except NoFaceError as e:
                     raise NoFaceError(f"{e}; the video must start with a frontal face") from None
                 actor = self.analysis.actor
-                puppet = Puppet(self._target or actor, self.analysis.deformer.feature_sizes(), model_iod(actor.model))
+                driven = actor if self._target is None else self._target
+                puppet = Puppet(driven, self.analysis.deformer.feature_sizes(), model_iod(actor.model))
                 canvas = np.empty((h, 2 * w, 3), np.uint8)
                 synth = np.empty((h, w, 3), np.uint8)
                 motion = self.analysis.last
