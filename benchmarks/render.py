@@ -8,8 +8,9 @@ in the same run, on one core.
 Each frame: projection of the posed head (the pose changes every frame), background fill and
 the textured render. The background is a grey colour filled in place, as ``render_mesh`` does;
 copying a background image instead also pulls a second frame-sized buffer through the cache,
-which on a 2 MB L2 evicts much of the texture (about a quarter slower for facemime at 640x480). The face fills most of the frame. The last line of output is one JSON
-object for comparisons over time.
+which on a 2 MB L2 evicts much of the texture (about a quarter slower for facemime at 640x480).
+The face fills most of the frame. The last line of output is one JSON object for comparisons
+over time.
 """
 
 from __future__ import annotations

@@ -4,8 +4,8 @@ import pytest
 
 from facemime.errors import InvalidInputError
 from facemime.io import VideoWriter, check_outputs
-from facemime.io.video import VideoReader
 from facemime.io.outputs import OutputExistsError
+from facemime.io.video import VideoReader
 
 
 @pytest.mark.parametrize(("suffix", "codec"), [(".mp4", "h264"), (".webm", "vp9")])
