@@ -77,6 +77,7 @@ def frame_field(
     region: tuple[int, int, int, int],
     sigma: float,
     bands: list[tuple[int, int]] | None = None,
+    out: npt.NDArray[np.float32] | None = None,
 ) -> npt.NDArray[np.float32]: ...
 
 class SnakeSolver:

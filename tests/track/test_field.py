@@ -47,3 +47,19 @@ def test_the_region_covers_the_points_with_their_margin_inside_the_image():
     points = np.array([[10.2, 50.0], [90.7, 60.5]])
     assert region(points, 5.0, 100, 80) == (5, 45, 97, 67)
     assert region(np.array([[99.0, 79.0]]), 0.0, 100, 80) == (96, 76, 100, 80)
+
+
+def test_a_reused_buffer_gets_the_same_field_whatever_it_held(frames):
+    prev, frame = frames
+    box, bands = (150, 200, 400, 480), [(210, 260), (400, 470)]
+    want = build_field(frame, None, box, 1.5, bands)
+    buffer = np.full((280, 250, 6), np.nan, np.float32)
+    got = build_field(frame, None, box, 1.5, bands, out=buffer)
+    assert got is buffer
+    np.testing.assert_array_equal(got, want)
+    assert not got[100:140].any()  # rows between the bands are 0, not what the buffer held
+
+
+def test_a_buffer_of_the_wrong_shape_is_refused(frames):
+    with pytest.raises(ValueError, match="shape"):
+        build_field(frames[1], None, (100, 100, 160, 150), 1.5, out=np.zeros((50, 61, 6), np.float32))

@@ -6,7 +6,8 @@ use facemime_core::snake::{
     FIELD_CHANNELS,
 };
 use numpy::{
-    IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+    IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
+    PyReadonlyArray3, PyUntypedArrayMethods,
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -254,9 +255,10 @@ fn rgb_view<'a>(name: &str, img: &'a PyReadonlyArray3<'_, u8>) -> PyResult<Image
 
 /// The (y1 − y0, x1 − x0, FIELD_CHANNELS) float32 field of `frame` over `region`
 /// (x0, y0, x1, y1), only in the rows of `bands` ((b0, b1) frame rows) when given; see
-/// `facemime.track.field`.
+/// `facemime.track.field`. Written into `out` (a C-contiguous array of that shape, returned)
+/// when given, else into a new array.
 #[pyfunction]
-#[pyo3(signature = (frame, prev, region, sigma, bands=None))]
+#[pyo3(signature = (frame, prev, region, sigma, bands=None, out=None))]
 fn frame_field<'py>(
     py: Python<'py>,
     frame: PyReadonlyArray3<u8>,
@@ -264,15 +266,39 @@ fn frame_field<'py>(
     region: [usize; 4],
     sigma: f64,
     bands: Option<Vec<[usize; 2]>>,
+    out: Option<Bound<'py, PyArray3<f32>>>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
     let img = rgb_view("frame", &frame)?;
     let before = prev.as_ref().map(|p| rgb_view("prev", p)).transpose()?;
-    let flat = py
-        .detach(|| snake::frame_field(&img, before.as_ref(), region, sigma, bands.as_deref()))
+    let shape = snake::field_shape(&img, before.as_ref(), region, sigma).map_err(CoreErr)?;
+    let out = match out {
+        Some(o) if o.shape() != shape => {
+            return Err(err(format!(
+                "out must have shape {shape:?}, got {:?}",
+                o.shape()
+            )))
+        }
+        Some(o) => o,
+        None => PyArray3::zeros(py, shape, false),
+    };
+    {
+        let mut buf = out.try_readwrite()?;
+        let slice = buf
+            .as_slice_mut()
+            .map_err(|_| err("out must be a C-contiguous float32 array".into()))?;
+        py.detach(|| {
+            snake::frame_field(
+                &img,
+                before.as_ref(),
+                region,
+                sigma,
+                bands.as_deref(),
+                slice,
+            )
+        })
         .map_err(CoreErr)?;
-    let shape = (region[3] - region[1], region[2] - region[0], FIELD_CHANNELS);
-    let out = ndarray::Array3::from_shape_vec(shape, flat).expect("H x W x C");
-    Ok(out.into_pyarray(py))
+    }
+    Ok(out)
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -73,20 +73,18 @@ def _pose(p: np.ndarray) -> Pose:
 
 
 def fit_pose(model_points: np.ndarray, image_points: np.ndarray, start: Pose,
-             towards: tuple[float, float] = (0.0, 0.0)) -> tuple[Pose, float]:
+             towards: tuple[float, float] = (0.0, 0.0)) -> Pose:
     """The pose that maps (M, 3) ``model_points`` onto (M, 2) ``image_points`` (px): Gauss-Newton
     with Huber weights (:data:`HUBER`) from ``start`` (``facemime._core.fit_pose``, analytic
     Jacobian); yaw and pitch are held towards ``start``'s (weight :data:`ANGLE_PRIOR`) and
-    ``towards`` (weight :data:`RELAX`), degrees. Returns the pose and the median reprojection
-    error (px)."""
+    ``towards`` (weight :data:`RELAX`), degrees."""
     x = np.ascontiguousarray(model_points, np.float64)
     target = np.ascontiguousarray(image_points, np.float64)
     p = _params(start)
     anchor = (ANGLE_PRIOR * p[:2] + RELAX * np.asarray(towards)) / (ANGLE_PRIOR + RELAX)
     p = np.array(_core.fit_pose(x, target, tuple(p), tuple(anchor), ANGLE_PRIOR + RELAX, HUBER, GN_ITERATIONS))
     p[:2] = np.clip(p[:2], -75.0, 75.0)
-    err = np.hypot(*(project(x, _pose(p))[0] - target).T)
-    return _pose(p), float(np.median(err))
+    return _pose(p)
 
 
 class PoseTracker:
@@ -109,7 +107,6 @@ class PoseTracker:
         self._triangles = np.asarray(triangles, np.int64)
         self._frontal = pose
         self.pose = pose
-        self.error = 0.0
         self._known: dict[int, np.ndarray] = {}
         self._lift(motion.points, motion.ids)
 
@@ -130,7 +127,7 @@ class PoseTracker:
         ok = int(known.sum()) >= MIN_POINTS
         if ok:
             xyz = np.array([self._known[i] for i in ids[known].tolist()])
-            self.pose, self.error = fit_pose(xyz, np.asarray(points, np.float64)[known], self.pose,
+            self.pose = fit_pose(xyz, np.asarray(points, np.float64)[known], self.pose,
                                              towards=(self._frontal.yaw, self._frontal.pitch))
         current = set(motion.ids.tolist())
         self._known = {i: p for i, p in self._known.items() if i in current}

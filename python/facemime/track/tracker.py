@@ -218,6 +218,7 @@ class Tracker:
         self._mouth_rows = [i for i, n in enumerate(CONTOUR_NAMES) if n.startswith("mouth")]
         self._feature_rows = {f: np.array([CONTOUR_NAMES.index(n) for n in names]) for f, names in FEATURES.items()}
         self._solver, self._targets0 = self._build_solver()
+        self._field_buffer = np.empty(0, np.float32)
         gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
         self._motion = motion.HeadMotion(gray, contours) if p.motion else None
         self._prev = frame
@@ -289,7 +290,13 @@ class Tracker:
             ys = knots[idx, 1]
             bands.append((max(int(np.floor(ys.min() - margin)), 0), max(int(np.ceil(ys.max() + margin)) + 1, 0)))
         prev = self._prev if max(p.mouth.gamma, p.mouth_inner.gamma, p.brows.gamma) > 0 else None
-        return build_field(frame, prev, box, p.smoothing, bands), (float(box[0]), float(box[1]))
+        # One buffer reused frame after frame: a fresh megabyte-sized array each frame cost
+        # more in page faults than filling it.
+        size = (box[3] - box[1]) * (box[2] - box[0]) * _core.FIELD_CHANNELS
+        if self._field_buffer.size < size:
+            self._field_buffer = np.empty(size + size // 4, np.float32)
+        out = self._field_buffer[:size].reshape(box[3] - box[1], box[2] - box[0], _core.FIELD_CHANNELS)
+        return build_field(frame, prev, box, p.smoothing, bands, out), (float(box[0]), float(box[1]))
 
     def _responses(self, frame: np.ndarray, start: np.ndarray, rest: np.ndarray, down: np.ndarray, targets: np.ndarray) -> np.ndarray:
         fld, origin = self._field(frame, start)

@@ -15,19 +15,27 @@ use crate::raster::ImageRef;
 /// Largest Gaussian σ (pixels) accepted.
 pub const MAX_SIGMA: f64 = 16.0;
 
-/// The region `[x0, y0, x1, y1)` (pixels, exclusive ends) of `frame` as a row-major
-/// (y1 − y0, x1 − x0, [`FIELD_CHANNELS`]) float32 field smoothed by a Gaussian of `sigma`
-/// pixels. `frame` and `prev` are (H, W, 3) RGB; without `prev`, L′ = L. With `bands`, frame
-/// rows `[b0, b1)`, only the rows of the region inside a band are computed (the same values
-/// as without) and the others are 0: the snakes of a frame read two bands, brows and mouth.
+/// Writes into `out` the region `[x0, y0, x1, y1)` (pixels, exclusive ends) of `frame` as a
+/// row-major (y1 − y0, x1 − x0, [`FIELD_CHANNELS`]) float32 field smoothed by a Gaussian of
+/// `sigma` pixels. `frame` and `prev` are (H, W, 3) RGB; without `prev`, L′ = L. With `bands`,
+/// frame rows `[b0, b1)`, only the rows of the region inside a band are computed (the same
+/// values as without) and the others are set to 0: the snakes of a frame read two bands, brows
+/// and mouth. `out` may hold anything before: the tracker reuses one buffer frame after frame.
 pub fn frame_field(
     frame: &ImageRef,
     prev: Option<&ImageRef>,
     region: [usize; 4],
     sigma: f64,
     bands: Option<&[[usize; 2]]>,
-) -> Result<Vec<f32>> {
-    check(frame, prev, region, sigma)?;
+    out: &mut [f32],
+) -> Result<()> {
+    let size = field_shape(frame, prev, region, sigma)?.iter().product();
+    if out.len() != size {
+        return invalid!(
+            "the field of region {region:?} has {size} values, its buffer {}",
+            out.len()
+        );
+    }
     let [_, y0, _, y1] = region;
     let wanted: Vec<bool> = match bands {
         None => vec![true; y1 - y0],
@@ -36,11 +44,17 @@ pub fn frame_field(
             .collect(),
     };
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
+    if std::arch::is_x86_feature_detected!("avx512f") {
+        // SAFETY: AVX-512F is present.
+        unsafe { build_avx512(frame, prev, region, sigma, &wanted, out) };
+        return Ok(());
+    } else if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: AVX2 is present.
-        return Ok(unsafe { build_avx2(frame, prev, region, sigma, &wanted) });
+        unsafe { build_avx2(frame, prev, region, sigma, &wanted, out) };
+        return Ok(());
     }
-    Ok(build(frame, prev, region, sigma, &wanted))
+    build(frame, prev, region, sigma, &wanted, out);
+    Ok(())
 }
 
 /// The rows each stage needs for the output rows `wanted`: (rows smoothed, rows blurred
@@ -61,7 +75,14 @@ fn needed(wanted: &[bool], radius: usize) -> (Vec<bool>, Vec<bool>) {
     (smoothed, across)
 }
 
-fn check(frame: &ImageRef, prev: Option<&ImageRef>, region: [usize; 4], sigma: f64) -> Result<()> {
+/// The (rows, columns, channels) shape of [`frame_field`]'s output, once its arguments are
+/// checked.
+pub fn field_shape(
+    frame: &ImageRef,
+    prev: Option<&ImageRef>,
+    region: [usize; 4],
+    sigma: f64,
+) -> Result<[usize; 3]> {
     if frame.channels != 3 {
         return invalid!("the frame must be RGB (3 channels), got {}", frame.channels);
     }
@@ -89,7 +110,7 @@ fn check(frame: &ImageRef, prev: Option<&ImageRef>, region: [usize; 4], sigma: f
     if !(sigma > 0.0 && sigma <= MAX_SIGMA) {
         return invalid!("sigma must be in (0, {MAX_SIGMA}] pixels, got {sigma}");
     }
-    Ok(())
+    Ok([y1 - y0, x1 - x0, FIELD_CHANNELS])
 }
 
 /// OpenCV's Gaussian taps for a float image: side round(8σ + 1) | 1, computed in f64.
@@ -130,7 +151,7 @@ fn weighted(out: &mut [f32], taps: &[f32], rows: &[&[f32]]) {
 }
 
 /// Outputs per block of [`weighted`]: four AVX2 registers.
-const BLOCK: usize = 32;
+const BLOCK: usize = 64;
 
 /// Smooths the (h, w) plane `img` in place with the separable `taps`, in the rows `smoothed`
 /// (reading the rows `across`, which must hold all that they reach); `pad` and `rows` are
@@ -219,7 +240,8 @@ fn build(
     region: [usize; 4],
     sigma: f64,
     wanted: &[bool],
-) -> Vec<f32> {
+    out: &mut [f32],
+) {
     let [x0, y0, x1, y1] = region;
     let (w, h) = (x1 - x0, y1 - y0);
     let taps = gaussian(sigma);
@@ -244,7 +266,6 @@ fn build(
     }
     let (luma, chroma) = (&*luma, &*chroma);
     let before = if prev.is_some() { &*prev_luma } else { luma };
-    let mut out = Vec::with_capacity(w * h * FIELD_CHANNELS);
     let mut d = [
         vec![0.0f32; w],
         vec![0.0f32; w],
@@ -254,14 +275,15 @@ fn build(
     fn line(plane: &[f32], w: usize, y: usize) -> &[f32] {
         &plane[y * w..][..w]
     }
-    for (y, &want) in wanted.iter().enumerate() {
-        // Each row is zeroed just before it is filled, while it is in the cache.
-        let at = out.len();
-        out.resize(at + w * FIELD_CHANNELS, 0.0);
+    for (y, (o, &want)) in out
+        .chunks_exact_mut(w * FIELD_CHANNELS)
+        .zip(wanted)
+        .enumerate()
+    {
         if !want {
+            o.fill(0.0);
             continue;
         }
-        let o = &mut out[at..];
         // Central differences with mirrored borders: across an edge both neighbours are the
         // same pixel, so the first and last columns (and rows) get 0.
         let (up, down) = (reflect101(y as isize - 1, h), reflect101(y as isize + 1, h));
@@ -282,7 +304,6 @@ fn build(
         }
     }
     SCRATCH.set(scratch);
-    out
 }
 
 /// [`build`] compiled for AVX2; the same operations in the same order, so the same values.
@@ -294,13 +315,42 @@ fn build_avx2(
     region: [usize; 4],
     sigma: f64,
     wanted: &[bool],
-) -> Vec<f32> {
-    build(frame, prev, region, sigma, wanted)
+    out: &mut [f32],
+) {
+    build(frame, prev, region, sigma, wanted, out)
+}
+
+/// [`build`] compiled for AVX-512; the same operations in the same order, so the same values.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn build_avx512(
+    frame: &ImageRef,
+    prev: Option<&ImageRef>,
+    region: [usize; 4],
+    sigma: f64,
+    wanted: &[bool],
+    out: &mut [f32],
+) {
+    build(frame, prev, region, sigma, wanted, out)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`frame_field`] into a buffer of NaN: every value it leaves is one it wrote.
+    fn field(
+        img: &ImageRef,
+        prev: Option<&ImageRef>,
+        region: [usize; 4],
+        sigma: f64,
+        bands: Option<&[[usize; 2]]>,
+    ) -> Result<Vec<f32>> {
+        let size = (region[2] - region[0]) * (region[3] - region[1]) * FIELD_CHANNELS;
+        let mut out = vec![f32::NAN; size];
+        frame_field(img, prev, region, sigma, bands, &mut out)?;
+        Ok(out)
+    }
 
     fn rgb(w: usize, h: usize, f: impl Fn(usize, usize) -> [u8; 3]) -> Vec<u8> {
         (0..h)
@@ -324,7 +374,7 @@ mod tests {
         let (w, h) = (40, 30);
         let data = rgb(w, h, |x, y| [(2 * x + y) as u8, (x + y) as u8, 7]);
         let img = ImageRef::new(&data, w, h, 3).unwrap();
-        let f = frame_field(&img, None, [5, 4, 35, 26], 1.5, None).unwrap();
+        let f = field(&img, None, [5, 4, 35, 26], 1.5, None).unwrap();
         let (fw, at) = (30, |x: usize, y: usize, c: usize| {
             (y * 30 + x) * FIELD_CHANNELS + c
         });
@@ -351,7 +401,7 @@ mod tests {
             ImageRef::new(&a, w, h, 3).unwrap(),
             ImageRef::new(&b, w, h, 3).unwrap(),
         );
-        let f = frame_field(&fa, Some(&fb), [0, 0, w, h], 1.0, None).unwrap();
+        let f = field(&fa, Some(&fb), [0, 0, w, h], 1.0, None).unwrap();
         for px in f.chunks_exact(FIELD_CHANNELS) {
             assert!((px[5] - 100.0).abs() < 1e-3);
         }
@@ -371,8 +421,9 @@ mod tests {
         let region = [3, 2, 61, 45];
         let bands = [[10, 14], [40, 60]];
         let wanted: Vec<bool> = (2..45).map(|y| (10..14).contains(&y) || y >= 40).collect();
-        let portable = build(&img, Some(&img), region, 1.5, &wanted);
-        let got = frame_field(&img, Some(&img), region, 1.5, Some(&bands)).unwrap();
+        let mut portable = vec![f32::NAN; 58 * 43 * FIELD_CHANNELS];
+        build(&img, Some(&img), region, 1.5, &wanted, &mut portable);
+        let got = field(&img, Some(&img), region, 1.5, Some(&bands)).unwrap();
         assert_eq!(got, portable);
     }
 
@@ -381,10 +432,10 @@ mod tests {
         let data = textured(50, 60);
         let img = ImageRef::new(&data, 50, 60, 3).unwrap();
         let region = [4, 3, 46, 57];
-        let full = frame_field(&img, Some(&img), region, 1.5, None).unwrap();
+        let full = field(&img, Some(&img), region, 1.5, None).unwrap();
         // One band at the region's top edge, one inside, one past its bottom.
         let bands = [[0, 5], [20, 24], [55, 70]];
-        let part = frame_field(&img, Some(&img), region, 1.5, Some(&bands)).unwrap();
+        let part = field(&img, Some(&img), region, 1.5, Some(&bands)).unwrap();
         let row = FIELD_CHANNELS * (region[2] - region[0]);
         for (i, (a, b)) in full.chunks(row).zip(part.chunks(row)).enumerate() {
             let y = i + region[1];
@@ -406,7 +457,7 @@ mod tests {
         );
         let field = |d: &[u8], region, bands: Option<&[[usize; 2]]>| {
             let img = ImageRef::new(d, 50, 60, 3).unwrap();
-            frame_field(&img, Some(&img), region, 1.5, bands).unwrap()
+            field(&img, Some(&img), region, 1.5, bands).unwrap()
         };
         let bands = [[8, 12], [30, 41]];
         let moved = data.clone();
@@ -424,11 +475,13 @@ mod tests {
         let img = ImageRef::new(&data, 8, 8, 3).unwrap();
         let gray = ImageRef::new(&data[..64], 8, 8, 1).unwrap();
         let small = ImageRef::new(&data[..48], 4, 4, 3).unwrap();
-        assert!(frame_field(&gray, None, [0, 0, 8, 8], 1.0, None).is_err());
-        assert!(frame_field(&img, Some(&small), [0, 0, 8, 8], 1.0, None).is_err());
-        assert!(frame_field(&img, None, [0, 0, 9, 8], 1.0, None).is_err());
-        assert!(frame_field(&img, None, [3, 0, 4, 8], 1.0, None).is_err());
-        assert!(frame_field(&img, None, [0, 0, 8, 8], 0.0, None).is_err());
-        assert!(frame_field(&img, None, [0, 0, 8, 8], f64::NAN, None).is_err());
+        assert!(field(&gray, None, [0, 0, 8, 8], 1.0, None).is_err());
+        assert!(field(&img, Some(&small), [0, 0, 8, 8], 1.0, None).is_err());
+        assert!(field(&img, None, [0, 0, 9, 8], 1.0, None).is_err());
+        assert!(field(&img, None, [3, 0, 4, 8], 1.0, None).is_err());
+        assert!(field(&img, None, [0, 0, 8, 8], 0.0, None).is_err());
+        assert!(field(&img, None, [0, 0, 8, 8], f64::NAN, None).is_err());
+        let mut short = vec![0.0; 8 * 8 * FIELD_CHANNELS - 1];
+        assert!(frame_field(&img, None, [0, 0, 8, 8], 1.0, None, &mut short).is_err());
     }
 }

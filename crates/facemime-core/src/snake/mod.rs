@@ -15,5 +15,5 @@ mod solver;
 
 pub use energy::{CurveParams, Operator, PairKind, PairSpec};
 pub use field::{Field, FIELD_CHANNELS};
-pub use frame_field::{frame_field, MAX_SIGMA};
+pub use frame_field::{field_shape, frame_field, MAX_SIGMA};
 pub use solver::{FrameInput, Problem, Settings, Solution};
