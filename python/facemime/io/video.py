@@ -12,6 +12,7 @@ from types import TracebackType
 import av
 import cv2
 import numpy as np
+from av.video.reformatter import VideoReformatter
 
 from facemime.errors import InputFileError, InvalidInputError
 from facemime.io.outputs import temporary_sibling
@@ -119,6 +120,8 @@ class VideoReader:
         rate = self._stream.average_rate or self._stream.guessed_rate
         self.fps = float(rate) if rate else 25.0
         self.frames = int(self._stream.frames or 0)
+        # One converter for all frames: ``VideoFrame.to_ndarray`` sets up a new one per frame.
+        self._to_rgb = VideoReformatter()
         if self.width <= 0 or self.height <= 0:
             self._container.close()
             raise InputFileError(f"cannot read video {self.path}: no frame size in its stream")
@@ -127,7 +130,7 @@ class VideoReader:
         try:
             for frame in self._container.decode(self._stream):
                 # One thread: FFmpeg's threaded conversion costs twice the time on a small frame.
-                yield frame.to_ndarray(format="rgb24", threads=1)
+                yield self._to_rgb.reformat(frame, format="rgb24", threads=1).to_ndarray()
         except (av.FFmpegError, OSError) as e:
             raise InputFileError(f"cannot decode video {self.path}: {_reason(e)}") from None
 
