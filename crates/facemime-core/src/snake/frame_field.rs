@@ -150,7 +150,7 @@ fn weighted(out: &mut [f32], taps: &[f32], rows: &[&[f32]]) {
     }
 }
 
-/// Outputs per block of [`weighted`]: four AVX2 registers.
+/// Outputs per block of [`weighted`]: four AVX2 registers (two AVX-512 ones).
 const BLOCK: usize = 64;
 
 /// Smooths the (h, w) plane `img` in place with the separable `taps`, in the rows `smoothed`
@@ -415,7 +415,7 @@ mod tests {
     }
 
     #[test]
-    fn avx2_equals_portable() {
+    fn simd_equals_portable() {
         let data = textured(64, 48);
         let img = ImageRef::new(&data, 64, 48, 3).unwrap();
         let region = [3, 2, 61, 45];
@@ -425,6 +425,32 @@ mod tests {
         build(&img, Some(&img), region, 1.5, &wanted, &mut portable);
         let got = field(&img, Some(&img), region, 1.5, Some(&bands)).unwrap();
         assert_eq!(got, portable);
+        // Each SIMD build this machine has, not only the one `frame_field` picks.
+        #[cfg(target_arch = "x86_64")]
+        {
+            type Build =
+                unsafe fn(&ImageRef, Option<&ImageRef>, [usize; 4], f64, &[bool], &mut [f32]);
+            let builds: [(&str, bool, Build); 2] = [
+                (
+                    "avx2",
+                    std::arch::is_x86_feature_detected!("avx2"),
+                    build_avx2,
+                ),
+                (
+                    "avx512f",
+                    std::arch::is_x86_feature_detected!("avx512f"),
+                    build_avx512,
+                ),
+            ];
+            for (name, present, build) in builds {
+                if present {
+                    let mut out = vec![f32::NAN; portable.len()];
+                    // SAFETY: the CPU has the build's feature.
+                    unsafe { build(&img, Some(&img), region, 1.5, &wanted, &mut out) };
+                    assert_eq!(out, portable, "{name}");
+                }
+            }
+        }
     }
 
     #[test]
