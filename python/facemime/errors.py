@@ -17,3 +17,7 @@ class InputFileError(FacemimeError, FileNotFoundError):
 
 class ModelFormatError(FacemimeError, ValueError):
     """A model file (generic head JSON, CANDIDE .wfm) is malformed."""
+
+
+class OutputFileError(FacemimeError, OSError):
+    """An output file cannot be written (a full disk, a failing encoder)."""

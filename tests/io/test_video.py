@@ -2,7 +2,7 @@ import av
 import numpy as np
 import pytest
 
-from facemime.errors import InvalidInputError
+from facemime.errors import InvalidInputError, OutputFileError
 from facemime.io import VideoWriter, check_outputs
 from facemime.io.outputs import OutputExistsError
 from facemime.io.video import VideoReader
@@ -45,6 +45,30 @@ def test_failed_write_leaves_nothing(tmp_path):
     with pytest.raises(RuntimeError), VideoWriter(path, fps=10) as w:
         w.write(np.zeros((16, 16, 3), np.uint8))
         raise RuntimeError("interrupted")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_reused_frame_buffer_is_written_as_it_was_at_each_write(tmp_path):
+    """Frames are encoded beside the caller's work; the caller may refill its buffer at once."""
+    buffer = np.empty((16, 32, 3), np.uint8)
+    with VideoWriter(tmp_path / "c.mp4", fps=25) as w:
+        for level in (20, 120, 220, 70):
+            buffer[...] = level
+            w.write(buffer)
+    with VideoReader(tmp_path / "c.mp4") as r:
+        levels = [int(f.mean().round()) for f in r]
+    assert np.allclose(levels, [20, 120, 220, 70], atol=3), levels
+
+
+def test_an_encoding_error_is_one_line_and_leaves_nothing(tmp_path, monkeypatch):
+    def disk_full(*args, **kwargs):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(av.VideoFrame, "from_ndarray", disk_full)
+    with pytest.raises(OutputFileError, match=r"cannot write video .*clip\.mp4: No space left on device"):
+        with VideoWriter(tmp_path / "clip.mp4", fps=25) as w:
+            for _ in range(3 * VideoWriter.QUEUED):  # more than the queue holds: no writer waits forever
+                w.write(np.zeros((16, 16, 3), np.uint8))
     assert list(tmp_path.iterdir()) == []
 
 

@@ -39,7 +39,7 @@ NO_FACE_DIM = 0.45
 class RunResult:
     """What :func:`run_video` did: frames, frames without a face, the files written, warnings,
     and seconds per stage (``decode``, ``track``, ``pose``, ``synth``, ``compose``, ``fit``,
-    ``encode``)."""
+    ``encode``: handing frames to the encoder, which encodes them on its own thread)."""
 
     frames: int
     frames_without_face: int

@@ -4,9 +4,11 @@
 from __future__ import annotations
 
 import os
+import queue
+import threading
 from fractions import Fraction
 from pathlib import Path
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from types import TracebackType
 
 import av
@@ -14,7 +16,7 @@ import cv2
 import numpy as np
 from av.video.reformatter import VideoReformatter
 
-from facemime.errors import InputFileError, InvalidInputError
+from facemime.errors import InputFileError, InvalidInputError, OutputFileError
 from facemime.io.outputs import temporary_sibling
 
 CODECS = {".mp4": ("libx264", {"crf": "20", "preset": "veryfast", "movflags": "+faststart"}),
@@ -26,6 +28,10 @@ class VideoWriter:
     writer closes without an error (a failed run leaves nothing behind).
 
     Frame sizes must be even (4:2:0); odd sizes are padded by one pixel of the edge colour.
+    Frames are encoded on a thread of the writer's own, beside the caller's work: :meth:`write`
+    converts a frame to the encoder's 4:2:0 layout (so the caller may reuse its buffer at once)
+    and waits only while :data:`QUEUED` frames are still to be encoded. An encoding error is
+    raised by the next :meth:`write` or on closing.
 
     >>> import tempfile, pathlib
     >>> out = pathlib.Path(tempfile.mkdtemp()) / "clip.mp4"
@@ -35,6 +41,9 @@ class VideoWriter:
     >>> out.stat().st_size > 0
     True
     """
+
+    #: Frames converted and waiting for the encoder at most.
+    QUEUED = 4
 
     def __init__(self, path: str | Path, fps: float):
         self.path = Path(path)
@@ -46,6 +55,10 @@ class VideoWriter:
         self._tmp: Path | None = None
         self._container = None
         self._stream = None
+        self._queue: queue.Queue[np.ndarray | None] = queue.Queue(self.QUEUED)
+        self._encoder: threading.Thread | None = None
+        self._error: BaseException | None = None
+        self._cancelled = False
         self.frames = 0
 
     def __enter__(self) -> "VideoWriter":
@@ -56,6 +69,7 @@ class VideoWriter:
         """Append one (H, W, 3) uint8 RGB frame; every frame must have the first one's size."""
         if not (isinstance(frame, np.ndarray) and frame.dtype == np.uint8 and frame.ndim == 3 and frame.shape[2] == 3):
             raise InvalidInputError(f"video frames must be (H, W, 3) uint8 RGB, got {getattr(frame, 'shape', frame)}")
+        self._raise_error()
         h, w = frame.shape[:2]
         if h % 2 or w % 2:
             frame = np.pad(frame, ((0, h % 2), (0, w % 2), (0, 0)), mode="edge")
@@ -68,23 +82,49 @@ class VideoWriter:
             self._stream.width, self._stream.height = frame.shape[1], frame.shape[0]
             self._stream.pix_fmt = "yuv420p"
             self._stream.options = {k: v for k, v in options.items() if k != "movflags"}
+            self._encoder = threading.Thread(target=self._encode, name=f"encoder {self.path.name}", daemon=True)
+            self._encoder.start()
         elif (frame.shape[1], frame.shape[0]) != (self._stream.width, self._stream.height):
             raise InvalidInputError(f"video frame size changed from {self._stream.width}x{self._stream.height} to {w}x{h}")
         # OpenCV's RGB -> I420 (BT.601, limited range, as FFmpeg's default) takes a tenth of
         # the time of the encoder's own conversion.
-        i420 = cv2.cvtColor(np.ascontiguousarray(frame), cv2.COLOR_RGB2YUV_I420)
-        for packet in self._stream.encode(av.VideoFrame.from_ndarray(i420, format="yuv420p")):
-            self._container.mux(packet)
+        self._queue.put(cv2.cvtColor(np.ascontiguousarray(frame), cv2.COLOR_RGB2YUV_I420))
         self.frames += 1
+
+    def _encode(self) -> None:
+        """The encoder thread: encodes queued frames until None, then flushes the encoder. After
+        an error, or once cancelled, it keeps taking frames (so that no writer waits forever)
+        and encodes none."""
+        while (i420 := self._queue.get()) is not None:
+            if self._error is None and not self._cancelled:
+                self._guarded(lambda: self._stream.encode(av.VideoFrame.from_ndarray(i420, format="yuv420p")))
+        if self._error is None and not self._cancelled:
+            self._guarded(lambda: self._stream.encode())
+
+    def _guarded(self, encode: Callable[[], list]) -> None:
+        """Mux the packets ``encode`` gives; keep an error for the writer's thread to raise."""
+        try:
+            for packet in encode():
+                self._container.mux(packet)
+        except (av.FFmpegError, OSError) as e:
+            self._error = OutputFileError(f"cannot write video {self.path}: {_reason(e)}")
+        except BaseException as e:  # noqa: BLE001 (an unexpected error, raised as it is)
+            self._error = e
+
+    def _raise_error(self) -> None:
+        if self._error is not None:
+            raise self._error
 
     def __exit__(self, exc_type: type | None, exc: BaseException | None, tb: TracebackType | None) -> None:
         try:
+            if self._encoder is not None:
+                self._cancelled = exc_type is not None
+                self._queue.put(None)
+                self._encoder.join()
             if self._container is not None:
-                if exc_type is None:
-                    for packet in self._stream.encode():
-                        self._container.mux(packet)
                 self._container.close()
             if exc_type is None:
+                self._raise_error()
                 if self.frames == 0:
                     raise InvalidInputError(f"no frames were written to {self.path}")
                 os.replace(self._tmp, self.path)
