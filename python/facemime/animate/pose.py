@@ -128,7 +128,7 @@ class PoseTracker:
         if ok:
             xyz = np.array([self._known[i] for i in ids[known].tolist()])
             self.pose = fit_pose(xyz, np.asarray(points, np.float64)[known], self.pose,
-                                             towards=(self._frontal.yaw, self._frontal.pitch))
+                                 towards=(self._frontal.yaw, self._frontal.pitch))
         current = set(motion.ids.tolist())
         self._known = {i: p for i, p in self._known.items() if i in current}
         self._lift(np.asarray(motion.points, np.float64), motion.ids)
