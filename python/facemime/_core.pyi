@@ -53,6 +53,17 @@ class FlowFrames:
         min_eigen: float,
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...
 
+def find_lip_edges(
+    frame: npt.NDArray[np.uint8],
+    colour: tuple[float, float, float],
+    points: npt.NDArray[np.float64],
+    normals: npt.NDArray[np.float64],
+    signs: npt.NDArray[np.float64],
+    expect: npt.NDArray[np.float64],
+    reach: float,
+    sigma: float,
+    min_step: float,
+) -> npt.NDArray[np.float64]: ...
 def robust_similarity(
     src: npt.NDArray[np.float64],
     dst: npt.NDArray[np.float64],

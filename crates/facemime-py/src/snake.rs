@@ -245,7 +245,10 @@ impl<'a> FrameArgs<'a> {
 }
 
 /// A (H, W, 3) C-contiguous uint8 frame as a core image view.
-fn rgb_view<'a>(name: &str, img: &'a PyReadonlyArray3<'_, u8>) -> PyResult<ImageRef<'a>> {
+pub(crate) fn rgb_view<'a>(
+    name: &str,
+    img: &'a PyReadonlyArray3<'_, u8>,
+) -> PyResult<ImageRef<'a>> {
     let shape = img.as_array().shape().to_vec();
     let data = img
         .as_slice()

@@ -8,7 +8,9 @@ Per frame:
    previous knots (the snakes' start and their temporal anchor) and the rest shape (the first
    frame's knots carried along by the accumulated head motion; each mouth feature's rest shape
    also follows, in part, the affine change of its knots, so an "O" or a wide-open mouth is not
-   pulled back to the neutral shape);
+   pulled back to the neutral shape); a mouth knot the optical flow could not follow starts at
+   the lip edge found along its curve's normal on a lip-colour score
+   (:mod:`facemime.track.lips`);
 2. the sign-descent solver (``facemime._core.SnakeSolver``) moves every knot at most δ0/(1−σ) px
    per pass: one pass for the brows, ``mouth_passes`` for the mouth, whose lips move fastest;
 3. each feature's confidence is its mean edge response relative to the first frame's; a feature
@@ -36,6 +38,7 @@ from facemime.metrics import resample
 from facemime.track import motion
 from facemime.track.contours import CONTOUR_NAMES, FEATURES, POLARITY
 from facemime.track.field import build_field, region
+from facemime.track.lips import LipSearch
 
 OPERATORS = ("directional", "magnitude")
 #: The mouth gets another solver pass only when a knot moved this fraction of a pass's reach.
@@ -79,6 +82,10 @@ class TrackerParams:
     shape. ``mouth_passes``: solver passes per frame for the mouth at most, each moving a knot
     at most δ0/(1−σ), so a fast-opening mouth can be followed; a pass follows only when a mouth
     knot moved :data:`FAST` of that reach in the previous one (the brows keep the first pass).
+    ``lip_reach``: a mouth knot the flow could not follow (its forward-backward check failed)
+    starts at the lip edge found on a lip-colour score within ± this fraction of the mouth's
+    width along its curve's normal (:mod:`facemime.track.lips`; 0: off); ``lip_step``: the
+    smallest such edge, in skin standard deviations per px.
     ``iterations``, ``tol``: each solver pass runs at most ``iterations`` steps, and a feature
     stops early once its own energy changes by less than ``tol`` between steps (0: never;
     measured on the six videos, stopping at 1e-4 raised the outer mouth's failure rate from 2.9%
@@ -106,6 +113,8 @@ class TrackerParams:
     calibration_passes: int = 3
     mouth_affine: float = 0.7
     mouth_passes: int = 2
+    lip_reach: float = 0.3
+    lip_step: float = 0.3
 
     def with_(self, **changes: object) -> "TrackerParams":
         """A copy with some settings changed."""
@@ -232,6 +241,9 @@ class Tracker:
         self._offset = edges - self._knots0
         self._knots0 = edges
         self._knots = edges.copy()
+        self._lips = None
+        if p.lip_reach > 0:
+            self._lips = LipSearch(frame, contours, self._index, edges, p.lip_reach, p.lip_step)
         self._linear = np.eye(2)
         self._down = self._down0
         self._response0 = np.maximum(self._responses(frame, edges, edges, self._down0, self._targets0), 1e-6)
@@ -328,6 +340,8 @@ class Tracker:
         if flow is not None:
             followed = np.isfinite(flow[:, 0])
             start[followed] = flow[followed]
+            if self._lips is not None:
+                self._lips.move(frame, start, ~followed, scale)
         start = np.clip(start, 0.0, bounds_hi)
         carried = motion.apply(total, self._knots0)
         rest = self._mouth_rest(carried, start)

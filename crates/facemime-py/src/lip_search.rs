@@ -1,0 +1,71 @@
+//! Bindings of `facemime_core::lip_search`: the lip-edge search along the mouth knots' normals.
+
+use facemime_core::lip_search::{self, LipColour, Probe, SearchSettings};
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use crate::error::CoreErr;
+use crate::points::rows;
+use crate::snake::rgb_view;
+
+/// frame: (H, W, 3) uint8 RGB; colour: (w_r, w_g, bias) of the lip score; points, normals:
+/// (K, 2) pixels and unit vectors; signs: (K,) +1 for a score rising along the normal, −1 for
+/// one falling; expect: (K,) offsets (px) to search nearest to; reach, sigma (px), min_step.
+/// Returns the (K,) offsets (px along the normals), NaN where no transition was found.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn find_lip_edges<'py>(
+    py: Python<'py>,
+    frame: PyReadonlyArray3<u8>,
+    colour: [f64; 3],
+    points: PyReadonlyArray2<f64>,
+    normals: PyReadonlyArray2<f64>,
+    signs: PyReadonlyArray1<f64>,
+    expect: PyReadonlyArray1<f64>,
+    reach: f64,
+    sigma: f64,
+    min_step: f64,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let img = rgb_view("frame", &frame)?;
+    let (at, normal) = (
+        rows::<2>("points", &points)?,
+        rows::<2>("normals", &normals)?,
+    );
+    let (signs, expect) = (signs.as_array(), expect.as_array());
+    let k = at.len();
+    if normal.len() != k || signs.len() != k || expect.len() != k {
+        return Err(PyValueError::new_err(format!(
+            "points, normals, signs and expect must have the same length, got {k}, {}, {} and {}",
+            normal.len(),
+            signs.len(),
+            expect.len()
+        )));
+    }
+    let probes: Vec<Probe> = (0..k)
+        .map(|i| Probe {
+            at: at[i],
+            normal: normal[i],
+            sign: signs[i],
+            expect: expect[i],
+        })
+        .collect();
+    let colour = LipColour {
+        weights: [colour[0], colour[1]],
+        bias: colour[2],
+    };
+    let settings = SearchSettings {
+        reach,
+        sigma,
+        min_step,
+    };
+    let found = py
+        .detach(|| lip_search::find_edges(&img, &colour, &probes, &settings))
+        .map_err(CoreErr)?;
+    Ok(found.into_pyarray(py))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(find_lip_edges, m)?)?;
+    Ok(())
+}
