@@ -111,7 +111,7 @@ class LipSearch:
         normal = np.stack([-along[:, 1], along[:, 0]], axis=1)  # curves run left to right: down
         pick = np.flatnonzero(which) + 1
         out = np.full(len(pts), np.nan)
-        reach = self._reach * scale
+        reach = max(self._reach * scale, SIGMA)  # the core takes σ ≤ reach, and a head may shrink
         # Outside the outer lips lies skin only: their edge is the outermost lip-skin transition
         # (the transitions nearer the mouth are those of the teeth and the opening).
         expect = OUTERMOST[name] * reach if name in OUTERMOST else self._offset0[name][pick] * scale
