@@ -13,12 +13,16 @@ Per frame:
    (:mod:`facemime.track.lips`);
 2. the sign-descent solver (``facemime._core.SnakeSolver``) moves every knot at most δ0/(1−σ) px
    per pass: one pass for the brows, ``mouth_passes`` for the mouth, whose lips move fastest;
-3. each feature's confidence is its mean edge response relative to the first frame's; a feature
-   whose confidence collapses or whose shape degenerates is flagged ``lost``, so that it never
-   drifts silently. A lost brow goes back to its first-frame shape carried by the head motion,
-   from where the next frame's snakes find it again (a brow that slid onto the eye otherwise
-   stays there); a lost mouth stays where it is (measured: its rest shape follows the head, not
-   the mouth, and resetting it made the tracks worse).
+3. each feature's confidence is its mean edge response relative to the first frame's. A brow
+   one of whose curves lost its edge (a brow raised fast, a head that jumped between frames) is
+   looked for again by matching the first frame's brow around where the head motion put it
+   (:mod:`facemime.track.brows`) and settled there by another solver run, kept when its
+   confidence rose. A feature whose confidence still collapses or whose shape degenerates is
+   flagged ``lost``, so that it never drifts silently. A lost brow goes to where the search
+   matched it, or else to its first-frame shape carried by the head motion, from where the next
+   frame's snakes find it again (a brow that slid onto the eye otherwise stays there); a lost
+   mouth stays where it is (measured: its rest shape follows the head, not the mouth, and
+   resetting it made the tracks worse).
 
 Coordinates are (x, y) pixels, origin at the centre of the top-left pixel, y down.
 """
@@ -36,6 +40,7 @@ from facemime import _core, validate
 from facemime.errors import InvalidInputError
 from facemime.metrics import resample
 from facemime.track import motion
+from facemime.track.brows import BrowSearch
 from facemime.track.contours import CONTOUR_NAMES, FEATURES, POLARITY
 from facemime.track.field import build_field, region
 from facemime.track.lips import LipSearch
@@ -85,7 +90,9 @@ class TrackerParams:
     ``lip_reach``: a mouth knot the flow could not follow (its forward-backward check failed)
     starts at the lip edge found on a lip-colour score within ± this fraction of the mouth's
     width along its curve's normal (:mod:`facemime.track.lips`; 0: off); ``lip_step``: the
-    smallest such edge, in skin standard deviations per px.
+    smallest such edge, in skin standard deviations per px. ``brow_search``: a brow whose
+    confidence falls below this (or whose shape degenerates) is looked for again by matching the
+    first frame's brow around where the head motion put it (:mod:`facemime.track.brows`; 0: off).
     ``iterations``, ``tol``: each solver pass runs at most ``iterations`` steps, and a feature
     stops early once its own energy changes by less than ``tol`` between steps (0: never;
     measured on the six videos, stopping at 1e-4 raised the outer mouth's failure rate from 2.9%
@@ -115,6 +122,7 @@ class TrackerParams:
     mouth_passes: int = 2
     lip_reach: float = 0.3
     lip_step: float = 0.3
+    brow_search: float = 0.3
 
     def with_(self, **changes: object) -> "TrackerParams":
         """A copy with some settings changed."""
@@ -124,7 +132,8 @@ class TrackerParams:
 @dataclass
 class FrameResult:
     """One frame's output: ``contours`` name -> (N, 2) float64 pixels; ``confidence`` feature ->
-    0..1; ``lost`` features flagged in this frame (a lost brow is reported on its rest shape);
+    0..1; ``lost`` features flagged in this frame (a lost brow is reported where the brow search
+    matched it, or else on its rest shape);
     ``iterations`` the solver ran; ``motion_ok`` whether the head motion was measured."""
 
     index: int
@@ -247,6 +256,7 @@ class Tracker:
         self._linear = np.eye(2)
         self._down = self._down0
         self._response0 = np.maximum(self._responses(frame, edges, edges, self._down0, self._targets0), 1e-6)
+        self._brow_search = {f: BrowSearch(gray, edges[self._features[f]]) for f in ("brow_left", "brow_right")}
         self._reported = self.contours
 
     def _build_solver(self) -> tuple[_core.SnakeSolver, np.ndarray]:
@@ -328,8 +338,8 @@ class Tracker:
         p = self.params
         self.frame_index += 1
         step, ok, flow = motion.IDENTITY, True, None
+        gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
         if self._motion is not None:
-            gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
             step, ok, flow = self._motion.update(gray, self._reported, self._knots if p.knot_flow else None)
         total = self._motion.total if self._motion is not None else motion.IDENTITY
         scale = math.sqrt(abs(total[0, 0] * total[1, 1] - total[0, 1] * total[1, 0]))
@@ -361,12 +371,25 @@ class Tracker:
         confidence, lost = {}, []
         ratio = np.clip(resp / self._response0, 0.0, 1.0)
         for feature, names in FEATURES.items():
-            conf = float(ratio[self._feature_rows[feature]].mean())
+            rows, idx = self._feature_rows[feature], self._features[feature]
+            conf = float(ratio[rows].mean())
+            fallback = carried
+            search = self._brow_search.get(feature)
+            if search is not None and (ratio[rows].min() < p.brow_search or not self._shape_ok(knots, carried, names)):
+                found = search.find(gray, scale, start[idx])
+                if found is not None:
+                    fallback = knots.copy()
+                    fallback[idx] = found
+                    again, more, again_resp = self._solve(*self._field(frame, fallback), fallback, rest, down, targets)
+                    iters += more
+                    conf_again = float(np.clip(again_resp[rows] / self._response0[rows], 0.0, 1.0).mean())
+                    if conf_again > conf or not self._shape_ok(knots, carried, names):
+                        knots[idx], conf = again[idx], conf_again
             confidence[feature] = conf
             if conf < p.lost_response or not self._shape_ok(knots, carried, names):
                 lost.append(feature)
                 if feature.startswith("brow"):
-                    knots[self._features[feature]] = carried[self._features[feature]]
+                    knots[idx] = fallback[idx]
         self._knots = knots
         self._linear = total[:, :2]
         self._down = down
