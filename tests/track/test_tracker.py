@@ -182,8 +182,6 @@ def test_bad_frames_are_refused():
 def test_tracks_a_real_talking_face(shared, name, count):
     # lp_d0 opens her mouth wide and closes it again: with a rest shape that could not change
     # (TrackerParams(mouth_affine=0)) the inner lips stayed behind (mean NME 0.044, max 0.08).
-    # vr_2's worst frame (inner mouth 0.075, frame 24) follows a lip-edge search that took a
-    # shadow below the lower lip for one knot (frame 18).
     from facemime.io.video import VideoReader
     from facemime.track.contours import from_face_mesh as reference_contours
 
@@ -197,4 +195,4 @@ def test_tracks_a_real_talking_face(shared, name, count):
         for g, names in GROUPS.items():
             errors[g].append(group_nme(result.contours, reference_contours(z["landmarks"][i]), names, float(z["iod"][i])))
     for g, e in errors.items():
-        assert np.mean(e) < 0.03 and max(e) < 0.08, g
+        assert np.mean(e) < 0.03 and max(e) < 0.06, g

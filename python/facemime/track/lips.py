@@ -5,6 +5,14 @@ forward-backward check fails, and the snakes, which reach only δ0/(1−σ) px p
 the closed mouth. Such a knot is moved instead along its curve's normal to the nearest lip edge
 of that curve's polarity on a lip-colour score (``facemime._core.find_lip_edges``).
 
+A lip can also be left behind while the flow follows it. As the mouth opens on teeth, an outer
+lip's knots can stay on the lip's inner edge (the teeth's edge has the same luma polarity as the
+skin-lip edge): the lip colour then continues outside them, and they are moved to the outermost
+lip-skin transition. The inner lips' knots can stay on the teeth near where the lips met: the
+lip is then much thicker than it was, and an inner knot farther from its outer lip than
+:data:`THICKER` first-frame lip thicknesses is moved to the lip edge found nearest one such
+thickness inside the outer lip.
+
 The score is a linear discriminant (Fisher's) of the chromaticities r = R/(R+G+B+1),
 g = G/(R+G+B+1), fitted on the first frame between the lip pixels (between the outer and inner
 mouth contours) and the skin around the mouth (:data:`SKIN_RING`): positive on lips, negative on
@@ -33,6 +41,49 @@ SIGMA = 1.5  # px: smoothing of the score along the normal
 #: The outer curves' edges are searched outermost first: above (−1) or below (+1) along the normal.
 OUTERMOST = {"mouth_outer_upper": -1.0, "mouth_outer_lower": +1.0}
 MOUTH = ("mouth_outer_upper", "mouth_outer_lower", "mouth_inner_upper", "mouth_inner_lower")
+#: Each inner lip curve and the outer one on the same lip.
+LIP_PAIRS = {"mouth_inner_upper": "mouth_outer_upper", "mouth_inner_lower": "mouth_outer_lower"}
+#: An inner knot farther from its outer lip than this many first-frame lip thicknesses is
+#: searched for again.
+THICKER = 1.8
+#: An outer knot is searched for again when the lip score this many of its first-frame lip
+#: thicknesses (at least 2 px) outside it exceeds :data:`LIP_OUTSIDE` (skin standard
+#: deviations): it lies inside its lip. Measured on the six videos: gates of 0.75 to 1.5 at
+#: probes of 0.6 to 1.5 thicknesses track alike; a gate of 0.5 took a shadow under vr_2's
+#: lower lip.
+PROBE = 0.75
+LIP_OUTSIDE = 1.0
+#: (dx, dy) of the 3×3 pixels averaged at a probe.
+_NINE = np.stack(np.meshgrid([-1, 0, 1], [-1, 0, 1]), axis=-1).reshape(-1, 2)
+
+
+def _normals(pts: np.ndarray) -> np.ndarray:
+    """(N, 2) unit normals of a curve running image-left to image-right: pointing down."""
+    along = np.empty_like(pts)  # central differences, one-sided at the ends (np.gradient's, unhalved)
+    along[1:-1] = pts[2:] - pts[:-2]
+    along[0], along[-1] = pts[1] - pts[0], pts[-1] - pts[-2]
+    along /= np.maximum(np.sqrt((along * along).sum(axis=1, keepdims=True)), 1e-9)
+    return np.stack([-along[:, 1], along[:, 0]], axis=1)
+
+
+def normal_gaps(pts: np.ndarray, normals: np.ndarray, curve: np.ndarray) -> np.ndarray:
+    """For each of ``pts`` (N, 2) px, the signed distance t (px) along its unit normal to the
+    nearest crossing of the polyline ``curve`` (M, 2): pts + t·normal lies on it; NaN where
+    the normal's line misses the polyline."""
+    a = curve[:-1]
+    e = curve[1:] - a  # (M-1, 2) segments
+    rx, ry = a[None, :, 0] - pts[:, None, 0], a[None, :, 1] - pts[:, None, 1]  # (N, M-1)
+    nx, ny = normals[:, None, 0], normals[:, None, 1]
+    # pts + t·n = a + s·e, by Cramer's rule: t = num_t / det, s = num_s / det
+    det = ny * e[:, 0] - nx * e[:, 1]
+    num_t = ry * e[:, 0] - rx * e[:, 1]
+    num_s = nx * ry - ny * rx
+    # 0 ≤ s ≤ 1 without dividing: num_s and det of one sign, |num_s| ≤ |det| (det ≠ 0)
+    crossed = (num_s * det >= 0.0) & (np.abs(num_s) <= np.abs(det)) & (det != 0.0)
+    t = np.full(det.shape, np.inf)
+    np.divide(num_t, det, out=t, where=crossed)
+    best = t[np.arange(len(t)), np.argmin(np.abs(t), axis=1)]
+    return np.where(np.isfinite(best), best, np.nan)
 
 
 def _polygon_mask(shape: tuple[int, int], upper: np.ndarray, lower: np.ndarray) -> np.ndarray:
@@ -75,7 +126,7 @@ def lip_colour(frame: np.ndarray, contours: Mapping[str, np.ndarray]) -> tuple[f
 
 
 class LipSearch:
-    """Moves mouth knots the flow could not follow onto the lip edges.
+    """Moves mouth knots the flow could not follow, or left inside the lips, onto the lip edges.
 
     ``frame``, ``contours``: the first frame and its given contours (fit the colour);
     ``index``: contour name -> its knots' indices in the tracker's knot array; ``edges``: the
@@ -87,6 +138,7 @@ class LipSearch:
     def __init__(self, frame: np.ndarray, contours: Mapping[str, np.ndarray], index: Mapping[str, np.ndarray],
                  edges: np.ndarray, reach: float, min_step: float):
         self._colour = lip_colour(frame, contours)
+        self._weights = np.array(self._colour[:2]) if self._colour is not None else np.zeros(2)
         corners = np.asarray(contours["mouth_outer_upper"], np.float64)[[0, -1]]
         self._reach = reach * float(np.linalg.norm(corners[1] - corners[0]))
         self._min_step = min_step
@@ -99,6 +151,24 @@ class LipSearch:
             for name, idx in self._index.items():
                 found, _ = self._search(frame, edges, name, np.ones(len(idx) - 2, bool), 1.0)
                 self._offset0[name] = np.nan_to_num(found)
+        # Each inner knot's signed distance to its outer lip along its normal on the first
+        # frame, and each outer lip's median thickness (px).
+        self._thickness0 = {n: self._gaps(edges, n)[0] for n in LIP_PAIRS}
+        # Each outer knot's lip thickness (px along its normal to the inner curve; where the
+        # normal misses it, the lip's median).
+        self._lip0 = {}
+        for inner, outer in LIP_PAIRS.items():
+            pts = edges[self._index[outer]]
+            gap = np.abs(normal_gaps(pts[1:-1], _normals(pts)[1:-1], edges[self._index[inner]]))
+            median = float(np.nanmedian(gap)) if np.isfinite(gap).any() else 0.0
+            self._lip0[outer] = np.where(np.isfinite(gap), gap, median)
+
+    def _gaps(self, knots: np.ndarray, inner: str) -> tuple[np.ndarray, np.ndarray]:
+        """The interior knots of curve ``inner``: their signed distances (px) along their
+        normals to the outer lip (NaN where they miss it) and their (N, 2) normals."""
+        pts = knots[self._index[inner]]
+        normal = _normals(pts)[1:-1]
+        return normal_gaps(pts[1:-1], normal, knots[self._index[LIP_PAIRS[inner]]]), normal
 
     def _search(self, frame: np.ndarray, knots: np.ndarray, name: str, which: np.ndarray,
                 scale: float) -> tuple[np.ndarray, np.ndarray]:
@@ -106,9 +176,7 @@ class LipSearch:
         ``name`` selected by ``which`` (a mask over the curve's interior knots; NaN for the
         others and where none was found), and the curve's (N, 2) unit normals."""
         pts = knots[self._index[name]]
-        along = np.gradient(pts, axis=0)
-        along /= np.maximum(np.linalg.norm(along, axis=1, keepdims=True), 1e-9)
-        normal = np.stack([-along[:, 1], along[:, 0]], axis=1)  # curves run left to right: down
+        normal = _normals(pts)
         pick = np.flatnonzero(which) + 1
         out = np.full(len(pts), np.nan)
         reach = max(self._reach * scale, SIGMA)  # the core takes σ ≤ reach, and a head may shrink
@@ -121,16 +189,58 @@ class LipSearch:
             reach, SIGMA, self._min_step)
         return out, normal
 
+    def _place(self, frame: np.ndarray, knots: np.ndarray, name: str, which: np.ndarray, scale: float) -> None:
+        """Move the interior knots of curve ``name`` selected by ``which`` to the lip edges
+        :meth:`_search` finds for them (in place)."""
+        found, normal = self._search(frame, knots, name, which, scale)
+        hit = np.flatnonzero(np.isfinite(found))
+        shift = found[hit] - self._offset0[name][hit] * scale
+        knots[self._index[name][hit]] += shift[:, None] * normal[hit]
+
     def move(self, frame: np.ndarray, knots: np.ndarray, unfollowed: np.ndarray, scale: float) -> None:
         """Move the interior mouth knots flagged in ``unfollowed`` (a mask over ``knots``, (K, 2)
-        px) to the lip edge found near them in ``frame``, head scale ``scale`` (in place)."""
+        px), then the outer knots inside their lips, then the inner knots too far inside the
+        mouth, to the lip edges found near them in ``frame``, head scale ``scale`` (in place)."""
         if not self.active:
             return
         for name, idx in self._index.items():
             which = unfollowed[idx[1:-1]]
-            if not which.any():
-                continue
-            found, normal = self._search(frame, knots, name, which, scale)
-            hit = np.flatnonzero(np.isfinite(found))
-            shift = found[hit] - self._offset0[name][hit] * scale
-            knots[idx[hit]] += shift[:, None] * normal[hit]
+            if which.any():
+                self._place(frame, knots, name, which, scale)
+        for name, side in OUTERMOST.items():
+            pts = knots[self._index[name]]
+            probes = pts[1:-1] + side * np.maximum(PROBE * self._lip0[name] * scale, 2.0)[:, None] * _normals(pts)[1:-1]
+            inside = self._score_near(frame, probes) > LIP_OUTSIDE
+            if inside.any():
+                self._place(frame, knots, name, inside, scale)
+        for name in LIP_PAIRS:
+            self._thin(frame, knots, name, scale)
+
+    def _score_near(self, frame: np.ndarray, pts: np.ndarray) -> np.ndarray:
+        """The lip score averaged over the 3×3 pixels nearest each of ``pts`` (N, 2) px."""
+        h, w = frame.shape[:2]
+        near = np.rint(pts).astype(np.int64)[:, None] + _NINE
+        flat = np.clip(near[..., 1], 0, h - 1) * w + np.clip(near[..., 0], 0, w - 1)
+        rg = _chromaticity(frame.reshape(-1, 3)[flat.ravel()])
+        return (rg @ self._weights - self._colour[2]).reshape(len(pts), len(_NINE)).mean(axis=1)
+
+    def _thin(self, frame: np.ndarray, knots: np.ndarray, name: str, scale: float) -> None:
+        """Move the interior knots of inner curve ``name`` that lie farther from their outer lip
+        than :data:`THICKER` first-frame lip thicknesses (at least 1 px each) to the lip edge
+        found nearest one thickness inside the outer lip (in place)."""
+        gap, normal = self._gaps(knots, name)
+        thickness = self._thickness0[name] * scale
+        far = np.abs(gap) > THICKER * np.maximum(np.abs(thickness), 1.0)  # False where NaN
+        if not far.any():
+            return
+        pick = np.flatnonzero(far)
+        reach = max(self._reach * scale, SIGMA)
+        pts = knots[self._index[name]][1:-1]
+        expect = np.clip(gap[pick] - thickness[pick], -reach, reach)
+        found = _core.find_lip_edges(
+            frame, self._colour, np.ascontiguousarray(pts[pick]), np.ascontiguousarray(normal[pick]),
+            np.full(len(pick), POLARITY[name][1]), expect, reach, SIGMA, self._min_step)
+        hit = np.isfinite(found)
+        knot = pick[hit] + 1  # index along the curve
+        shift = found[hit] - np.median(self._offset0[name][1:-1]) * scale
+        knots[self._index[name][knot]] += shift[:, None] * normal[pick[hit]]

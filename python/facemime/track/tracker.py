@@ -8,9 +8,9 @@ Per frame:
    previous knots (the snakes' start and their temporal anchor) and the rest shape (the first
    frame's knots carried along by the accumulated head motion; each mouth feature's rest shape
    also follows, in part, the affine change of its knots, so an "O" or a wide-open mouth is not
-   pulled back to the neutral shape); a mouth knot the optical flow could not follow starts at
-   the lip edge found along its curve's normal on a lip-colour score
-   (:mod:`facemime.track.lips`);
+   pulled back to the neutral shape); a mouth knot the optical flow could not follow, or that
+   it left inside the lips as the mouth opened, starts at the lip edge found along its curve's
+   normal on a lip-colour score (:mod:`facemime.track.lips`);
 2. the sign-descent solver (``facemime._core.SnakeSolver``) moves every knot at most δ0/(1−σ) px
    per pass: one pass for the brows, ``mouth_passes`` for the mouth, whose lips move fastest;
 3. each feature's confidence is its mean edge response relative to the first frame's. A brow
@@ -50,6 +50,8 @@ OPERATORS = ("directional", "magnitude")
 FAST = 0.6
 #: Fraction of the inner mouth's sideways drift from the centre of the outer mouth removed per frame.
 CENTRING = 0.3
+#: The inner mouth's width may shrink to this fraction of its rest width before it counts as lost.
+NARROWEST = 0.25
 
 
 @dataclass(frozen=True)
@@ -439,11 +441,14 @@ class Tracker:
         return rest
 
     def _shape_ok(self, knots: np.ndarray, rest: np.ndarray, names: tuple[str, str]) -> bool:
-        """The upper curve's chord stays within a factor 2 of its rest chord."""
+        """The upper curve's chord stays within a factor 2 of its rest chord (the inner mouth's
+        may shrink to :data:`NARROWEST` of it: a mouth rounding into an "O" opens only in the
+        middle of the line where the lips met)."""
         first, last = self._index[names[0]][[0, -1]]
         chord = _length(knots[last] - knots[first])
         rest_chord = _length(rest[last] - rest[first])
-        return bool(0.5 * rest_chord <= chord <= 2.0 * rest_chord)
+        least = NARROWEST if names[0] == "mouth_inner_upper" else 0.5
+        return bool(least * rest_chord <= chord <= 2.0 * rest_chord)
 
     @property
     def motion(self) -> motion.HeadMotion | None:
