@@ -48,11 +48,15 @@ LIP_PAIRS = {"mouth_inner_upper": "mouth_outer_upper", "mouth_inner_lower": "mou
 THICKER = 1.8
 #: An outer knot is searched for again when the lip score this many of its first-frame lip
 #: thicknesses (at least 2 px) outside it exceeds :data:`LIP_OUTSIDE` (skin standard
-#: deviations): it lies inside its lip. Measured on the six videos: gates of 0.75 to 1.5 at
-#: probes of 0.6 to 1.5 thicknesses track alike; a gate of 0.5 took a shadow under vr_2's
-#: lower lip.
+#: deviations): it lies inside its lip; but only where, :data:`BEYOND` times as far out, the
+#: score is below :data:`SKIN_BEYOND`: skin follows. Measured on the six videos: gates of 0.75
+#: to 1.5 at probes of 0.6 to 1.5 thicknesses track alike; a gate of 0.5 took a shadow under
+#: vr_2's lower lip; without the skin beyond, vr_2's reddish skin around the mouth could pull
+#: its outer lips outwards frame after frame.
 PROBE = 0.75
 LIP_OUTSIDE = 1.0
+BEYOND = 3.0
+SKIN_BEYOND = 0.5
 #: (dx, dy) of the 3×3 pixels averaged at a probe.
 _NINE = np.stack(np.meshgrid([-1, 0, 1], [-1, 0, 1]), axis=-1).reshape(-1, 2)
 
@@ -199,7 +203,7 @@ class LipSearch:
 
     def move(self, frame: np.ndarray, knots: np.ndarray, unfollowed: np.ndarray, scale: float) -> None:
         """Move the interior mouth knots flagged in ``unfollowed`` (a mask over ``knots``, (K, 2)
-        px), then the outer knots inside their lips, then the inner knots too far inside the
+        px), then the outer knots inside their lips (lip colour outside them, then skin), then the inner knots too far inside the
         mouth, to the lip edges found near them in ``frame``, head scale ``scale`` (in place)."""
         if not self.active:
             return
@@ -209,8 +213,10 @@ class LipSearch:
                 self._place(frame, knots, name, which, scale)
         for name, side in OUTERMOST.items():
             pts = knots[self._index[name]]
-            probes = pts[1:-1] + side * np.maximum(PROBE * self._lip0[name] * scale, 2.0)[:, None] * _normals(pts)[1:-1]
-            inside = self._score_near(frame, probes) > LIP_OUTSIDE
+            out = side * _normals(pts)[1:-1]
+            near = np.maximum(PROBE * self._lip0[name] * scale, 2.0)[:, None]
+            inside = self._score_near(frame, pts[1:-1] + near * out) > LIP_OUTSIDE
+            inside &= self._score_near(frame, pts[1:-1] + BEYOND * near * out) < SKIN_BEYOND
             if inside.any():
                 self._place(frame, knots, name, inside, scale)
         for name in LIP_PAIRS:

@@ -52,6 +52,9 @@ FAST = 0.6
 CENTRING = 0.3
 #: The inner mouth's width may shrink to this fraction of its rest width before it counts as lost.
 NARROWEST = 0.25
+#: A brow match that puts a knot coordinate this many solver reaches (δ0/(1−σ)) from the brow's
+#: snakes moves them; a nearer one tells them nothing new.
+AGREE = 1.0
 
 
 @dataclass(frozen=True)
@@ -382,6 +385,7 @@ class Tracker:
                 if found is not None:
                     fallback = knots.copy()
                     fallback[idx] = found
+                if found is not None and np.abs(found - knots[idx]).max() >= AGREE * reach:
                     again, more, again_resp = self._solve(*self._field(frame, fallback), fallback, rest, down, targets)
                     iters += more
                     conf_again = float(np.clip(again_resp[rows] / self._response0[rows], 0.0, 1.0).mean())
