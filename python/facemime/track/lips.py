@@ -211,12 +211,14 @@ class LipSearch:
             which = unfollowed[idx[1:-1]]
             if which.any():
                 self._place(frame, knots, name, which, scale)
+        probes = []  # per outer curve: the near and the far probes, scored in one call
         for name, side in OUTERMOST.items():
-            pts = knots[self._index[name]]
-            out = side * _normals(pts)[1:-1]
-            near = np.maximum(PROBE * self._lip0[name] * scale, 2.0)[:, None]
-            inside = self._score_near(frame, pts[1:-1] + near * out) > LIP_OUTSIDE
-            inside &= self._score_near(frame, pts[1:-1] + BEYOND * near * out) < SKIN_BEYOND
+            pts = knots[self._index[name]][1:-1]
+            step = side * np.maximum(PROBE * self._lip0[name] * scale, 2.0)[:, None] * _normals(knots[self._index[name]])[1:-1]
+            probes += [pts + step, pts + BEYOND * step]
+        scores = np.split(self._score_near(frame, np.concatenate(probes)), np.cumsum([len(q) for q in probes])[:-1])
+        for k, name in enumerate(OUTERMOST):
+            inside = (scores[2 * k] > LIP_OUTSIDE) & (scores[2 * k + 1] < SKIN_BEYOND)
             if inside.any():
                 self._place(frame, knots, name, inside, scale)
         for name in LIP_PAIRS:
@@ -226,7 +228,9 @@ class LipSearch:
         """The lip score averaged over the 3×3 pixels nearest each of ``pts`` (N, 2) px."""
         h, w = frame.shape[:2]
         near = np.rint(pts).astype(np.int64)[:, None] + _NINE
-        flat = np.clip(near[..., 1], 0, h - 1) * w + np.clip(near[..., 0], 0, w - 1)
+        if near.min() < 0 or near[..., 0].max() >= w or near[..., 1].max() >= h:
+            near = np.minimum(np.maximum(near, 0), [w - 1, h - 1])
+        flat = near[..., 1] * w + near[..., 0]
         rg = _chromaticity(frame.reshape(-1, 3)[flat.ravel()])
         return (rg @ self._weights - self._colour[2]).reshape(len(pts), len(_NINE)).mean(axis=1)
 
