@@ -34,9 +34,11 @@ from facemime.track.contours import POLARITY
 SKIN_RING = 0.3
 #: The search is off when lip and skin colours are closer than this: the distance of their
 #: mean chromaticities (the six shared videos: 0.026 to 0.062), and that distance over their
-#: pooled spread along the discriminant (1.3 to 2.0).
-MIN_CHROMA = 0.01
-MIN_SEPARATION = 0.5
+#: pooled spread along the discriminant (1.3 to 2.0). The demo's rendered astronaut, smiling
+#: on her first frame, has 0.010 and 0.65: on so weak a score the searches moved her lips onto
+#: noise (mouth NME 0.015 without them, 0.08 with).
+MIN_CHROMA = 0.02
+MIN_SEPARATION = 1.0
 SIGMA = 1.5  # px: smoothing of the score along the normal
 #: The outer curves' edges are searched outermost first: above (−1) or below (+1) along the normal.
 OUTERMOST = {"mouth_outer_upper": -1.0, "mouth_outer_lower": +1.0}
@@ -175,15 +177,17 @@ class LipSearch:
         return normal_gaps(pts[1:-1], normal, knots[self._index[LIP_PAIRS[inner]]]), normal
 
     def _search(self, frame: np.ndarray, knots: np.ndarray, name: str, which: np.ndarray,
-                scale: float) -> tuple[np.ndarray, np.ndarray]:
+                scale: float, within: float | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The offsets (px along the downward normals) of the lip edges from the knots of curve
         ``name`` selected by ``which`` (a mask over the curve's interior knots; NaN for the
-        others and where none was found), and the curve's (N, 2) unit normals."""
+        others and where none was found), and the curve's (N, 2) unit normals. ``within``: a
+        search range (px) shorter than the usual one."""
         pts = knots[self._index[name]]
         normal = _normals(pts)
         pick = np.flatnonzero(which) + 1
         out = np.full(len(pts), np.nan)
-        reach = max(self._reach * scale, SIGMA)  # the core takes σ ≤ reach, and a head may shrink
+        reach = self._reach * scale if within is None else min(within, self._reach * scale)
+        reach = max(reach, SIGMA)  # the core takes σ ≤ reach, and a head may shrink
         # Outside the outer lips lies skin only: their edge is the outermost lip-skin transition
         # (the transitions nearer the mouth are those of the teeth and the opening).
         expect = OUTERMOST[name] * reach if name in OUTERMOST else self._offset0[name][pick] * scale
@@ -193,34 +197,37 @@ class LipSearch:
             reach, SIGMA, self._min_step)
         return out, normal
 
-    def _place(self, frame: np.ndarray, knots: np.ndarray, name: str, which: np.ndarray, scale: float) -> None:
+    def _place(self, frame: np.ndarray, knots: np.ndarray, name: str, which: np.ndarray, scale: float,
+               within: float | None = None) -> None:
         """Move the interior knots of curve ``name`` selected by ``which`` to the lip edges
         :meth:`_search` finds for them (in place)."""
-        found, normal = self._search(frame, knots, name, which, scale)
+        found, normal = self._search(frame, knots, name, which, scale, within)
         hit = np.flatnonzero(np.isfinite(found))
         shift = found[hit] - self._offset0[name][hit] * scale
         knots[self._index[name][hit]] += shift[:, None] * normal[hit]
 
     def move(self, frame: np.ndarray, knots: np.ndarray, unfollowed: np.ndarray, scale: float) -> None:
         """Move the interior mouth knots flagged in ``unfollowed`` (a mask over ``knots``, (K, 2)
-        px), then the outer knots inside their lips (lip colour outside them, then skin), then the inner knots too far inside the
-        mouth, to the lip edges found near them in ``frame``, head scale ``scale`` (in place)."""
+        px), then the outer knots inside their lips (lip colour outside them, then skin), then
+        the inner knots too far inside the mouth, to the lip edges found near them in ``frame``,
+        head scale ``scale`` (in place)."""
         if not self.active:
             return
         for name, idx in self._index.items():
             which = unfollowed[idx[1:-1]]
             if which.any():
                 self._place(frame, knots, name, which, scale)
-        probes = []  # per outer curve: the near and the far probes, scored in one call
+        probes, near = [], {}  # per outer curve: the near and the far probes, scored in one call
         for name, side in OUTERMOST.items():
             pts = knots[self._index[name]][1:-1]
-            step = side * np.maximum(PROBE * self._lip0[name] * scale, 2.0)[:, None] * _normals(knots[self._index[name]])[1:-1]
+            near[name] = np.maximum(PROBE * self._lip0[name] * scale, 2.0)
+            step = side * near[name][:, None] * _normals(knots[self._index[name]])[1:-1]
             probes += [pts + step, pts + BEYOND * step]
         scores = np.split(self._score_near(frame, np.concatenate(probes)), np.cumsum([len(q) for q in probes])[:-1])
         for k, name in enumerate(OUTERMOST):
             inside = (scores[2 * k] > LIP_OUTSIDE) & (scores[2 * k + 1] < SKIN_BEYOND)
-            if inside.any():
-                self._place(frame, knots, name, inside, scale)
+            if inside.any():  # the lip's edge lies between the two probes
+                self._place(frame, knots, name, inside, scale, within=BEYOND * float(near[name][inside].max()))
         for name in LIP_PAIRS:
             self._thin(frame, knots, name, scale)
 
