@@ -95,9 +95,10 @@ class TrackerParams:
     ``lip_reach``: a mouth knot the flow could not follow (its forward-backward check failed)
     starts at the lip edge found on a lip-colour score within ± this fraction of the mouth's
     width along its curve's normal (:mod:`facemime.track.lips`; 0: off); ``lip_step``: the
-    smallest such edge, in skin standard deviations per px. ``brow_search``: a brow whose
-    confidence falls below this (or whose shape degenerates) is looked for again by matching the
-    first frame's brow around where the head motion put it (:mod:`facemime.track.brows`; 0: off).
+    smallest such edge, in skin standard deviations per px. ``brow_search``: a brow one of whose
+    curves' edge response falls below this fraction of the first frame's (or whose shape
+    degenerates) is looked for again by matching the first frame's brow around where the head
+    motion put it (:mod:`facemime.track.brows`; 0: off).
     ``iterations``, ``tol``: each solver pass runs at most ``iterations`` steps, and a feature
     stops early once its own energy changes by less than ``tol`` between steps (0: never;
     measured on the six videos, stopping at 1e-4 raised the outer mouth's failure rate from 2.9%
@@ -385,12 +386,12 @@ class Tracker:
                 if found is not None:
                     fallback = knots.copy()
                     fallback[idx] = found
-                if found is not None and np.abs(found - knots[idx]).max() >= AGREE * reach:
-                    again, more, again_resp = self._solve(*self._field(frame, fallback), fallback, rest, down, targets)
-                    iters += more
-                    conf_again = float(np.clip(again_resp[rows] / self._response0[rows], 0.0, 1.0).mean())
-                    if conf_again > conf or not self._shape_ok(knots, carried, names):
-                        knots[idx], conf = again[idx], conf_again
+                    if np.abs(found - knots[idx]).max() >= AGREE * reach:
+                        again, more, again_resp = self._solve(*self._field(frame, fallback), fallback, rest, down, targets)
+                        iters += more
+                        conf_again = float(np.clip(again_resp[rows] / self._response0[rows], 0.0, 1.0).mean())
+                        if conf_again > conf or not self._shape_ok(knots, carried, names):
+                            knots[idx], conf = again[idx], conf_again
             confidence[feature] = conf
             if conf < p.lost_response or not self._shape_ok(knots, carried, names):
                 lost.append(feature)
