@@ -157,9 +157,9 @@ class LipSearch:
             for name, idx in self._index.items():
                 found, _ = self._search(frame, edges, name, np.ones(len(idx) - 2, bool), 1.0)
                 self._offset0[name] = np.nan_to_num(found)
-        # Each inner knot's signed distance to its outer lip along its normal on the first
-        # frame, and each outer lip's median thickness (px).
-        self._thickness0 = {n: self._gaps(edges, n)[0] for n in LIP_PAIRS}
+        # Each inner knot's signed distance (px) to its outer lip along its normal on the first
+        # frame.
+        self._thickness0 = {n: self._gaps(edges, n) for n in LIP_PAIRS}
         # Each outer knot's lip thickness (px along its normal to the inner curve; where the
         # normal misses it, the lip's median).
         self._lip0 = {}
@@ -169,19 +169,20 @@ class LipSearch:
             median = float(np.nanmedian(gap)) if np.isfinite(gap).any() else 0.0
             self._lip0[outer] = np.where(np.isfinite(gap), gap, median)
 
-    def _gaps(self, knots: np.ndarray, inner: str) -> tuple[np.ndarray, np.ndarray]:
-        """The interior knots of curve ``inner``: their signed distances (px) along their
-        normals to the outer lip (NaN where they miss it) and their (N, 2) normals."""
+    def _gaps(self, knots: np.ndarray, inner: str) -> np.ndarray:
+        """The signed distances (px) of the interior knots of curve ``inner`` along their
+        normals to the outer lip (NaN where they miss it)."""
         pts = knots[self._index[inner]]
-        normal = _normals(pts)[1:-1]
-        return normal_gaps(pts[1:-1], normal, knots[self._index[LIP_PAIRS[inner]]]), normal
+        return normal_gaps(pts[1:-1], _normals(pts)[1:-1], knots[self._index[LIP_PAIRS[inner]]])
 
-    def _search(self, frame: np.ndarray, knots: np.ndarray, name: str, which: np.ndarray,
-                scale: float, within: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    def _search(self, frame: np.ndarray, knots: np.ndarray, name: str, which: np.ndarray, scale: float,
+                within: float | None = None, expect: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The offsets (px along the downward normals) of the lip edges from the knots of curve
         ``name`` selected by ``which`` (a mask over the curve's interior knots; NaN for the
         others and where none was found), and the curve's (N, 2) unit normals. ``within``: a
-        search range (px) shorter than the usual one."""
+        search range (px) shorter than the usual one; ``expect``: the offsets to search nearest
+        to, one per selected knot (default: the outermost for an outer curve, else the knot's
+        first-frame offset)."""
         pts = knots[self._index[name]]
         normal = _normals(pts)
         pick = np.flatnonzero(which) + 1
@@ -190,7 +191,8 @@ class LipSearch:
         reach = max(reach, SIGMA)  # the core takes σ ≤ reach, and a head may shrink
         # Outside the outer lips lies skin only: their edge is the outermost lip-skin transition
         # (the transitions nearer the mouth are those of the teeth and the opening).
-        expect = OUTERMOST[name] * reach if name in OUTERMOST else self._offset0[name][pick] * scale
+        if expect is None:
+            expect = OUTERMOST[name] * reach if name in OUTERMOST else self._offset0[name][pick] * scale
         out[pick] = _core.find_lip_edges(
             frame, self._colour, np.ascontiguousarray(pts[pick]), np.ascontiguousarray(normal[pick]),
             np.full(len(pick), POLARITY[name][1]), np.broadcast_to(expect, len(pick)).astype(np.float64),
@@ -198,12 +200,13 @@ class LipSearch:
         return out, normal
 
     def _place(self, frame: np.ndarray, knots: np.ndarray, name: str, which: np.ndarray, scale: float,
-               within: float | None = None) -> None:
+               within: float | None = None, expect: np.ndarray | None = None, offset: float | None = None) -> None:
         """Move the interior knots of curve ``name`` selected by ``which`` to the lip edges
-        :meth:`_search` finds for them (in place)."""
-        found, normal = self._search(frame, knots, name, which, scale, within)
+        :meth:`_search` finds for them, each keeping its first-frame offset from its edge (or
+        ``offset`` px, scaled with the head; in place)."""
+        found, normal = self._search(frame, knots, name, which, scale, within, expect)
         hit = np.flatnonzero(np.isfinite(found))
-        shift = found[hit] - self._offset0[name][hit] * scale
+        shift = found[hit] - (self._offset0[name][hit] if offset is None else offset) * scale
         knots[self._index[name][hit]] += shift[:, None] * normal[hit]
 
     def move(self, frame: np.ndarray, knots: np.ndarray, unfollowed: np.ndarray, scale: float) -> None:
@@ -244,20 +247,12 @@ class LipSearch:
     def _thin(self, frame: np.ndarray, knots: np.ndarray, name: str, scale: float) -> None:
         """Move the interior knots of inner curve ``name`` that lie farther from their outer lip
         than :data:`THICKER` first-frame lip thicknesses (at least 1 px each) to the lip edge
-        found nearest one thickness inside the outer lip (in place)."""
-        gap, normal = self._gaps(knots, name)
+        found nearest one thickness inside the outer lip, keeping the curve's median first-frame
+        offset from its edge (in place)."""
+        gap = self._gaps(knots, name)
         thickness = self._thickness0[name] * scale
         far = np.abs(gap) > THICKER * np.maximum(np.abs(thickness), 1.0)  # False where NaN
-        if not far.any():
-            return
-        pick = np.flatnonzero(far)
-        reach = max(self._reach * scale, SIGMA)
-        pts = knots[self._index[name]][1:-1]
-        expect = np.clip(gap[pick] - thickness[pick], -reach, reach)
-        found = _core.find_lip_edges(
-            frame, self._colour, np.ascontiguousarray(pts[pick]), np.ascontiguousarray(normal[pick]),
-            np.full(len(pick), POLARITY[name][1]), expect, reach, SIGMA, self._min_step)
-        hit = np.isfinite(found)
-        knot = pick[hit] + 1  # index along the curve
-        shift = found[hit] - np.median(self._offset0[name][1:-1]) * scale
-        knots[self._index[name][knot]] += shift[:, None] * normal[pick[hit]]
+        if far.any():
+            reach = max(self._reach * scale, SIGMA)
+            self._place(frame, knots, name, far, scale, expect=np.clip(gap[far] - thickness[far], -reach, reach),
+                        offset=float(np.median(self._offset0[name][1:-1])))
