@@ -64,6 +64,11 @@ def find_lip_edges(
     sigma: float,
     min_step: float,
 ) -> npt.NDArray[np.float64]: ...
+def lip_scores_near(
+    frame: npt.NDArray[np.uint8],
+    colour: tuple[float, float, float],
+    points: npt.NDArray[np.float64],
+) -> npt.NDArray[np.float64]: ...
 def robust_similarity(
     src: npt.NDArray[np.float64],
     dst: npt.NDArray[np.float64],
@@ -118,6 +123,7 @@ class SnakeSolver:
         rest: npt.NDArray[np.float64],
         down: tuple[float, float],
         pair_targets: npt.NDArray[np.float64],
+        curves: npt.NDArray[np.bool_] | None = None,
     ) -> tuple[npt.NDArray[np.float64], int, float, npt.NDArray[np.float64]]: ...
     def evaluate(
         self,

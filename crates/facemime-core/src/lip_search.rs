@@ -95,6 +95,37 @@ pub fn find_edges(
         .collect())
 }
 
+/// The score averaged over the 3×3 pixels nearest each of `points` (the pixel the point rounds
+/// to, ties to even, and its eight neighbours, clamped to the image). `image` is (H, W, 3) RGB.
+pub fn scores_near(image: &ImageRef, colour: &LipColour, points: &[[f64; 2]]) -> Result<Vec<f64>> {
+    if image.channels != 3 {
+        return invalid!("the image must be RGB, got {} channels", image.channels);
+    }
+    if let Some(p) = points
+        .iter()
+        .find(|p| !(p[0].is_finite() && p[1].is_finite()))
+    {
+        return invalid!("points must be finite, got {p:?}");
+    }
+    let clamp = |v: f64, size: usize| v.clamp(0.0, (size - 1) as f64) as usize;
+    Ok(points
+        .iter()
+        .map(|p| {
+            let (x, y) = (p[0].round_ties_even(), p[1].round_ties_even());
+            let mut total = 0.0;
+            for dy in [-1.0, 0.0, 1.0] {
+                for dx in [-1.0, 0.0, 1.0] {
+                    let (px, py) = (clamp(x + dx, image.width), clamp(y + dy, image.height));
+                    let at = (py * image.width + px) * 3;
+                    let rgb = std::array::from_fn(|c| image.data[at + c] as f64);
+                    total += score(colour, rgb);
+                }
+            }
+            total / 9.0
+        })
+        .collect())
+}
+
 /// The score of an RGB colour.
 fn score(c: &LipColour, [r, g, b]: [f64; 3]) -> f64 {
     let sum = r + g + b + 1.0;
@@ -225,6 +256,24 @@ mod tests {
             |expect| find_edges(&img, &COLOUR, &[probe(22.0, 1.0, expect)], &SETTINGS).unwrap()[0];
         assert!((at(-8.0) + 8.5).abs() <= 0.1, "{}", at(-8.0));
         assert!((at(6.0) - 7.5).abs() <= 0.1, "{}", at(6.0));
+    }
+
+    #[test]
+    fn scores_near_average_the_nine_nearest_pixels() {
+        let img = two_tone(20);
+        let image = ImageRef::new(&img, 40, 40, 3).unwrap();
+        let skin = score(&COLOUR, [205.0, 160.0, 140.0]);
+        let lip = score(&COLOUR, [175.0, 70.0, 75.0]);
+        // Rows 18..=20 around (10, 19.4): two of skin, one of lip; a corner clamps to skin.
+        let got = scores_near(&image, &COLOUR, &[[10.0, 19.4], [5.0, 30.0], [-3.0, -2.0]]).unwrap();
+        let expected = [(2.0 * skin + lip) / 3.0, lip, skin];
+        for (g, e) in got.iter().zip(expected) {
+            assert!((g - e).abs() < 1e-12, "{got:?} vs {expected:?}");
+        }
+        // 19.5 rounds to 20 (ties to even): rows 19..=21, one of skin, two of lip.
+        let tie = scores_near(&image, &COLOUR, &[[10.0, 19.5]]).unwrap()[0];
+        assert!((tie - (skin + 2.0 * lip) / 3.0).abs() < 1e-12);
+        assert!(scores_near(&image, &COLOUR, &[[f64::NAN, 1.0]]).is_err());
     }
 
     #[test]

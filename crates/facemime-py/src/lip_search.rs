@@ -65,7 +65,27 @@ fn find_lip_edges<'py>(
     Ok(found.into_pyarray(py))
 }
 
+/// frame: (H, W, 3) uint8 RGB; colour: (w_r, w_g, bias) of the lip score; points: (K, 2)
+/// pixels. Returns the (K,) scores averaged over the 3×3 pixels nearest each point.
+#[pyfunction]
+fn lip_scores_near<'py>(
+    py: Python<'py>,
+    frame: PyReadonlyArray3<u8>,
+    colour: [f64; 3],
+    points: PyReadonlyArray2<f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let img = rgb_view("frame", &frame)?;
+    let at = rows::<2>("points", &points)?;
+    let colour = LipColour {
+        weights: [colour[0], colour[1]],
+        bias: colour[2],
+    };
+    let scores = lip_search::scores_near(&img, &colour, &at).map_err(CoreErr)?;
+    Ok(scores.into_pyarray(py))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(find_lip_edges, m)?)?;
+    m.add_function(wrap_pyfunction!(lip_scores_near, m)?)?;
     Ok(())
 }

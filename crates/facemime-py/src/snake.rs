@@ -132,8 +132,10 @@ impl SnakeSolver {
         self.problem.n_knots()
     }
 
-    /// Solves one frame; returns (knots (K, 2), iterations, energy, response (C,)).
-    #[pyo3(signature = (field, origin, bounds, start, rest, down, pair_targets))]
+    /// Solves one frame; returns (knots (K, 2), iterations, energy, response (C,)). With
+    /// `curves`, a (C,) bool mask, only the features of the flagged curves are solved (see
+    /// `Problem::solve_some`).
+    #[pyo3(signature = (field, origin, bounds, start, rest, down, pair_targets, curves=None))]
     #[allow(clippy::too_many_arguments, clippy::type_complexity)]
     fn solve<'py>(
         &self,
@@ -145,6 +147,7 @@ impl SnakeSolver {
         rest: PyReadonlyArray2<f64>,
         down: (f64, f64),
         pair_targets: PyReadonlyArray1<f64>,
+        curves: Option<PyReadonlyArray1<bool>>,
     ) -> PyResult<(
         Bound<'py, PyArray2<f64>>,
         usize,
@@ -152,7 +155,11 @@ impl SnakeSolver {
         Bound<'py, PyArray1<f64>>,
     )> {
         let frame = FrameArgs::new(&field, origin, bounds, &start, &rest, down, &pair_targets)?;
-        let sol = py.detach(|| frame.run(|input| self.problem.solve(input)))?;
+        let mask = match curves {
+            Some(m) => m.as_array().to_vec(),
+            None => vec![true; self.problem.n_curves()],
+        };
+        let sol = py.detach(|| frame.run(|input| self.problem.solve_some(input, &mask)))?;
         let flat: Vec<f64> = sol.knots.iter().flatten().copied().collect();
         let knots = ndarray::Array2::from_shape_vec((sol.knots.len(), 2), flat).expect("K x 2");
         Ok((

@@ -59,8 +59,6 @@ PROBE = 0.75
 LIP_OUTSIDE = 1.0
 BEYOND = 3.0
 SKIN_BEYOND = 0.5
-#: (dx, dy) of the 3×3 pixels averaged at a probe.
-_NINE = np.stack(np.meshgrid([-1, 0, 1], [-1, 0, 1]), axis=-1).reshape(-1, 2)
 
 
 def _normals(pts: np.ndarray) -> np.ndarray:
@@ -144,7 +142,6 @@ class LipSearch:
     def __init__(self, frame: np.ndarray, contours: Mapping[str, np.ndarray], index: Mapping[str, np.ndarray],
                  edges: np.ndarray, reach: float, min_step: float):
         self._colour = lip_colour(frame, contours)
-        self._weights = np.array(self._colour[:2]) if self._colour is not None else np.zeros(2)
         corners = np.asarray(contours["mouth_outer_upper"], np.float64)[[0, -1]]
         self._reach = reach * float(np.linalg.norm(corners[1] - corners[0]))
         self._min_step = min_step
@@ -226,23 +223,14 @@ class LipSearch:
             near[name] = np.maximum(PROBE * self._lip0[name] * scale, 2.0)
             step = side * near[name][:, None] * _normals(knots[self._index[name]])[1:-1]
             probes += [pts + step, pts + BEYOND * step]
-        scores = np.split(self._score_near(frame, np.concatenate(probes)), np.cumsum([len(q) for q in probes])[:-1])
+        scores = _core.lip_scores_near(frame, self._colour, np.concatenate(probes))
+        scores = np.split(scores, np.cumsum([len(q) for q in probes])[:-1])
         for k, name in enumerate(OUTERMOST):
             inside = (scores[2 * k] > LIP_OUTSIDE) & (scores[2 * k + 1] < SKIN_BEYOND)
             if inside.any():  # the lip's edge lies between the two probes
                 self._place(frame, knots, name, inside, scale, within=BEYOND * float(near[name][inside].max()))
         for name in LIP_PAIRS:
             self._thin(frame, knots, name, scale)
-
-    def _score_near(self, frame: np.ndarray, pts: np.ndarray) -> np.ndarray:
-        """The lip score averaged over the 3×3 pixels nearest each of ``pts`` (N, 2) px."""
-        h, w = frame.shape[:2]
-        near = np.rint(pts).astype(np.int64)[:, None] + _NINE
-        if near.min() < 0 or near[..., 0].max() >= w or near[..., 1].max() >= h:
-            near = np.minimum(np.maximum(near, 0), [w - 1, h - 1])
-        flat = near[..., 1] * w + near[..., 0]
-        rg = _chromaticity(frame.reshape(-1, 3)[flat.ravel()])
-        return (rg @ self._weights - self._colour[2]).reshape(len(pts), len(_NINE)).mean(axis=1)
 
     def _thin(self, frame: np.ndarray, knots: np.ndarray, name: str, scale: float) -> None:
         """Move the interior knots of inner curve ``name`` that lie farther from their outer lip

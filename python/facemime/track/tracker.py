@@ -241,6 +241,9 @@ class Tracker:
         self._bands = (self._mouth_knots, np.unique(np.concatenate([self._features["brow_left"], self._features["brow_right"]])))
         self._mouth_rows = [i for i, n in enumerate(CONTOUR_NAMES) if n.startswith("mouth")]
         self._feature_rows = {f: np.array([CONTOUR_NAMES.index(n) for n in names]) for f, names in FEATURES.items()}
+        # Curve masks of the features solved on their own: the mouth's second pass, a brow found again.
+        self._feature_curves = {f: np.isin(np.arange(len(CONTOUR_NAMES)), rows) for f, rows in self._feature_rows.items()}
+        self._mouth_curves = np.isin(np.arange(len(CONTOUR_NAMES)), self._mouth_rows)
         self._solver, self._targets0 = self._build_solver()
         self._field_buffer = np.empty(0, np.float32)
         gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
@@ -306,15 +309,18 @@ class Tracker:
         along = (corners[1] - corners[0]) / max(np.linalg.norm(corners[1] - corners[0]), 1e-9)
         return np.array([-along[1], along[0]])
 
-    def _field(self, frame: np.ndarray, knots: np.ndarray) -> tuple[np.ndarray, tuple[float, float]]:
-        """The image field around ``knots``, wide enough for one solver pass from them."""
+    def _field(self, frame: np.ndarray, knots: np.ndarray,
+               bands_of: tuple[np.ndarray, ...] | None = None) -> tuple[np.ndarray, tuple[float, float]]:
+        """The image field around ``knots``, wide enough for one solver pass from them; with
+        ``bands_of``, knot index arrays, around those knots only."""
         p = self.params
         margin = p.delta0 / (1.0 - p.sigma) + 4.0 * p.smoothing + 2.0
-        box = region(knots, margin, self.width, self.height)
+        bands_of = self._bands if bands_of is None else bands_of
+        box = region(knots[np.concatenate(bands_of)], margin, self.width, self.height)
         # The snakes read the image only near the knots: the rows of the brows and of the
         # mouth, not the eyes and nose between them.
         bands = []
-        for idx in self._bands:
+        for idx in bands_of:
             ys = knots[idx, 1]
             bands.append((max(int(np.floor(ys.min() - margin)), 0), max(int(np.ceil(ys.max() + margin)) + 1, 0)))
         prev = self._prev if max(p.mouth.gamma, p.mouth_inner.gamma, p.brows.gamma) > 0 else None
@@ -332,8 +338,12 @@ class Tracker:
         return resp
 
     def _solve(self, fld: np.ndarray, origin: tuple[float, float], start: np.ndarray, rest: np.ndarray,
-               down: np.ndarray, targets: np.ndarray) -> tuple[np.ndarray, int, np.ndarray]:
-        knots, iters, _, resp = self._solver.solve(fld, origin, (self.width, self.height), start, rest, tuple(down), targets)
+               down: np.ndarray, targets: np.ndarray,
+               curves: np.ndarray | None = None) -> tuple[np.ndarray, int, np.ndarray]:
+        """One solver pass from ``start``; with ``curves``, a mask over CONTOUR_NAMES, for
+        their features only (the others stay at ``start``, their responses NaN)."""
+        knots, iters, _, resp = self._solver.solve(fld, origin, (self.width, self.height), start, rest, tuple(down),
+                                                   targets, curves)
         return knots, iters, resp
 
     def update(self, frame: np.ndarray) -> FrameResult:
@@ -369,7 +379,8 @@ class Tracker:
             if np.abs(knots[self._mouth_knots] - before[self._mouth_knots]).max() < FAST * reach:
                 break
             before = knots.copy()
-            again, more, again_resp = self._solve(*self._field(frame, before), before, rest, down, targets)
+            again, more, again_resp = self._solve(*self._field(frame, before, self._bands[:1]), before, rest, down,
+                                                  targets, self._mouth_curves)
             knots[self._mouth_knots] = again[self._mouth_knots]
             resp[self._mouth_rows] = again_resp[self._mouth_rows]
             iters += more
@@ -387,7 +398,8 @@ class Tracker:
                     fallback = knots.copy()
                     fallback[idx] = found
                     if np.abs(found - knots[idx]).max() >= AGREE * reach:
-                        again, more, again_resp = self._solve(*self._field(frame, fallback), fallback, rest, down, targets)
+                        again, more, again_resp = self._solve(*self._field(frame, fallback, (idx,)), fallback, rest,
+                                                              down, targets, self._feature_curves[feature])
                         iters += more
                         conf_again = float(np.clip(again_resp[rows] / self._response0[rows], 0.0, 1.0).mean())
                         if conf_again > conf or not self._shape_ok(knots, carried, names):

@@ -161,15 +161,35 @@ impl Problem {
 
     /// Runs the solver on one frame.
     pub fn solve(&self, input: &FrameInput<'_>) -> Result<Solution> {
+        self.solve_some(input, &vec![true; self.curves.len()])
+    }
+
+    /// Runs the solver on one frame for the features (groups of coupled curves) of the curves
+    /// flagged in `curves` only: the other features' knots stay at the start, their curves are
+    /// not evaluated and their response is NaN. Each solved feature gets exactly the knots,
+    /// iterations and response it gets from [`Problem::solve`]; the energy is the solved
+    /// features'.
+    pub fn solve_some(&self, input: &FrameInput<'_>, curves: &[bool]) -> Result<Solution> {
+        if curves.len() != self.curves.len() {
+            return invalid!(
+                "the curve mask must have {} values, got {}",
+                self.curves.len(),
+                curves.len()
+            );
+        }
+        let mut moving = vec![false; self.n_groups];
+        for (&on, &g) in curves.iter().zip(&self.curve_group) {
+            moving[g] |= on;
+        }
+        let active = moving.clone();
         let mut ws = self.workspace(input)?;
         let mut knots = input.start.to_vec();
         let [xmax, ymax] = [input.bounds[0] - 1.0, input.bounds[1] - 1.0];
-        let mut energy = self.evaluate(&knots, input, &mut ws);
+        let mut energy = self.evaluate(&knots, input, &active, &mut ws);
         let s = &self.settings;
         let mut step = s.delta0;
         let mut iterations = 0;
         let mut before = ws.group_energy.clone();
-        let mut moving = vec![true; self.n_groups];
         while iterations < s.iterations && moving.contains(&true) {
             for ((k, g), &group) in knots.iter_mut().zip(&ws.grad).zip(&self.knot_group) {
                 if moving[group] {
@@ -179,7 +199,7 @@ impl Problem {
             }
             step *= s.sigma;
             iterations += 1;
-            energy = self.evaluate(&knots, input, &mut ws);
+            energy = self.evaluate(&knots, input, &active, &mut ws);
             for ((go, e), e0) in moving.iter_mut().zip(&ws.group_energy).zip(&before) {
                 if (e - e0).abs() < s.tol {
                     *go = false;
@@ -198,7 +218,7 @@ impl Problem {
     /// Total energy and each curve's mean H at the starting knots, without moving them.
     pub fn evaluate_start(&self, input: &FrameInput<'_>) -> Result<(f64, Vec<f64>)> {
         let mut ws = self.workspace(input)?;
-        let e = self.evaluate(input.start, input, &mut ws);
+        let e = self.evaluate(input.start, input, &vec![true; self.n_groups], &mut ws);
         Ok((e, ws.response))
     }
 
@@ -217,12 +237,23 @@ impl Problem {
         })
     }
 
-    /// Total energy at `knots`; writes its gradient and each curve's mean H into `ws`.
-    fn evaluate(&self, knots: &[P2], input: &FrameInput<'_>, ws: &mut Workspace) -> f64 {
+    /// Total energy at `knots` of the `active` groups; writes its gradient and each of their
+    /// curves' mean H into `ws` (NaN for the other curves).
+    fn evaluate(
+        &self,
+        knots: &[P2],
+        input: &FrameInput<'_>,
+        active: &[bool],
+        ws: &mut Workspace,
+    ) -> f64 {
         ws.grad.iter_mut().for_each(|g| *g = [0.0; 2]);
         ws.group_energy.iter_mut().for_each(|e| *e = 0.0);
         let n = self.settings.points_per_segment;
         for (c, (idx, p)) in self.curves.iter().enumerate() {
+            if !active[self.curve_group[c]] {
+                ws.response[c] = f64::NAN;
+                continue;
+            }
             let ei = energy::internal(
                 idx,
                 knots,
@@ -242,6 +273,7 @@ impl Problem {
             .iter()
             .zip(input.pair_targets)
             .zip(&self.pair_group)
+            .filter(|&(_, &group)| active[group])
         {
             ws.group_energy[group] += energy::pair(q, target, knots, input.down, &mut ws.grad);
         }
@@ -522,6 +554,38 @@ mod tests {
             (joint.knots[7][1] - 9.0).abs() > 3.0,
             "B moved towards its edge"
         );
+    }
+
+    #[test]
+    fn solving_some_features_leaves_the_others_and_matches_the_joint_solve() {
+        // Two features near the band's two edges; solving only the second one must give its
+        // joint-solve knots and response exactly and leave the first at its start.
+        let data = band_field(20.0, 8.0);
+        let field = Field::new(&data, W, H, [0.0, 0.0]).unwrap();
+        let curves = vec![
+            ((0..5).collect(), curve_params(-1.0)),
+            ((5..10).collect(), curve_params(1.0)),
+        ];
+        let problem = Problem::new(curves, vec![], 10, settings()).unwrap();
+        let mut start = line(22.0, 10.0, 5);
+        start.extend(line(30.0, 10.0, 5));
+        let input = FrameInput {
+            field,
+            start: &start,
+            rest: &start,
+            down: [0.0, 1.0],
+            pair_targets: &[],
+            bounds: [W as f64, H as f64],
+        };
+        let joint = problem.solve(&input).unwrap();
+        let some = problem.solve_some(&input, &[false, true]).unwrap();
+        assert_eq!(&some.knots[..5], &start[..5]);
+        assert_eq!(&some.knots[5..], &joint.knots[5..]);
+        assert_ne!(&joint.knots[5..], &start[5..]);
+        assert!(some.response[0].is_nan());
+        assert_eq!(some.response[1], joint.response[1]);
+        assert_eq!(some.iterations, joint.iterations);
+        assert!(problem.solve_some(&input, &[true]).is_err());
     }
 
     #[test]
