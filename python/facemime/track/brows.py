@@ -4,15 +4,16 @@ A brow raised fast, or a head that jumps between frames (a video that dropped fr
 brow further than the snakes reach (δ0/(1−σ) px per frame) and than the optical flow follows:
 the snakes then settle on the eyelid's crease or on bare skin and the brow's edge response
 collapses. Such a brow is looked for again by matching the first frame's brow, gray and scaled
-with the head, over a window around where the head motion put it (normalised cross-correlation,
-``cv2.matchTemplate``). Coordinates are (x, y) pixels, origin at the centre of the top-left
-pixel, y down.
+with the head, over a window around where the head motion put it (:mod:`facemime.track.match`).
+Coordinates are (x, y) pixels, origin at the centre of the top-left pixel, y down.
 """
 
 from __future__ import annotations
 
 import cv2
 import numpy as np
+
+from facemime.track.match import crop_box, find
 
 #: The template is the box of the brow's knots grown by this fraction of the brow's width.
 MARGIN = 0.12
@@ -29,10 +30,7 @@ class BrowSearch:
     def __init__(self, gray: np.ndarray, knots: np.ndarray):
         self._knots0 = np.asarray(knots, np.float64)
         self._width = float(np.ptp(self._knots0[:, 0]))
-        margin = MARGIN * self._width
-        lo = np.floor(self._knots0.min(axis=0) - margin).astype(int)
-        hi = np.ceil(self._knots0.max(axis=0) + margin).astype(int) + 1
-        lo, hi = np.maximum(lo, 0), np.minimum(hi, [gray.shape[1], gray.shape[0]])
+        lo, hi = crop_box(self._knots0, MARGIN * self._width, gray.shape[1], gray.shape[0])
         self._template = gray[lo[1]:hi[1], lo[0]:hi[0]].copy()
         self._centre0 = (lo + hi - 1) / 2.0  # the template's centre, px of the first frame
         self.active = min(self._template.shape) >= 8 and self._template.std() >= 1.0
@@ -46,19 +44,6 @@ class BrowSearch:
         templ = self._template
         if abs(scale - 1.0) > 0.02:
             templ = cv2.resize(templ, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR)
-        th, tw = templ.shape
-        reach = REACH * self._width * scale
-        # The window: the template's box at the expected position, grown by the reach.
         centre = np.asarray(expected, np.float64).mean(axis=0) + (self._centre0 - self._knots0.mean(axis=0)) * scale
-        x0 = max(int(round(centre[0] - (tw - 1) / 2.0 - reach)), 0)
-        y0 = max(int(round(centre[1] - (th - 1) / 2.0 - reach)), 0)
-        x1 = min(int(round(centre[0] + (tw - 1) / 2.0 + reach)) + 1, gray.shape[1])
-        y1 = min(int(round(centre[1] + (th - 1) / 2.0 + reach)) + 1, gray.shape[0])
-        if x1 - x0 < tw or y1 - y0 < th:
-            return None
-        scores = cv2.matchTemplate(gray[y0:y1, x0:x1], templ, cv2.TM_CCOEFF_NORMED)
-        _, best, _, (bx, by) = cv2.minMaxLoc(scores)
-        if not best >= MIN_MATCH:
-            return None
-        found = np.array([x0 + bx + (tw - 1) / 2.0, y0 + by + (th - 1) / 2.0])
-        return (self._knots0 - self._centre0) * scale + found
+        found = find(gray, templ, centre, REACH * self._width * scale, MIN_MATCH)
+        return None if found is None else (self._knots0 - self._centre0) * scale + found

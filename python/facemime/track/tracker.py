@@ -8,9 +8,11 @@ Per frame:
    previous knots (the snakes' start and their temporal anchor) and the rest shape (the first
    frame's knots carried along by the accumulated head motion; each mouth feature's rest shape
    also follows, in part, the affine change of its knots, so an "O" or a wide-open mouth is not
-   pulled back to the neutral shape); a mouth knot the optical flow could not follow, or that
-   it left inside the lips as the mouth opened, starts at the lip edge found along its curve's
-   normal on a lip-colour score (:mod:`facemime.track.lips`);
+   pulled back to the neutral shape); when the optical flow lost most of the mouth's knots, those
+   it lost first move sideways with the previous frame's mouth region, matched in this one
+   (:mod:`facemime.track.mouth`); a mouth knot the flow could not follow, or that it left inside
+   the lips as the mouth opened, starts at the lip edge found along its curve's normal on a
+   lip-colour score (:mod:`facemime.track.lips`);
 2. the sign-descent solver (``facemime._core.SnakeSolver``) moves every knot at most δ0/(1−σ) px
    per pass: one pass for the brows, ``mouth_passes`` for the mouth, whose lips move fastest;
 3. each feature's confidence is its mean edge response relative to the first frame's. A brow
@@ -44,6 +46,7 @@ from facemime.track.brows import BrowSearch
 from facemime.track.contours import CONTOUR_NAMES, FEATURES, POLARITY
 from facemime.track.field import build_field, region
 from facemime.track.lips import LipSearch
+from facemime.track.mouth import mouth_shift
 
 OPERATORS = ("directional", "magnitude")
 #: The mouth gets another solver pass only when a knot moved this fraction of a pass's reach.
@@ -52,8 +55,9 @@ FAST = 0.6
 CENTRING = 0.3
 #: The inner mouth's width may shrink to this fraction of its rest width before it counts as lost.
 NARROWEST = 0.25
-#: A brow match that puts a knot coordinate this many solver reaches (δ0/(1−σ)) from the brow's
-#: snakes moves them; a nearer one tells them nothing new.
+#: A match (a brow found again, the mouth's region followed) that puts a knot coordinate this
+#: many solver reaches (δ0/(1−σ)) from where the knots were moves them; a nearer one tells the
+#: snakes nothing new.
 AGREE = 1.0
 
 
@@ -98,7 +102,15 @@ class TrackerParams:
     smallest such edge, in skin standard deviations per px. ``brow_search``: a brow one of whose
     curves' edge response falls below this fraction of the first frame's (or whose shape
     degenerates) is looked for again by matching the first frame's brow around where the head
-    motion put it (:mod:`facemime.track.brows`; 0: off).
+    motion put it (:mod:`facemime.track.brows`; 0: off). ``mouth_patch``: when fewer than this
+    fraction of the mouth's knots pass the flow's forward-backward check, the previous frame's
+    mouth region is matched around where the head motion put it, and the knots the flow lost
+    start moved along the mouth line by how far it moved that way beyond the head, when that is
+    at least :data:`AGREE` solver reaches (:mod:`facemime.track.mouth`; 0: off). Measured on the
+    six videos: 0.3 to 0.7 track alike; without the reach gate, 0.6 and more moved knots the
+    flow had nearly all followed and the outer mouth's failures rose to 2.5%; moved up and down
+    too, a mouth opening dragged its upper lip down, and under nearby settings vr_2's mouth grew
+    frame after frame (10% failures).
     ``iterations``, ``tol``: each solver pass runs at most ``iterations`` steps, and a feature
     stops early once its own energy changes by less than ``tol`` between steps (0: never;
     measured on the six videos, stopping at 1e-4 raised the outer mouth's failure rate from 2.9%
@@ -129,6 +141,7 @@ class TrackerParams:
     lip_reach: float = 0.3
     lip_step: float = 0.3
     brow_search: float = 0.3
+    mouth_patch: float = 0.5
 
     def with_(self, **changes: object) -> "TrackerParams":
         """A copy with some settings changed."""
@@ -248,7 +261,7 @@ class Tracker:
         self._field_buffer = np.empty(0, np.float32)
         gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
         self._motion = motion.HeadMotion(gray, contours) if p.motion else None
-        self._prev = frame
+        self._prev, self._gray = frame, gray
         self.frame_index = 0
         # The snakes settle on the image edges, which may sit a little off the given contours
         # (a landmark convention, not an error): settle them on the first frame, track the edges
@@ -362,10 +375,13 @@ class Tracker:
         down = total[:, :2] @ self._down0
         down /= _length(down)
         bounds_hi = np.array([self.width - 1.0, self.height - 1.0])
+        reach = p.delta0 / (1.0 - p.sigma)
         start = motion.apply(step, self._knots)
         if flow is not None:
             followed = np.isfinite(flow[:, 0])
             start[followed] = flow[followed]
+            if followed[self._mouth_knots].mean() < p.mouth_patch:
+                self._mouth_sideways(gray, start, followed, step, down, reach)
             if self._lips is not None:
                 self._lips.move(frame, start, ~followed, scale)
         start = np.clip(start, 0.0, bounds_hi)
@@ -373,7 +389,6 @@ class Tracker:
         rest = self._mouth_rest(carried, start)
         targets = self._targets0 * scale
         knots, iters, resp = self._solve(*self._field(frame, start), start, rest, down, targets)
-        reach = p.delta0 / (1.0 - p.sigma)
         before = start
         for _ in range(p.mouth_passes - 1):
             if np.abs(knots[self._mouth_knots] - before[self._mouth_knots]).max() < FAST * reach:
@@ -412,11 +427,26 @@ class Tracker:
         self._knots = knots
         self._linear = total[:, :2]
         self._down = down
-        self._prev = frame
+        self._prev, self._gray = frame, gray
         reported = self._reported_knots()
         # The head motion reads the contours next frame: its own copy, not the caller's.
         self._reported = self._named(reported)
         return FrameResult(self.frame_index, self._named(reported), confidence, lost, iters, ok)
+
+    def _mouth_sideways(self, gray: np.ndarray, start: np.ndarray, followed: np.ndarray, step: np.ndarray,
+                        down: np.ndarray, reach: float) -> None:
+        """Move the mouth knots the flow lost (``followed`` False) along the mouth line by how far
+        the previous frame's mouth region moved that way beyond the head's ``step``, when that is
+        at least :data:`AGREE` × ``reach`` px (in place; the mouth's motion up and down, an
+        opening, is the lip searches' to follow)."""
+        mouth = self._mouth_knots
+        shift = mouth_shift(self._gray, gray, self._knots[mouth], motion.apply(step, self._knots[mouth]))
+        if shift is None:
+            return
+        along = np.array([down[1], -down[0]])
+        sideways = float(shift @ along)
+        if abs(sideways) >= AGREE * reach:
+            start[mouth[~followed[mouth]]] += sideways * along
 
     def _centre_inner(self, knots: np.ndarray, rest: np.ndarray, down: np.ndarray) -> None:
         """Slide the inner mouth along the mouth line so that it sits where it sat in the outer
