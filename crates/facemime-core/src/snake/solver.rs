@@ -429,6 +429,18 @@ mod tests {
         }
     }
 
+    /// A frame without pairs whose rest knots are its start, the head upright.
+    fn plain_input<'a>(field: Field<'a>, start: &'a [P2]) -> FrameInput<'a> {
+        FrameInput {
+            field,
+            start,
+            rest: start,
+            down: [0.0, 1.0],
+            pair_targets: &[],
+            bounds: [W as f64, H as f64],
+        }
+    }
+
     fn line(y: f64, x0: f64, count: usize) -> Vec<P2> {
         (0..count).map(|k| [x0 + 5.0 * k as f64, y]).collect()
     }
@@ -448,14 +460,7 @@ mod tests {
         .unwrap();
         let lower = Problem::new(vec![(idx, curve_params(1.0))], vec![], 8, settings()).unwrap();
         let start = line(23.5, 10.0, 8);
-        let input = FrameInput {
-            field,
-            start: &start,
-            rest: &start,
-            down: [0.0, 1.0],
-            pair_targets: &[],
-            bounds: [W as f64, H as f64],
-        };
+        let input = plain_input(field, &start);
         let up = upper.solve(&input).unwrap();
         assert!(
             up.knots.iter().all(|k| (k[1] - 19.5).abs() < 0.6),
@@ -522,14 +527,7 @@ mod tests {
         start.extend(line(32.0, 10.0, 5));
         let solve = |curves: Vec<(Vec<usize>, CurveParams)>, n: usize| {
             let field = Field::new(&data, W, H, [0.0, 0.0]).unwrap();
-            let input = FrameInput {
-                field,
-                start: &start[..n],
-                rest: &start[..n],
-                down: [0.0, 1.0],
-                pair_targets: &[],
-                bounds: [W as f64, H as f64],
-            };
+            let input = plain_input(field, &start[..n]);
             Problem::new(curves, vec![], n, s)
                 .unwrap()
                 .solve(&input)
@@ -569,14 +567,7 @@ mod tests {
         let problem = Problem::new(curves, vec![], 10, settings()).unwrap();
         let mut start = line(22.0, 10.0, 5);
         start.extend(line(30.0, 10.0, 5));
-        let input = FrameInput {
-            field,
-            start: &start,
-            rest: &start,
-            down: [0.0, 1.0],
-            pair_targets: &[],
-            bounds: [W as f64, H as f64],
-        };
+        let input = plain_input(field, &start);
         let joint = problem.solve(&input).unwrap();
         let some = problem.solve_some(&input, &[false, true]).unwrap();
         assert_eq!(&some.knots[..5], &start[..5]);
@@ -633,7 +624,7 @@ mod tests {
             let p = curve_params(1.0);
             let problem = Problem::new(vec![((0..6).collect(), p)], vec![], 6, s).unwrap();
             let start: Vec<P2> = (0..6).map(|k| [(x0 + 4.0 * k as f64).clamp(0.0, 63.0), y0.clamp(0.0, 47.0)]).collect();
-            let input = FrameInput { field, start: &start, rest: &start, down: [0.0, 1.0], pair_targets: &[], bounds: [W as f64, H as f64] };
+            let input = plain_input(field, &start);
             let sol = problem.solve(&input).unwrap();
             let bound = delta0 / (1.0 - sigma) + 1e-9;
             for (k, s0) in sol.knots.iter().zip(&start) {
