@@ -107,10 +107,8 @@ class TrackerParams:
     mouth region is matched around where the head motion put it, and the knots the flow lost
     start moved along the mouth line by how far it moved that way beyond the head, when that is
     at least :data:`AGREE` solver reaches (:mod:`facemime.track.mouth`; 0: off). Measured on the
-    six videos: 0.3 to 0.7 track alike; without the reach gate, 0.6 and more moved knots the
-    flow had nearly all followed and the outer mouth's failures rose to 2.5%; moved up and down
-    too, a mouth opening dragged its upper lip down, and under nearby settings vr_2's mouth grew
-    frame after frame (10% failures).
+    six videos, 0.3 to 0.7 track alike; without the reach gate, 0.6 raised the outer mouth's
+    failures to 2.5%, and moved up and down too, an opening mouth dragged its upper lip down.
     ``iterations``, ``tol``: each solver pass runs at most ``iterations`` steps, and a feature
     stops early once its own energy changes by less than ``tol`` between steps (0: never;
     measured on the six videos, stopping at 1e-4 raised the outer mouth's failure rate from 2.9%
@@ -394,7 +392,7 @@ class Tracker:
             if np.abs(knots[self._mouth_knots] - before[self._mouth_knots]).max() < FAST * reach:
                 break
             before = knots.copy()
-            again, more, again_resp = self._solve(*self._field(frame, before, self._bands[:1]), before, rest, down,
+            again, more, again_resp = self._solve(*self._field(frame, before, (self._mouth_knots,)), before, rest, down,
                                                   targets, self._mouth_curves)
             knots[self._mouth_knots] = again[self._mouth_knots]
             resp[self._mouth_rows] = again_resp[self._mouth_rows]
