@@ -69,6 +69,11 @@ def lip_scores_near(
     colour: tuple[float, float, float],
     points: npt.NDArray[np.float64],
 ) -> npt.NDArray[np.float64]: ...
+def lip_score_map(
+    frame: npt.NDArray[np.uint8],
+    colour: tuple[float, float, float],
+    bounds: tuple[int, int, int, int],
+) -> npt.NDArray[np.float32]: ...
 def robust_similarity(
     src: npt.NDArray[np.float64],
     dst: npt.NDArray[np.float64],

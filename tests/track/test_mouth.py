@@ -1,14 +1,19 @@
-"""Following the whole mouth by matching its region when the optical flow loses its knots."""
+"""Following the whole mouth when the optical flow loses its knots, and finding it again when it
+has been lost for a while."""
 
 import cv2
 import numpy as np
 import pytest
 
-from facemime.metrics import group_nme
-from facemime.track import Tracker, TrackerParams
+from facemime.metrics import curve_error, group_nme
+from facemime.track import CONTOUR_NAMES, Tracker, TrackerParams
 from facemime.track.contours import GROUPS
+from facemime.track.lips import lip_colour
 from facemime.track.match import find
-from facemime.track.mouth import mouth_shift
+from facemime.track.mouth import mouth_shift, relocate
+from facemime.track.synthetic import band_face
+
+MOUTH = [n for n in CONTOUR_NAMES if n.startswith("mouth")]
 
 
 def texture(seed: int, size: int = 256) -> np.ndarray:
@@ -69,3 +74,46 @@ def test_follows_a_mouth_pushed_sideways_in_a_real_video(shared, patch):
         assert max(errors) < 0.07 and np.mean(errors) < 0.035
     else:
         assert max(errors) > 0.08
+
+
+def outer_polygon(contours) -> np.ndarray:
+    return np.concatenate([contours["mouth_outer_upper"], contours["mouth_outer_lower"][::-1]])
+
+
+def test_relocate_finds_the_lips_near_where_they_were_expected():
+    frame, truth = band_face()
+    colour = lip_colour(frame, truth)
+    lips = outer_polygon(truth)
+    found = relocate(frame, colour, lips + [25.0, 8.0], lips + [60.0, 0.0])
+    assert found is not None
+    assert np.abs(found.apply(lips + [25.0, 8.0], lips.mean(axis=0) + [25.0, 8.0]) - lips).max() < 1.0
+    # A mouth already on the lips is not moved.
+    assert relocate(frame, colour, lips + [25.0, 8.0], lips) is None
+
+
+SIZE = (384, 256)
+
+
+def mouth_moved(dx: float) -> np.ndarray:
+    """The band face with only its mouth (rows 156-190: no freckle there) moved ``dx`` px."""
+    out = band_face(size=SIZE)[0]
+    out[156:190] = band_face(shift=(dx, 0.0), size=SIZE)[0][156:190]
+    return out
+
+
+@pytest.mark.parametrize("after", [5, 0])
+def test_a_mouth_lost_for_a_while_is_found_again(after):
+    # The mouth slides 100 px to the side (followed), then is back in one frame (a cut): the
+    # tracked mouth is left on the cheek, lost, and stays there unless it is looked for.
+    frame0, truth0 = band_face(size=SIZE)
+    tracker = Tracker(frame0, truth0, TrackerParams(mouth_relocate=after))
+    for k in range(1, 21):
+        tracker.update(mouth_moved(5.0 * k))
+    lost = [bool(tracker.update(frame0).lost) for _ in range(8)]
+    result = tracker.update(frame0)
+    error = max(curve_error(result.contours[n], truth0[n]) for n in MOUTH)
+    if after:
+        assert lost == [True] * after + [False] * (8 - after)
+        assert error < 1.0
+    else:
+        assert all(lost) and error > 50.0

@@ -60,8 +60,9 @@ def test_no_coordinate_moves_more_than_the_solver_bound_per_pass_in_a_frame(mout
     # The brows get one solver pass per frame, the mouth ``mouth_passes``: each pass moves a
     # coordinate at most δ0/(1−σ); a motion faster than that uses the mouth's extra passes.
     # A brow that this fast motion loses jumps back to its rest shape instead (not a pass); the
-    # wide brow search, which is not a solver pass either, is off.
-    params = TrackerParams(motion=False, delta0=1.0, sigma=0.6, mouth_passes=mouth_passes, brow_search=0.0)
+    # wide searches for a brow or a mouth lost, which are not solver passes either, are off.
+    params = TrackerParams(motion=False, delta0=1.0, sigma=0.6, mouth_passes=mouth_passes, brow_search=0.0,
+                           mouth_relocate=0)
     bound = params.delta0 / (1.0 - params.sigma)
     frame0, truth0 = band_face()
     tracker = Tracker(frame0, truth0, params)

@@ -126,6 +126,31 @@ pub fn scores_near(image: &ImageRef, colour: &LipColour, points: &[[f64; 2]]) ->
         .collect())
 }
 
+/// The score of every pixel of the box `[x0, y0, x1, y1)` (exclusive ends, inside the image),
+/// row by row. `image` is (H, W, 3) RGB.
+pub fn score_map(image: &ImageRef, colour: &LipColour, bounds: [usize; 4]) -> Result<Vec<f32>> {
+    if image.channels != 3 {
+        return invalid!("the image must be RGB, got {} channels", image.channels);
+    }
+    let [x0, y0, x1, y1] = bounds;
+    if x0 > x1 || y0 > y1 || x1 > image.width || y1 > image.height {
+        return invalid!(
+            "box {bounds:?} is not inside the {}x{} image",
+            image.width,
+            image.height
+        );
+    }
+    let mut out = Vec::with_capacity((x1 - x0) * (y1 - y0));
+    for y in y0..y1 {
+        let row = &image.data[(y * image.width + x0) * 3..(y * image.width + x1) * 3];
+        out.extend(
+            row.chunks_exact(3)
+                .map(|p| score(colour, [p[0] as f64, p[1] as f64, p[2] as f64]) as f32),
+        );
+    }
+    Ok(out)
+}
+
 /// The score of an RGB colour.
 fn score(c: &LipColour, [r, g, b]: [f64; 3]) -> f64 {
     let sum = r + g + b + 1.0;
@@ -274,6 +299,19 @@ mod tests {
         let tie = scores_near(&image, &COLOUR, &[[10.0, 19.5]]).unwrap()[0];
         assert!((tie - (skin + 2.0 * lip) / 3.0).abs() < 1e-12);
         assert!(scores_near(&image, &COLOUR, &[[f64::NAN, 1.0]]).is_err());
+    }
+
+    #[test]
+    fn the_score_map_scores_each_pixel_of_the_box() {
+        let img = two_tone(20);
+        let image = ImageRef::new(&img, 40, 40, 3).unwrap();
+        let map = score_map(&image, &COLOUR, [5, 18, 9, 22]).unwrap();
+        assert_eq!(map.len(), 16);
+        let skin = score(&COLOUR, [205.0, 160.0, 140.0]) as f32;
+        let lip = score(&COLOUR, [175.0, 70.0, 75.0]) as f32;
+        assert_eq!(&map[..8], &[skin; 8]);
+        assert_eq!(&map[8..], &[lip; 8]);
+        assert!(score_map(&image, &COLOUR, [5, 18, 41, 22]).is_err());
     }
 
     #[test]

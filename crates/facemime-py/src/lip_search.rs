@@ -1,7 +1,9 @@
 //! Bindings of `facemime_core::lip_search`: the lip-edge search along the mouth knots' normals.
 
 use facemime_core::lip_search::{self, LipColour, Probe, SearchSettings};
-use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -84,8 +86,29 @@ fn lip_scores_near<'py>(
     Ok(scores.into_pyarray(py))
 }
 
+/// frame: (H, W, 3) uint8 RGB; colour: (w_r, w_g, bias) of the lip score; bounds: (x0, y0, x1,
+/// y1), exclusive ends. Returns the (y1 − y0, x1 − x0) float32 scores of the box's pixels.
+#[pyfunction]
+fn lip_score_map<'py>(
+    py: Python<'py>,
+    frame: PyReadonlyArray3<u8>,
+    colour: [f64; 3],
+    bounds: (usize, usize, usize, usize),
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let img = rgb_view("frame", &frame)?;
+    let colour = LipColour {
+        weights: [colour[0], colour[1]],
+        bias: colour[2],
+    };
+    let (x0, y0, x1, y1) = bounds;
+    let map = lip_search::score_map(&img, &colour, [x0, y0, x1, y1]).map_err(CoreErr)?;
+    let map = ndarray::Array2::from_shape_vec((y1 - y0, x1 - x0), map).expect("box-sized");
+    Ok(map.into_pyarray(py))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(find_lip_edges, m)?)?;
     m.add_function(wrap_pyfunction!(lip_scores_near, m)?)?;
+    m.add_function(wrap_pyfunction!(lip_score_map, m)?)?;
     Ok(())
 }

@@ -3,7 +3,7 @@
 1. OpenCV's Haar cascades find the largest face and its eyes (:mod:`facemime.fit.detect`).
 2. The generic head is placed on the eye centres (rotation, uniform scale, translation).
 3. Each brow and the lips are slid and scaled to where the image contrast puts them
-   (:func:`facemime.fit.features.locate`): brows darker than the skin around them, lips
+   (:func:`facemime.track.match.locate`): brows darker than the skin around them, lips
    redder.
 4. The mouth and brow curves settle on their edges with the tracker's snakes.
 
@@ -18,12 +18,12 @@ import cv2
 import numpy as np
 
 from facemime.fit.detect import FaceDetection, detect_face
-from facemime.fit.features import locate
 from facemime.fit.placement import frontal_pose, model_eye_centres, model_iod
 from facemime.fit.points import GROUPS, ReferencePoints, model_chain
 from facemime.model.head import HeadModel, generic_head
 from facemime.render.projection import project
 from facemime.track.contours import CONTOUR_NAMES
+from facemime.track.match import locate
 from facemime.track.tracker import Tracker, TrackerParams
 
 #: Search settings per feature, in units of the inter-ocular distance (outer eye corners):

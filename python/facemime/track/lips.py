@@ -136,17 +136,18 @@ class LipSearch:
     ``index``: contour name -> its knots' indices in the tracker's knot array; ``edges``: the
     first frame's knots as settled on the image edges; ``reach``: search range, ± this fraction
     of the first frame's mouth width; ``min_step``: smallest edge (score units per px).
-    ``active`` is False when the colours did not separate: :meth:`move` then does nothing.
+    ``active`` is False when the colours did not separate: :meth:`move` then does nothing;
+    ``colour`` is the lip score (w_r, w_g, bias) when it is True.
     """
 
     def __init__(self, frame: np.ndarray, contours: Mapping[str, np.ndarray], index: Mapping[str, np.ndarray],
                  edges: np.ndarray, reach: float, min_step: float):
-        self._colour = lip_colour(frame, contours)
+        self.colour = lip_colour(frame, contours)
         corners = np.asarray(contours["mouth_outer_upper"], np.float64)[[0, -1]]
         self._reach = reach * float(np.linalg.norm(corners[1] - corners[0]))
         self._min_step = min_step
         self._index = {n: index[n] for n in MOUTH}
-        self.active = self._colour is not None and self._reach >= 1.0
+        self.active = self.colour is not None and self._reach >= 1.0
         # Where each knot sat from its lip edge on the first frame (the snakes settle on the
         # luma edge, which may lie a little off the colour edge): kept in later frames.
         self._offset0 = {n: np.zeros(len(i)) for n, i in self._index.items()}
@@ -191,7 +192,7 @@ class LipSearch:
         if expect is None:
             expect = OUTERMOST[name] * reach if name in OUTERMOST else self._offset0[name][pick] * scale
         out[pick] = _core.find_lip_edges(
-            frame, self._colour, np.ascontiguousarray(pts[pick]), np.ascontiguousarray(normal[pick]),
+            frame, self.colour, np.ascontiguousarray(pts[pick]), np.ascontiguousarray(normal[pick]),
             np.full(len(pick), POLARITY[name][1]), np.broadcast_to(expect, len(pick)).astype(np.float64),
             reach, SIGMA, self._min_step)
         return out, normal
@@ -223,7 +224,7 @@ class LipSearch:
             near[name] = np.maximum(PROBE * self._lip0[name] * scale, 2.0)
             step = side * near[name][:, None] * _normals(knots[self._index[name]])[1:-1]
             probes += [pts + step, pts + BEYOND * step]
-        scores = _core.lip_scores_near(frame, self._colour, np.concatenate(probes))
+        scores = _core.lip_scores_near(frame, self.colour, np.concatenate(probes))
         scores = np.split(scores, np.cumsum([len(q) for q in probes])[:-1])
         for k, name in enumerate(OUTERMOST):
             inside = (scores[2 * k] > LIP_OUTSIDE) & (scores[2 * k + 1] < SKIN_BEYOND)

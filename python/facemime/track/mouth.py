@@ -1,4 +1,5 @@
-"""Following the whole mouth when the optical flow loses its knots.
+"""Following the whole mouth when the optical flow loses its knots, and finding it again when
+it has been lost for a while.
 
 A mouth pushed sideways or pulled into a grimace within a frame or two (face-pulling, or a video
 that drops frames) deforms faster than the flow's windows follow: most mouth knots fail its
@@ -7,15 +8,23 @@ reach (δ0/(1−σ) px) from the lips. The mouth region as a whole still looks m
 previous frame: matching that region, gray, around where the head motion put it
 (:mod:`facemime.track.match`) measures how far the mouth moved beyond the head; the tracker
 moves the knots the flow lost by its part along the mouth line (an opening, up and down, is
-left to the lip searches). Coordinates are (x, y) pixels, origin at the centre of the top-left
-pixel, y down.
+left to the lip searches).
+
+A mouth that slid off the lips (onto the cheek, after a cut between takes) can hold an edge
+there and stay, flagged lost. After several lost frames the lips are looked for by their colour:
+the first frame's outer mouth, placed where the brows put it, is slid and scaled over the lip
+score (:func:`facemime.track.match.locate`) within most of a mouth width, and kept only where it
+is clearly more lip-coloured, against the skin around it, than the tracked mouth.
+
+Coordinates are (x, y) pixels, origin at the centre of the top-left pixel, y down.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from facemime.track.match import crop_box, find
+from facemime import _core
+from facemime.track.match import Placement, crop_box, find, locate
 
 #: The template is the box of the previous frame's mouth knots grown by this fraction of the
 #: mouth's width (some skin around the lips: measured on the six videos, 0.1 followed the mouth
@@ -26,6 +35,18 @@ REACH = 0.4
 #: A match below this correlation is no match (on lp_d6 the matches that moved the mouth right
 #: correlate 0.6 to 0.97; across a cut between takes a wrong one, 27 px off, 0.53).
 MIN_MATCH = 0.6
+#: A lost mouth is looked for within ± these fractions of its width (x, y) of where the brows put
+#: it, at these scales.
+RELOCATE_REACH = (0.8, 0.4)
+RELOCATE_SCALES = (0.8, 1.0, 1.25)
+#: The band of skin around the mouth that its inside is compared with, a fraction of its width.
+RING = 0.12
+#: The lip score is clipped to ± this (skin standard deviations), so that a few vivid pixels do
+#: not outweigh the rest.
+CLIP = 2.0
+#: A place found is kept when its contrast (mean clipped lip score inside minus in the ring)
+#: beats the tracked mouth's by this much.
+GAIN = 0.5
 
 
 def mouth_shift(prev_gray: np.ndarray, gray: np.ndarray, prev: np.ndarray, carried: np.ndarray) -> np.ndarray | None:
@@ -44,3 +65,20 @@ def mouth_shift(prev_gray: np.ndarray, gray: np.ndarray, prev: np.ndarray, carri
     if found is None:
         return None
     return found - expected
+
+
+def relocate(frame: np.ndarray, colour: tuple[float, float, float], expected: np.ndarray,
+             current: np.ndarray) -> Placement | None:
+    """Where the lips of ``frame`` ((H, W, 3) uint8 RGB; lip score ``colour`` = (w_r, w_g,
+    bias), :func:`facemime.track.lips.lip_colour`) are, as the placement of the outer mouth
+    polygon ``expected`` ((N, 2) px, where the mouth is expected) that fits them best; None
+    unless it beats the tracked polygon ``current`` by :data:`GAIN`."""
+    height, width = frame.shape[:2]
+    size = float(np.ptp(expected[:, 0]))
+    reach, ring = (RELOCATE_REACH[0] * size, RELOCATE_REACH[1] * size), max(2.0, RING * size)
+    lo, hi = crop_box(np.concatenate([expected, current]), max(RELOCATE_SCALES) * reach[0] + ring, width, height)
+    scores = _core.lip_score_map(frame, colour, (int(lo[0]), int(lo[1]), int(hi[0]), int(hi[1])))
+    channel = np.clip(scores, -CLIP, CLIP)
+    found = locate(channel, expected - lo, reach, ring, RELOCATE_SCALES)
+    now = locate(channel, current - lo, (0.0, 0.0), ring)
+    return found if found.contrast > now.contrast + GAIN else None

@@ -24,7 +24,8 @@ Per frame:
    matched it, or else to its first-frame shape carried by the head motion, from where the next
    frame's snakes find it again (a brow that slid onto the eye otherwise stays there); a lost
    mouth stays where it is (measured: its rest shape follows the head, not the mouth, and
-   resetting it made the tracks worse).
+   resetting it made the tracks worse); one lost ``mouth_relocate`` frames in a row is looked for
+   by its lip colour near where the brows put it (:mod:`facemime.track.mouth`).
 
 Coordinates are (x, y) pixels, origin at the centre of the top-left pixel, y down.
 """
@@ -46,7 +47,7 @@ from facemime.track.brows import BrowSearch
 from facemime.track.contours import CONTOUR_NAMES, FEATURES, POLARITY
 from facemime.track.field import build_field, region
 from facemime.track.lips import LipSearch
-from facemime.track.mouth import mouth_shift
+from facemime.track.mouth import mouth_shift, relocate
 
 OPERATORS = ("directional", "magnitude")
 #: The mouth gets another solver pass only when a knot moved this fraction of a pass's reach.
@@ -109,6 +110,8 @@ class TrackerParams:
     at least :data:`AGREE` solver reaches (:mod:`facemime.track.mouth`; 0: off). Measured on the
     six videos, 0.3 to 0.7 track alike; without the reach gate, 0.6 raised the outer mouth's
     failures to 2.5%, and moved up and down too, an opening mouth dragged its upper lip down.
+    ``mouth_relocate``: a mouth lost this many frames in a row is looked for by its lip colour
+    around where the brows put it (:func:`facemime.track.mouth.relocate`; 0: off).
     ``iterations``, ``tol``: each solver pass runs at most ``iterations`` steps, and a feature
     stops early once its own energy changes by less than ``tol`` between steps (0: never;
     measured on the six videos, stopping at 1e-4 raised the outer mouth's failure rate from 2.9%
@@ -140,6 +143,7 @@ class TrackerParams:
     lip_step: float = 0.3
     brow_search: float = 0.3
     mouth_patch: float = 0.5
+    mouth_relocate: int = 5
 
     def with_(self, **changes: object) -> "TrackerParams":
         """A copy with some settings changed."""
@@ -260,6 +264,7 @@ class Tracker:
         gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
         self._motion = motion.HeadMotion(gray, contours) if p.motion else None
         self._prev, self._gray = frame, gray
+        self._mouth_lost_for = 0  # frames in a row with a mouth feature lost
         self.frame_index = 0
         # The snakes settle on the image edges, which may sit a little off the given contours
         # (a landmark convention, not an error): settle them on the first frame, track the edges
@@ -422,6 +427,9 @@ class Tracker:
                 lost.append(feature)
                 if feature.startswith("brow"):
                     knots[idx] = fallback[idx]
+        self._mouth_lost_for = self._mouth_lost_for + 1 if any(f.startswith("mouth") for f in lost) else 0
+        if 0 < p.mouth_relocate <= self._mouth_lost_for and self._lips is not None and self._lips.active:
+            self._relocate_mouth(frame, knots)
         self._knots = knots
         self._linear = total[:, :2]
         self._down = down
@@ -445,6 +453,19 @@ class Tracker:
         sideways = float(shift @ along)
         if abs(sideways) >= AGREE * reach:
             start[mouth[~followed[mouth]]] += sideways * along
+
+    def _relocate_mouth(self, frame: np.ndarray, knots: np.ndarray) -> None:
+        """Put the mouth, lost for ``mouth_relocate`` frames, where its lip colour is found near
+        where the brows put the first frame's mouth, in that mouth's shape (in place; unchanged
+        when nothing clearly better was found)."""
+        expected = motion.apply(motion.brow_similarity(self.edges, self._named(knots)), self._knots0)
+        upper, lower = self._index["mouth_outer_upper"], self._index["mouth_outer_lower"]
+        outer = lambda k: np.concatenate([k[upper], k[lower][::-1]])  # noqa: E731
+        found = relocate(frame, self._lips.colour, outer(expected), outer(knots))
+        if found is not None:
+            mouth = self._mouth_knots
+            knots[mouth] = found.apply(expected[mouth], outer(expected).mean(axis=0))
+            self._mouth_lost_for = 0
 
     def _centre_inner(self, knots: np.ndarray, rest: np.ndarray, down: np.ndarray) -> None:
         """Slide the inner mouth along the mouth line so that it sits where it sat in the outer
