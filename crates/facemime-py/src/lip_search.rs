@@ -11,6 +11,14 @@ use crate::error::CoreErr;
 use crate::points::rows;
 use crate::snake::rgb_view;
 
+/// The core's lip colour from (w_r, w_g, bias).
+fn lip_colour(c: [f64; 3]) -> LipColour {
+    LipColour {
+        weights: [c[0], c[1]],
+        bias: c[2],
+    }
+}
+
 /// frame: (H, W, 3) uint8 RGB; colour: (w_r, w_g, bias) of the lip score; points, normals:
 /// (K, 2) pixels and unit vectors; signs: (K,) +1 for a score rising along the normal, −1 for
 /// one falling; expect: (K,) offsets (px) to search nearest to; reach, sigma (px), min_step.
@@ -52,10 +60,7 @@ fn find_lip_edges<'py>(
             expect: expect[i],
         })
         .collect();
-    let colour = LipColour {
-        weights: [colour[0], colour[1]],
-        bias: colour[2],
-    };
+    let colour = lip_colour(colour);
     let settings = SearchSettings {
         reach,
         sigma,
@@ -78,10 +83,7 @@ fn lip_scores_near<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let img = rgb_view("frame", &frame)?;
     let at = rows::<2>("points", &points)?;
-    let colour = LipColour {
-        weights: [colour[0], colour[1]],
-        bias: colour[2],
-    };
+    let colour = lip_colour(colour);
     let scores = lip_search::scores_near(&img, &colour, &at).map_err(CoreErr)?;
     Ok(scores.into_pyarray(py))
 }
@@ -96,10 +98,7 @@ fn lip_score_map<'py>(
     bounds: (usize, usize, usize, usize),
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let img = rgb_view("frame", &frame)?;
-    let colour = LipColour {
-        weights: [colour[0], colour[1]],
-        bias: colour[2],
-    };
+    let colour = lip_colour(colour);
     let (x0, y0, x1, y1) = bounds;
     let map = lip_search::score_map(&img, &colour, [x0, y0, x1, y1]).map_err(CoreErr)?;
     let map = ndarray::Array2::from_shape_vec((y1 - y0, x1 - x0), map).expect("box-sized");
