@@ -55,16 +55,14 @@ def mouth_shift(prev_gray: np.ndarray, gray: np.ndarray, prev: np.ndarray, carri
     moved by the head motion) to where the previous frame's mouth region matched best; None when
     it matched nowhere."""
     height, width = gray.shape
-    lo, hi = crop_box(prev, MARGIN * float(np.ptp(prev[:, 0])), width, height)
+    size = float(np.ptp(prev[:, 0]))
+    lo, hi = crop_box(prev, MARGIN * size, width, height)
     template = prev_gray[lo[1]:hi[1], lo[0]:hi[0]]
     if min(template.shape) < 8 or template.std() < 1.0:
         return None
     expected = (lo + hi - 1) / 2.0 + carried.mean(axis=0) - prev.mean(axis=0)
-    reach = REACH * float(np.ptp(prev[:, 0]))
-    found = find(gray, template, expected, reach, MIN_MATCH)
-    if found is None:
-        return None
-    return found - expected
+    found = find(gray, template, expected, REACH * size, MIN_MATCH)
+    return None if found is None else found - expected
 
 
 def relocate(frame: np.ndarray, colour: tuple[float, float, float], expected: np.ndarray,
