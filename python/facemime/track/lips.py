@@ -157,21 +157,20 @@ class LipSearch:
                 self._offset0[name] = np.nan_to_num(found)
         # Each inner knot's signed distance (px) to its outer lip along its normal on the first
         # frame.
-        self._thickness0 = {n: self._gaps(edges, n) for n in LIP_PAIRS}
+        self._thickness0 = {n: self._gaps(edges, n, outer) for n, outer in LIP_PAIRS.items()}
         # Each outer knot's lip thickness (px along its normal to the inner curve; where the
         # normal misses it, the lip's median).
         self._lip0 = {}
         for inner, outer in LIP_PAIRS.items():
-            pts = edges[self._index[outer]]
-            gap = np.abs(normal_gaps(pts[1:-1], _normals(pts)[1:-1], edges[self._index[inner]]))
+            gap = np.abs(self._gaps(edges, outer, inner))
             median = float(np.nanmedian(gap)) if np.isfinite(gap).any() else 0.0
             self._lip0[outer] = np.where(np.isfinite(gap), gap, median)
 
-    def _gaps(self, knots: np.ndarray, inner: str) -> np.ndarray:
-        """The signed distances (px) of the interior knots of curve ``inner`` along their
-        normals to the outer lip (NaN where they miss it)."""
-        pts = knots[self._index[inner]]
-        return normal_gaps(pts[1:-1], _normals(pts)[1:-1], knots[self._index[LIP_PAIRS[inner]]])
+    def _gaps(self, knots: np.ndarray, name: str, other: str) -> np.ndarray:
+        """The signed distances (px) of the interior knots of curve ``name`` along their
+        normals to curve ``other`` (NaN where they miss it)."""
+        pts = knots[self._index[name]]
+        return normal_gaps(pts[1:-1], _normals(pts)[1:-1], knots[self._index[other]])
 
     def _search(self, frame: np.ndarray, knots: np.ndarray, name: str, which: np.ndarray, scale: float,
                 within: float | None = None, expect: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -238,7 +237,7 @@ class LipSearch:
         than :data:`THICKER` first-frame lip thicknesses (at least 1 px each) to the lip edge
         found nearest one thickness inside the outer lip, keeping the curve's median first-frame
         offset from its edge (in place)."""
-        gap = self._gaps(knots, name)
+        gap = self._gaps(knots, name, LIP_PAIRS[name])
         thickness = self._thickness0[name] * scale
         far = np.abs(gap) > THICKER * np.maximum(np.abs(thickness), 1.0)  # False where NaN
         if far.any():

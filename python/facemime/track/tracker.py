@@ -254,6 +254,7 @@ class Tracker:
         self._features = {f: np.unique(np.concatenate([self._index[n] for n in names])) for f, names in FEATURES.items()}
         self._mouth_knots = np.unique(np.concatenate([self._features["mouth_outer"], self._features["mouth_inner"]]))
         self._bands = (self._mouth_knots, np.unique(np.concatenate([self._features["brow_left"], self._features["brow_right"]])))
+        self._banded = np.concatenate(self._bands)
         self._mouth_rows = [i for i, n in enumerate(CONTOUR_NAMES) if n.startswith("mouth")]
         self._feature_rows = {f: np.array([CONTOUR_NAMES.index(n) for n in names]) for f, names in FEATURES.items()}
         # Curve masks of the features solved on their own: the mouth's second pass, a brow found again.
@@ -331,8 +332,9 @@ class Tracker:
         ``bands_of``, knot index arrays, around those knots only."""
         p = self.params
         margin = p.delta0 / (1.0 - p.sigma) + 4.0 * p.smoothing + 2.0
+        banded = self._banded if bands_of is None else np.concatenate(bands_of)
         bands_of = self._bands if bands_of is None else bands_of
-        box = region(knots[np.concatenate(bands_of)], margin, self.width, self.height)
+        box = region(knots[banded], margin, self.width, self.height)
         # The snakes read the image only near the knots: the rows of the brows and of the
         # mouth, not the eyes and nose between them.
         bands = []
@@ -409,8 +411,9 @@ class Tracker:
             rows, idx = self._feature_rows[feature], self._features[feature]
             conf = float(ratio[rows].mean())
             fallback = carried
+            shape_ok = self._shape_ok(knots, carried, names)
             search = self._brow_search.get(feature)
-            if search is not None and (ratio[rows].min() < p.brow_search or not self._shape_ok(knots, carried, names)):
+            if search is not None and (ratio[rows].min() < p.brow_search or not shape_ok):
                 found = search.find(gray, scale, start[idx])
                 if found is not None:
                     fallback = knots.copy()
@@ -420,10 +423,11 @@ class Tracker:
                                                               down, targets, self._feature_curves[feature])
                         iters += more
                         conf_again = float(np.clip(again_resp[rows] / self._response0[rows], 0.0, 1.0).mean())
-                        if conf_again > conf or not self._shape_ok(knots, carried, names):
+                        if conf_again > conf or not shape_ok:
                             knots[idx], conf = again[idx], conf_again
+                            shape_ok = self._shape_ok(knots, carried, names)
             confidence[feature] = conf
-            if conf < p.lost_response or not self._shape_ok(knots, carried, names):
+            if conf < p.lost_response or not shape_ok:
                 lost.append(feature)
                 if feature.startswith("brow"):
                     knots[idx] = fallback[idx]
