@@ -74,6 +74,11 @@ def lip_score_map(
     colour: tuple[float, float, float],
     bounds: tuple[int, int, int, int],
 ) -> npt.NDArray[np.float32]: ...
+def normal_gaps(
+    points: npt.NDArray[np.float64],
+    normals: npt.NDArray[np.float64],
+    curve: npt.NDArray[np.float64],
+) -> npt.NDArray[np.float64]: ...
 def robust_similarity(
     src: npt.NDArray[np.float64],
     dst: npt.NDArray[np.float64],

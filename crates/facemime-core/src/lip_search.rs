@@ -151,6 +151,39 @@ pub fn score_map(image: &ImageRef, colour: &LipColour, bounds: [usize; 4]) -> Re
     Ok(out)
 }
 
+/// For each of `points` (px) and its unit normal, the signed distance t (px) along the normal
+/// to the nearest crossing of the polyline `curve`: point + t·normal lies on it; NaN where the
+/// normal's line misses every segment (or the curve has fewer than two points).
+pub fn normal_gaps(points: &[[f64; 2]], normals: &[[f64; 2]], curve: &[[f64; 2]]) -> Vec<f64> {
+    points
+        .iter()
+        .zip(normals)
+        .map(|(p, n)| {
+            let mut best = f64::INFINITY;
+            for seg in curve.windows(2) {
+                let (a, e) = (seg[0], [seg[1][0] - seg[0][0], seg[1][1] - seg[0][1]]);
+                let (rx, ry) = (a[0] - p[0], a[1] - p[1]);
+                // p + t·n = a + s·e by Cramer's rule: t = num_t / det, s = num_s / det, and
+                // 0 ≤ s ≤ 1 without dividing: num_s and det of one sign, |num_s| ≤ |det|.
+                let det = n[1] * e[0] - n[0] * e[1];
+                let num_t = ry * e[0] - rx * e[1];
+                let num_s = n[0] * ry - n[1] * rx;
+                if num_s * det >= 0.0 && num_s.abs() <= det.abs() && det != 0.0 {
+                    let t = num_t / det;
+                    if t.abs() < best.abs() {
+                        best = t;
+                    }
+                }
+            }
+            if best.is_finite() {
+                best
+            } else {
+                f64::NAN
+            }
+        })
+        .collect()
+}
+
 /// The score of an RGB colour.
 fn score(c: &LipColour, [r, g, b]: [f64; 3]) -> f64 {
     let sum = r + g + b + 1.0;
@@ -312,6 +345,20 @@ mod tests {
         assert_eq!(&map[..8], &[skin; 8]);
         assert_eq!(&map[8..], &[lip; 8]);
         assert!(score_map(&image, &COLOUR, [5, 18, 41, 22]).is_err());
+    }
+
+    #[test]
+    fn normal_gaps_reach_the_nearest_crossing_or_nan() {
+        // A V-shaped curve, and points looking down (+y) and up onto it.
+        let curve = [[0.0, 0.0], [10.0, 10.0], [20.0, 0.0]];
+        let points = [[5.0, 8.0], [15.0, 0.0], [30.0, 0.0], [10.0, 10.0]];
+        let down = [[0.0, 1.0]; 4];
+        let gaps = normal_gaps(&points, &down, &curve);
+        assert_eq!(gaps[0], -3.0); // up to (5, 5)
+        assert_eq!(gaps[1], 5.0); // down to (15, 5)
+        assert!(gaps[2].is_nan()); // beyond the curve's ends
+        assert_eq!(gaps[3], 0.0); // on the curve's vertex
+        assert!(normal_gaps(&points[..1], &down[..1], &curve[..1])[0].is_nan());
     }
 
     #[test]

@@ -105,9 +105,35 @@ fn lip_score_map<'py>(
     Ok(map.into_pyarray(py))
 }
 
+/// points, normals: (K, 2) pixels and unit vectors; curve: (M, 2) pixels, a polyline.
+/// Returns the (K,) signed distances (px) along the normals to the curve's nearest crossing,
+/// NaN where a normal's line misses it.
+#[pyfunction]
+fn normal_gaps<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<f64>,
+    normals: PyReadonlyArray2<f64>,
+    curve: PyReadonlyArray2<f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let (at, normal) = (
+        rows::<2>("points", &points)?,
+        rows::<2>("normals", &normals)?,
+    );
+    if normal.len() != at.len() {
+        return Err(PyValueError::new_err(format!(
+            "points and normals must have the same length, got {} and {}",
+            at.len(),
+            normal.len()
+        )));
+    }
+    let curve = rows::<2>("curve", &curve)?;
+    Ok(lip_search::normal_gaps(&at, &normal, &curve).into_pyarray(py))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(find_lip_edges, m)?)?;
     m.add_function(wrap_pyfunction!(lip_scores_near, m)?)?;
     m.add_function(wrap_pyfunction!(lip_score_map, m)?)?;
+    m.add_function(wrap_pyfunction!(normal_gaps, m)?)?;
     Ok(())
 }

@@ -73,21 +73,9 @@ def _normals(pts: np.ndarray) -> np.ndarray:
 def normal_gaps(pts: np.ndarray, normals: np.ndarray, curve: np.ndarray) -> np.ndarray:
     """For each of ``pts`` (N, 2) px, the signed distance t (px) along its unit normal to the
     nearest crossing of the polyline ``curve`` (M, 2): pts + t·normal lies on it; NaN where
-    the normal's line misses the polyline."""
-    a = curve[:-1]
-    e = curve[1:] - a  # (M-1, 2) segments
-    rx, ry = a[None, :, 0] - pts[:, None, 0], a[None, :, 1] - pts[:, None, 1]  # (N, M-1)
-    nx, ny = normals[:, None, 0], normals[:, None, 1]
-    # pts + t·n = a + s·e, by Cramer's rule: t = num_t / det, s = num_s / det
-    det = ny * e[:, 0] - nx * e[:, 1]
-    num_t = ry * e[:, 0] - rx * e[:, 1]
-    num_s = nx * ry - ny * rx
-    # 0 ≤ s ≤ 1 without dividing: num_s and det of one sign, |num_s| ≤ |det| (det ≠ 0)
-    crossed = (num_s * det >= 0.0) & (np.abs(num_s) <= np.abs(det)) & (det != 0.0)
-    t = np.full(det.shape, np.inf)
-    np.divide(num_t, det, out=t, where=crossed)
-    best = t[np.arange(len(t)), np.argmin(np.abs(t), axis=1)]
-    return np.where(np.isfinite(best), best, np.nan)
+    the normal's line misses the polyline (``facemime._core.normal_gaps``)."""
+    as_points = lambda p: np.ascontiguousarray(p, np.float64).reshape(-1, 2)  # noqa: E731
+    return _core.normal_gaps(as_points(pts), as_points(normals), as_points(curve))
 
 
 def _polygon_mask(shape: tuple[int, int], upper: np.ndarray, lower: np.ndarray) -> np.ndarray:
@@ -224,9 +212,10 @@ class LipSearch:
             step = side * near[name][:, None] * _normals(knots[self._index[name]])[1:-1]
             probes += [pts + step, pts + BEYOND * step]
         scores = _core.lip_scores_near(frame, self.colour, np.concatenate(probes))
-        scores = np.split(scores, np.cumsum([len(q) for q in probes])[:-1])
+        ends = np.cumsum([0] + [len(q) for q in probes])
         for k, name in enumerate(OUTERMOST):
-            inside = (scores[2 * k] > LIP_OUTSIDE) & (scores[2 * k + 1] < SKIN_BEYOND)
+            near_score, far_score = (scores[ends[j]:ends[j + 1]] for j in (2 * k, 2 * k + 1))
+            inside = (near_score > LIP_OUTSIDE) & (far_score < SKIN_BEYOND)
             if inside.any():  # the lip's edge lies between the two probes
                 self._place(frame, knots, name, inside, scale, within=BEYOND * float(near[name][inside].max()))
         for name in LIP_PAIRS:
