@@ -19,6 +19,11 @@ EPSILON = 0.03  # px (of the level): stop once a step is shorter
 MIN_EIGEN = 1e-4 * 1024
 
 
+def as_points(points: object) -> np.ndarray:
+    """``points`` as the core takes (x, y) points: a C-contiguous (N, 2) float64 array."""
+    return np.ascontiguousarray(points, np.float64).reshape(-1, 2)
+
+
 class FrameFlow:
     """Feed gray frames with :meth:`push`; :meth:`track` follows points from the previous frame
     into the current one, or back."""
@@ -34,5 +39,4 @@ class FrameFlow:
     def track(self, points: np.ndarray, backward: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """Positions in the current frame of (N, 2) points of the previous one (the reverse
         with ``backward``): ((N, 2) float64, NaN where lost; (N,) bool, followed)."""
-        pts = np.ascontiguousarray(points, np.float64).reshape(-1, 2)
-        return self._frames.track(pts, backward, ITERATIONS, EPSILON, MIN_EIGEN)
+        return self._frames.track(as_points(points), backward, ITERATIONS, EPSILON, MIN_EIGEN)

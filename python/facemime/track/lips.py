@@ -29,6 +29,7 @@ import numpy as np
 
 from facemime import _core
 from facemime.track.contours import POLARITY
+from facemime.track.flow import as_points
 
 #: Side of the square that grows the outer mouth into the skin ring, as a fraction of the mouth width.
 SKIN_RING = 0.3
@@ -74,7 +75,6 @@ def normal_gaps(pts: np.ndarray, normals: np.ndarray, curve: np.ndarray) -> np.n
     """For each of ``pts`` (N, 2) px, the signed distance t (px) along its unit normal to the
     nearest crossing of the polyline ``curve`` (M, 2): pts + t·normal lies on it; NaN where
     the normal's line misses the polyline (``facemime._core.normal_gaps``)."""
-    as_points = lambda p: np.ascontiguousarray(p, np.float64).reshape(-1, 2)  # noqa: E731
     return _core.normal_gaps(as_points(pts), as_points(normals), as_points(curve))
 
 

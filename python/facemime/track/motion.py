@@ -17,7 +17,7 @@ import cv2
 import numpy as np
 
 from facemime import _core
-from facemime.track.flow import LEVELS, WINDOW, FrameFlow
+from facemime.track.flow import LEVELS, WINDOW, FrameFlow, as_points
 
 #: Rigid zones in face coordinates (s, t) of the first frame: a point is ``c + s·W·u + t·v``
 #: where ``c`` is the centre of the brows, ``v`` runs from it to the centre of the mouth, ``u`` is
@@ -59,7 +59,6 @@ def robust_similarity(src: np.ndarray, dst: np.ndarray, limit: float, rounds: in
     ``dst`` (N, 2) px despite outliers, and the (N,) inlier mask (residual below ``limit`` px).
     Iteratively reweighted least squares with Tukey's biweight, started from the median
     displacement; deterministic (``facemime._core.robust_similarity``)."""
-    as_points = lambda p: np.ascontiguousarray(p, np.float64).reshape(-1, 2)  # noqa: E731
     return _core.robust_similarity(as_points(src), as_points(dst), float(limit), int(rounds))
 
 
