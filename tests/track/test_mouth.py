@@ -101,7 +101,7 @@ def mouth_moved(dx: float) -> np.ndarray:
     return out
 
 
-@pytest.mark.parametrize("after", [5, 0])
+@pytest.mark.parametrize("after", [1, 5, 0])
 def test_a_mouth_lost_for_a_while_is_found_again(after):
     # The mouth slides 100 px to the side (followed), then is back in one frame (a cut): the
     # tracked mouth is left on the cheek, lost, and stays there unless it is looked for.

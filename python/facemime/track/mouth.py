@@ -11,10 +11,11 @@ moves the knots the flow lost by its part along the mouth line (an opening, up a
 left to the lip searches).
 
 A mouth that slid off the lips (onto the cheek, after a cut between takes) can hold an edge
-there and stay, flagged lost. After several lost frames the lips are looked for by their colour:
-the first frame's outer mouth, placed where the brows put it, is slid and scaled over the lip
-score (:func:`facemime.track.match.locate`) within most of a mouth width, and kept only where it
-is clearly more lip-coloured, against the skin around it, than the tracked mouth.
+there and stay, flagged lost. After a lost frame (the tracker's ``mouth_relocate``) the lips are
+looked for by their colour: the first frame's outer mouth, placed where the brows put it, is
+slid and scaled over the lip score (:func:`facemime.track.match.locate`) within most of a mouth
+width, and kept only where it is clearly more lip-coloured, against the skin around it, than
+the tracked mouth.
 
 Coordinates are (x, y) pixels, origin at the centre of the top-left pixel, y down.
 """
