@@ -25,7 +25,8 @@ Per frame:
    frame's snakes find it again (a brow that slid onto the eye otherwise stays there); a lost
    mouth stays where it is (measured: its rest shape follows the head, not the mouth, and
    resetting it made the tracks worse), and is looked for by its lip colour near where the brows
-   put it once it has been lost ``mouth_relocate`` frames in a row (:mod:`facemime.track.mouth`).
+   put it once it has been lost ``mouth_relocate`` frames in a row (:mod:`facemime.track.mouth`),
+   then settled there by another solver run: a mouth that holds its edges there is not lost.
 
 Coordinates are (x, y) pixels, origin at the centre of the top-left pixel, y down.
 """
@@ -112,10 +113,11 @@ class TrackerParams:
     six videos, 0.3 to 0.7 track alike; without the reach gate, 0.6 raised the outer mouth's
     failures to 2.5%, and moved up and down too, an opening mouth dragged its upper lip down.
     ``mouth_relocate``: a mouth lost this many frames in a row is looked for by its lip colour
-    around where the brows put it (:func:`facemime.track.mouth.relocate`; 0: off). Measured on
-    lp_d6, whose mouth a grimace moves 32 px sideways within a frame: after 1 lost frame rather
-    than 5, its frames with an outer mouth NME above 0.1 went from 13 to 5 (inner 15 to 9); the
-    other five videos never lose their mouth.
+    around where the brows put it (:func:`facemime.track.mouth.relocate`; 0: off), and settled
+    there by a solver pass; a mouth that then holds its edges is not lost. Measured on lp_d6,
+    whose mouth a grimace moves 32 px sideways within a frame: at 1 rather than 5, and settled,
+    its frames with an outer mouth NME above 0.1 went from 13 to 4 (inner 15 to 9) and its frames
+    with a lost feature from 10 to 2; the other five videos never lose their mouth.
     ``face_width``: a face whose brows are wider than this (outer width, px, on the first
     frame) is tracked on frames shrunk to make them this wide, its contours reported in the
     frame's pixels (:mod:`facemime.track.scale`; None: never). The pixel settings above were
@@ -450,7 +452,11 @@ class Tracker:
                     knots[idx] = fallback[idx]
         self._mouth_lost_for = self._mouth_lost_for + 1 if any(f.startswith("mouth") for f in lost) else 0
         if 0 < p.mouth_relocate <= self._mouth_lost_for and self._lips is not None and self._lips.active:
-            self._relocate_mouth(frame, knots)
+            found, more = self._relocate_mouth(frame, knots, carried, down, targets)
+            iters += more
+            if found is not None:
+                confidence.update(found)
+                lost = [f for f in lost if not f.startswith("mouth")]
         self._knots = knots
         self._linear = total[:, :2]
         self._down = down
@@ -475,18 +481,35 @@ class Tracker:
         if abs(sideways) >= AGREE * reach:
             start[mouth[~followed[mouth]]] += sideways * along
 
-    def _relocate_mouth(self, frame: np.ndarray, knots: np.ndarray) -> None:
+    def _relocate_mouth(self, frame: np.ndarray, knots: np.ndarray, carried: np.ndarray, down: np.ndarray,
+                        targets: np.ndarray) -> tuple[dict[str, float] | None, int]:
         """Put the mouth, lost for ``mouth_relocate`` frames, where its lip colour is found near
-        where the brows put the first frame's mouth, in that mouth's shape (in place; unchanged
-        when nothing clearly better was found)."""
+        where the brows put the first frame's mouth, in that mouth's shape, and let one solver
+        pass (the frame's ``down`` and gap ``targets``) settle it there (in place; unchanged when
+        nothing clearly better was found). Returns the mouth features' confidences when the
+        settled mouth is no longer lost (confidences at least ``lost_response``, shapes sound
+        against the rest knots ``carried``), else None; and the solver's iterations."""
         expected = motion.apply(motion.brow_similarity(self._named(self._knots0), self._named(knots)), self._knots0)
         upper, lower = self._index["mouth_outer_upper"], self._index["mouth_outer_lower"]
         outer = lambda k: np.concatenate([k[upper], k[lower][::-1]])  # noqa: E731
         found = relocate(frame, self._lips.colour, outer(expected), outer(knots))
-        if found is not None:
-            mouth = self._mouth_knots
-            knots[mouth] = found.apply(expected[mouth], outer(expected).mean(axis=0))
-            self._mouth_lost_for = 0
+        if found is None:
+            return None, 0
+        mouth = self._mouth_knots
+        knots[mouth] = found.apply(expected[mouth], outer(expected).mean(axis=0))
+        self._mouth_lost_for = 0
+        rest = self._mouth_rest(carried, knots)
+        settled, iters, resp = self._solve(*self._field(frame, knots, (mouth,)), knots, rest, down, targets,
+                                           self._mouth_curves)
+        self._centre_inner(settled, rest, down)
+        ratio = np.clip(resp / self._response0, 0.0, 1.0)
+        features = ("mouth_outer", "mouth_inner")
+        confidence = {f: float(ratio[self._feature_rows[f]].mean()) for f in features}
+        if all(confidence[f] >= self.params.lost_response and self._shape_ok(settled, carried, FEATURES[f])
+               for f in features):
+            knots[mouth] = settled[mouth]
+            return confidence, iters
+        return None, iters
 
     def _centre_inner(self, knots: np.ndarray, rest: np.ndarray, down: np.ndarray) -> None:
         """Slide the inner mouth along the mouth line so that it sits where it sat in the outer
