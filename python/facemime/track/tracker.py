@@ -289,7 +289,7 @@ class Tracker:
         # and report them shifted back by that offset (which turns and scales with the head).
         edges = self._knots0
         for _ in range(p.calibration_passes):
-            edges = self._solve(*self._field(frame, edges), edges, self._knots0, self._down0, self._targets0)[0]
+            edges = self._solve(frame, edges, self._knots0, self._down0, self._targets0)[0]
         self._offset = edges - self._knots0
         self._knots0 = edges
         self._knots = edges.copy()
@@ -372,14 +372,19 @@ class Tracker:
         _, resp = self._solver.evaluate(fld, origin, (self.width, self.height), start, rest, tuple(down), targets)
         return resp
 
-    def _solve(self, fld: np.ndarray, origin: tuple[float, float], start: np.ndarray, rest: np.ndarray,
-               down: np.ndarray, targets: np.ndarray,
-               curves: np.ndarray | None = None) -> tuple[np.ndarray, int, np.ndarray]:
-        """One solver pass from ``start``; with ``curves``, a mask over CONTOUR_NAMES, for
-        their features only (the others stay at ``start``, their responses NaN)."""
+    def _solve(self, frame: np.ndarray, start: np.ndarray, rest: np.ndarray, down: np.ndarray, targets: np.ndarray,
+               part: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, int, np.ndarray]:
+        """One solver pass from ``start`` on ``frame``'s field; with ``part`` = (knot indices, a
+        mask over CONTOUR_NAMES), for those curves only, on the field around those knots (the
+        others stay at ``start``, their responses NaN)."""
+        fld, origin = self._field(frame, start, None if part is None else (part[0],))
         knots, iters, _, resp = self._solver.solve(fld, origin, (self.width, self.height), start, rest, tuple(down),
-                                                   targets, curves)
+                                                   targets, None if part is None else part[1])
         return knots, iters, resp
+
+    def _ratio(self, resp: np.ndarray) -> np.ndarray:
+        """Edge responses as fractions of the first frame's, clipped to 0..1 (the confidence)."""
+        return np.clip(resp / self._response0, 0.0, 1.0)
 
     def update(self, frame: np.ndarray) -> FrameResult:
         """Track one more frame, (H, W, 3) uint8 RGB of the first frame's size."""
@@ -412,20 +417,20 @@ class Tracker:
         carried = motion.apply(total, self._knots0)
         rest = self._mouth_rest(carried, start)
         targets = self._targets0 * scale
-        knots, iters, resp = self._solve(*self._field(frame, start), start, rest, down, targets)
+        knots, iters, resp = self._solve(frame, start, rest, down, targets)
         before = start
         for _ in range(p.mouth_passes - 1):
             if np.abs(knots[self._mouth_knots] - before[self._mouth_knots]).max() < FAST * reach:
                 break
             before = knots.copy()
-            again, more, again_resp = self._solve(*self._field(frame, before, (self._mouth_knots,)), before, rest, down,
-                                                  targets, self._mouth_curves)
+            again, more, again_resp = self._solve(frame, before, rest, down, targets,
+                                                  (self._mouth_knots, self._mouth_curves))
             knots[self._mouth_knots] = again[self._mouth_knots]
             resp[self._mouth_rows] = again_resp[self._mouth_rows]
             iters += more
         self._centre_inner(knots, rest, down)
         confidence, lost = {}, []
-        ratio = np.clip(resp / self._response0, 0.0, 1.0)
+        ratio = self._ratio(resp)
         for feature, names in FEATURES.items():
             rows, idx = self._feature_rows[feature], self._features[feature]
             conf = float(ratio[rows].mean())
@@ -438,10 +443,10 @@ class Tracker:
                     fallback = knots.copy()
                     fallback[idx] = found
                     if np.abs(found - knots[idx]).max() >= AGREE * reach:
-                        again, more, again_resp = self._solve(*self._field(frame, fallback, (idx,)), fallback, rest,
-                                                              down, targets, self._feature_curves[feature])
+                        again, more, again_resp = self._solve(frame, fallback, rest, down, targets,
+                                                              (idx, self._feature_curves[feature]))
                         iters += more
-                        conf_again = float(np.clip(again_resp[rows] / self._response0[rows], 0.0, 1.0).mean())
+                        conf_again = float(self._ratio(again_resp)[rows].mean())
                         if conf_again > conf or not shape_ok:
                             knots[idx], conf = again[idx], conf_again
                             shape_ok = self._shape_ok(knots, carried, names)
@@ -499,10 +504,9 @@ class Tracker:
         knots[mouth] = found.apply(expected[mouth], outer(expected).mean(axis=0))
         self._mouth_lost_for = 0
         rest = self._mouth_rest(carried, knots)
-        settled, iters, resp = self._solve(*self._field(frame, knots, (mouth,)), knots, rest, down, targets,
-                                           self._mouth_curves)
+        settled, iters, resp = self._solve(frame, knots, rest, down, targets, (mouth, self._mouth_curves))
         self._centre_inner(settled, rest, down)
-        ratio = np.clip(resp / self._response0, 0.0, 1.0)
+        ratio = self._ratio(resp)
         features = ("mouth_outer", "mouth_inner")
         confidence = {f: float(ratio[self._feature_rows[f]].mean()) for f in features}
         if all(confidence[f] >= self.params.lost_response and self._shape_ok(settled, carried, FEATURES[f])
