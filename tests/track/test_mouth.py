@@ -84,11 +84,31 @@ def test_relocate_finds_the_lips_near_where_they_were_expected():
     frame, truth = band_face()
     colour = lip_colour(frame, truth)
     lips = outer_polygon(truth)
-    found = relocate(frame, colour, lips + [25.0, 8.0], lips + [60.0, 0.0])
+    down = np.array([0.0, 1.0])
+    found = relocate(frame, colour, lips + [25.0, 8.0], lips + [60.0, 0.0], down)
     assert found is not None
     assert np.abs(found.apply(lips + [25.0, 8.0], lips.mean(axis=0) + [25.0, 8.0]) - lips).max() < 1.0
     # A mouth already on the lips is not moved.
-    assert relocate(frame, colour, lips + [25.0, 8.0], lips) is None
+    assert relocate(frame, colour, lips + [25.0, 8.0], lips, down) is None
+
+
+def test_relocate_looks_further_down_the_face_than_up():
+    # The lips 80 px wide: a jaw dropping moves them down from where the brows expect them, by up
+    # to half a width (40 px) searched; nothing moves them far up (0.2 widths, 16 px, searched),
+    # where the nostrils would be.
+    frame, truth = band_face()
+    colour = lip_colour(frame, truth)
+    lips = outer_polygon(truth)
+    aside = lips + [60.0, 0.0]
+    below = relocate(frame, colour, lips - [0.0, 30.0], aside, np.array([0.0, 1.0]))
+    assert below is not None
+    assert np.abs(below.apply(lips - [0.0, 30.0], lips.mean(axis=0) - [0.0, 30.0]) - lips).max() < 1.0
+    above = relocate(frame, colour, lips + [0.0, 30.0], aside, np.array([0.0, 1.0]))
+    assert above is None or above.shift[1] >= -0.2 * 80.0 - 1.0
+    # "Down" is the face's: on a face upside down the reaches swap.
+    flipped = relocate(frame, colour, lips + [0.0, 30.0], aside, np.array([0.0, -1.0]))
+    assert flipped is not None
+    assert np.abs(flipped.apply(lips + [0.0, 30.0], lips.mean(axis=0) + [0.0, 30.0]) - lips).max() < 1.0
 
 
 SIZE = (384, 256)

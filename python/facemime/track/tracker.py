@@ -117,7 +117,9 @@ class TrackerParams:
     there by a solver pass; a mouth that then holds its edges is not lost. Measured on lp_d6,
     whose mouth a grimace moves 32 px sideways within a frame: at 1 rather than 5, and settled,
     its frames with an outer mouth NME above 0.1 went from 13 to 4 (inner 15 to 9) and its frames
-    with a lost feature from 10 to 2; the other five videos never lose their mouth.
+    with a lost feature from 10 to 2; the other five videos never lose their mouth. Such
+    single-start counts on lp_d6 swing with 0.2 px of noise on the start; over eight starts see
+    :data:`facemime.track.mouth.RELOCATE_REACH`.
     ``face_width``: a face whose brows are wider than this (outer width, px, on the first
     frame) is tracked on frames shrunk to make them this wide, its contours reported in the
     frame's pixels (:mod:`facemime.track.scale`; None: never). The pixel settings above were
@@ -497,7 +499,7 @@ class Tracker:
         expected = motion.apply(motion.brow_similarity(self._named(self._knots0), self._named(knots)), self._knots0)
         upper, lower = self._index["mouth_outer_upper"], self._index["mouth_outer_lower"]
         outer = lambda k: np.concatenate([k[upper], k[lower][::-1]])  # noqa: E731
-        found = relocate(frame, self._lips.colour, outer(expected), outer(knots))
+        found = relocate(frame, self._lips.colour, outer(expected), outer(knots), down)
         if found is None:
             return None, 0
         mouth = self._mouth_knots
