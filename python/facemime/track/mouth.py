@@ -84,7 +84,8 @@ def relocate(frame: np.ndarray, colour: tuple[float, float, float], expected: np
     size = float(np.ptp(expected[:, 0]))
     sideways, up, lower = RELOCATE_REACH
     # The window's centre moves down the face by half the difference of its reaches.
-    middle = expected + 0.5 * (lower - up) * size * down
+    offset = 0.5 * (lower - up) * size * down
+    middle = expected + offset
     reach, ring = (sideways * size, 0.5 * (lower + up) * size), max(2.0, RING * size)
     lo, hi = crop_box(np.concatenate([middle, current]), max(RELOCATE_SCALES) * max(reach) + ring, width, height)
     scores = _core.lip_score_map(frame, colour, (int(lo[0]), int(lo[1]), int(hi[0]), int(hi[1])))
@@ -93,4 +94,4 @@ def relocate(frame: np.ndarray, colour: tuple[float, float, float], expected: np
     now = locate(channel, current - lo, (0.0, 0.0), ring)
     if found.contrast <= now.contrast + GAIN:
         return None
-    return Placement(found.shift + (middle[0] - expected[0]), found.scale, found.contrast)
+    return Placement(found.shift + offset, found.scale, found.contrast)
