@@ -11,7 +11,7 @@ from facemime.track.contours import GROUPS
 from facemime.track.lips import lip_colour
 from facemime.track.match import find
 from facemime.track.mouth import mouth_shift, relocate
-from facemime.track.synthetic import band_face
+from facemime.track.synthetic import LIP, SKIN, band_face
 
 MOUTH = [n for n in CONTOUR_NAMES if n.startswith("mouth")]
 
@@ -139,3 +139,19 @@ def test_a_mouth_lost_for_a_while_is_found_again(after):
         assert error < 1.0
     else:
         assert all(lost) and error > 50.0
+
+
+def test_a_lost_mouth_is_not_put_on_lip_colour_it_cannot_settle_on():
+    # The mouth is covered by skin and a lip-coloured blob, with no opening between lips,
+    # lies 45 px lower. Lip colour alone would put the mouth there (its outer curves hold the
+    # blob's edge, its inner ones find nothing); it stays where it was, flagged lost.
+    frame0, truth0 = band_face(size=SIZE)
+    covered = frame0.copy()
+    covered[150:195] = SKIN
+    cv2.ellipse(covered, (192, 212), (36, 9), 0, 0, 360, LIP, -1, cv2.LINE_AA)
+    covered = cv2.GaussianBlur(covered, (0, 0), 0.8)
+    tracker = Tracker(frame0, truth0)
+    for _ in range(5):
+        result = tracker.update(covered)
+        assert {"mouth_outer", "mouth_inner"} <= set(result.lost)
+        assert max(np.abs(result.contours[n] - truth0[n]).max() for n in MOUTH) < 5.0

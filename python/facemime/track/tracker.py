@@ -26,7 +26,9 @@ Per frame:
    mouth stays where it is (measured: its rest shape follows the head, not the mouth, and
    resetting it made the tracks worse), and is looked for by its lip colour near where the brows
    put it once it has been lost ``mouth_relocate`` frames in a row (:mod:`facemime.track.mouth`),
-   then settled there by another solver run: a mouth that holds its edges there is not lost.
+   then settled there by another solver run: a mouth that holds its edges there is not lost, one
+   that does not stays where it was (lip colour alone put a grimace's wide mouth, teeth bared,
+   onto its lower lip).
 
 Coordinates are (x, y) pixels, origin at the centre of the top-left pixel, y down.
 """
@@ -114,12 +116,15 @@ class TrackerParams:
     failures to 2.5%, and moved up and down too, an opening mouth dragged its upper lip down.
     ``mouth_relocate``: a mouth lost this many frames in a row is looked for by its lip colour
     around where the brows put it (:func:`facemime.track.mouth.relocate`; 0: off), and settled
-    there by a solver pass; a mouth that then holds its edges is not lost. Measured on lp_d6,
-    whose mouth a grimace moves 32 px sideways within a frame: at 1 rather than 5, and settled,
-    its frames with an outer mouth NME above 0.1 went from 13 to 4 (inner 15 to 9) and its frames
-    with a lost feature from 10 to 2; the other five videos never lose their mouth. Such
-    single-start counts on lp_d6 swing with 0.2 px of noise on the start; over eight starts see
-    :data:`facemime.track.mouth.RELOCATE_REACH`.
+    there by a solver pass; a mouth that then holds its edges is not lost, one that does not
+    stays where it was. Measured on lp_d6, whose mouth a grimace moves 32 px sideways within a
+    frame: at 1 rather than 5, and settled, its frames with an outer mouth NME above 0.1 went
+    from 13 to 4 (inner 15 to 9) and its frames with a lost feature from 10 to 2; the other five
+    videos never lose their mouth. Such single-start counts on lp_d6 swing with 0.2 px of noise
+    on the start (see :data:`facemime.track.mouth.RELOCATE_REACH`): over eight starts, leaving
+    an unsettled mouth where it was rather than where its lip colour was found took the outer
+    mouth's frames above 0.1 from 9.9 to 6.8 per start (inner 14.2 to 10.6), its lost frames
+    from 6.0 to 4.5, and made no start worse.
     ``face_width``: a face whose brows are wider than this (outer width, px, on the first
     frame) is tracked on frames shrunk to make them this wide, its contours reported in the
     frame's pixels (:mod:`facemime.track.scale`; None: never). The pixel settings above were
@@ -490,12 +495,12 @@ class Tracker:
 
     def _relocate_mouth(self, frame: np.ndarray, knots: np.ndarray, carried: np.ndarray, down: np.ndarray,
                         targets: np.ndarray) -> tuple[dict[str, float] | None, int]:
-        """Put the mouth, lost for ``mouth_relocate`` frames, where its lip colour is found near
-        where the brows put the first frame's mouth, in that mouth's shape, and let one solver
-        pass (the frame's ``down`` and gap ``targets``) settle it there (in place; unchanged when
-        nothing clearly better was found). Returns the mouth features' confidences when the
-        settled mouth is no longer lost (confidences at least ``lost_response``, shapes sound
-        against the rest knots ``carried``), else None; and the solver's iterations."""
+        """Look for the mouth, lost for ``mouth_relocate`` frames, where its lip colour is found
+        near where the brows put the first frame's mouth, in that mouth's shape, and let one
+        solver pass (the frame's ``down`` and gap ``targets``) settle it there. The settled mouth
+        replaces the mouth knots (in place) only when it is no longer lost: confidences at least
+        ``lost_response``, shapes sound against the rest knots ``carried``. Returns then the
+        mouth features' confidences, else None; and the solver's iterations."""
         expected = motion.apply(motion.brow_similarity(self._named(self._knots0), self._named(knots)), self._knots0)
         upper, lower = self._index["mouth_outer_upper"], self._index["mouth_outer_lower"]
         outer = lambda k: np.concatenate([k[upper], k[lower][::-1]])  # noqa: E731
@@ -503,10 +508,10 @@ class Tracker:
         if found is None:
             return None, 0
         mouth = self._mouth_knots
-        knots[mouth] = found.apply(expected[mouth], outer(expected).mean(axis=0))
-        self._mouth_lost_for = 0
-        rest = self._mouth_rest(carried, knots)
-        settled, iters, resp = self._solve(frame, knots, rest, down, targets, (mouth, self._mouth_curves))
+        placed = knots.copy()
+        placed[mouth] = found.apply(expected[mouth], outer(expected).mean(axis=0))
+        rest = self._mouth_rest(carried, placed)
+        settled, iters, resp = self._solve(frame, placed, rest, down, targets, (mouth, self._mouth_curves))
         self._centre_inner(settled, rest, down)
         ratio = self._ratio(resp)
         features = ("mouth_outer", "mouth_inner")
@@ -514,6 +519,7 @@ class Tracker:
         if all(confidence[f] >= self.params.lost_response and self._shape_ok(settled, carried, FEATURES[f])
                for f in features):
             knots[mouth] = settled[mouth]
+            self._mouth_lost_for = 0
             return confidence, iters
         return None, iters
 
