@@ -142,8 +142,8 @@ def test_a_mouth_lost_for_a_while_is_found_again(after):
 
 
 def test_a_lost_mouth_is_not_put_on_lip_colour_it_cannot_settle_on():
-    # The mouth is covered by skin and a lip-coloured blob, with no opening between lips,
-    # lies 45 px lower. Lip colour alone would put the mouth there (its outer curves hold the
+    # The mouth is covered by skin, and a lip-coloured blob with no opening between lips lies
+    # 44 px lower. Lip colour alone would put the mouth there (its outer curves hold the
     # blob's edge, its inner ones find nothing); it stays where it was, flagged lost.
     frame0, truth0 = band_face(size=SIZE)
     covered = frame0.copy()
