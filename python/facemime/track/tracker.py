@@ -504,12 +504,13 @@ class Tracker:
         expected = motion.apply(motion.brow_similarity(self._named(self._knots0), self._named(knots)), self._knots0)
         upper, lower = self._index["mouth_outer_upper"], self._index["mouth_outer_lower"]
         outer = lambda k: np.concatenate([k[upper], k[lower][::-1]])  # noqa: E731
-        found = relocate(frame, self._lips.colour, outer(expected), outer(knots), down)
+        polygon = outer(expected)
+        found = relocate(frame, self._lips.colour, polygon, outer(knots), down)
         if found is None:
             return None, 0
         mouth = self._mouth_knots
         placed = knots.copy()
-        placed[mouth] = found.apply(expected[mouth], outer(expected).mean(axis=0))
+        placed[mouth] = found.apply(expected[mouth], polygon.mean(axis=0))
         rest = self._mouth_rest(carried, placed)
         settled, iters, resp = self._solve(frame, placed, rest, down, targets, (mouth, self._mouth_curves))
         self._centre_inner(settled, rest, down)
