@@ -81,9 +81,10 @@ def track(video: Path, init: Path | None, out_file: Path, overlay: Path | None, 
     click.echo(str(out_file))
     if overlay is not None:
         click.echo(str(overlay))
-    fps = run.frames / max(run.seconds, 1e-9)
     lost = f", {run.frames_with_lost} with a lost feature" if run.frames_with_lost else ""
-    click.echo(f"tracked {run.frames} frames at {fps:.0f} frames/s (decoding excluded){lost}", err=True)
+    rate = f" at {(run.frames - 1) / run.seconds:.0f} frames/s" if run.frames > 1 and run.seconds > 0 else ""
+    click.echo(f"tracked {run.frames} frames{rate} after a {run.start_seconds:.2f} s start on the first "
+               f"(decoding and encoding excluded){lost}", err=True)
 
 
 @cli.command()
