@@ -100,6 +100,8 @@ def main() -> None:
     ap.add_argument("--frames", type=int, default=200, help="frames per video at most")
     ap.add_argument("--repeats", type=int, default=3, help="runs of each measurement; the fastest counts")
     args = ap.parse_args()
+    if args.repeats < 1:
+        ap.error("--repeats must be at least 1")
     cv2.setNumThreads(1)
     totals = {"frames": 0, "decode": 0.0, "tracker": 0.0, "snakes": 0.0, "lk": 0.0, "iterations": 0}
     for video in VIDEOS:
