@@ -4,11 +4,10 @@ use facemime_core::lip_search::{self, LipColour, Probe, SearchSettings};
 use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
 };
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
-use crate::points::rows;
+use crate::points::{rows, same_length};
 use crate::snake::rgb_view;
 
 /// The core's lip colour from (w_r, w_g, bias).
@@ -44,14 +43,12 @@ fn find_lip_edges<'py>(
     );
     let (signs, expect) = (signs.as_array(), expect.as_array());
     let k = at.len();
-    if normal.len() != k || signs.len() != k || expect.len() != k {
-        return Err(PyValueError::new_err(format!(
-            "points, normals, signs and expect must have the same length, got {k}, {}, {} and {}",
-            normal.len(),
-            signs.len(),
-            expect.len()
-        )));
-    }
+    same_length(&[
+        ("points", k),
+        ("normals", normal.len()),
+        ("signs", signs.len()),
+        ("expect", expect.len()),
+    ])?;
     let probes: Vec<Probe> = (0..k)
         .map(|i| Probe {
             at: at[i],
@@ -119,13 +116,7 @@ fn normal_gaps<'py>(
         rows::<2>("points", &points)?,
         rows::<2>("normals", &normals)?,
     );
-    if normal.len() != at.len() {
-        return Err(PyValueError::new_err(format!(
-            "points and normals must have the same length, got {} and {}",
-            at.len(),
-            normal.len()
-        )));
-    }
+    same_length(&[("points", at.len()), ("normals", normal.len())])?;
     let curve = rows::<2>("curve", &curve)?;
     Ok(lip_search::normal_gaps(&at, &normal, &curve).into_pyarray(py))
 }

@@ -18,3 +18,17 @@ pub fn rows<const D: usize>(name: &str, a: &PyReadonlyArray2<f64>) -> PyResult<V
         .map(|r| std::array::from_fn(|i| r[i]))
         .collect())
 }
+
+/// An error unless the arrays, given as (name, length) pairs, all have the same length.
+pub fn same_length(arrays: &[(&str, usize)]) -> PyResult<()> {
+    if arrays.iter().all(|&(_, n)| n == arrays[0].1) {
+        return Ok(());
+    }
+    let names: Vec<&str> = arrays.iter().map(|&(name, _)| name).collect();
+    let lengths: Vec<String> = arrays.iter().map(|&(_, n)| n.to_string()).collect();
+    Err(PyValueError::new_err(format!(
+        "{} must have the same length, got {}",
+        names.join(", "),
+        lengths.join(", ")
+    )))
+}

@@ -2,10 +2,9 @@
 
 use facemime_core::pose::{self, FitSettings};
 use numpy::PyReadonlyArray2;
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::points::rows;
+use crate::points::{rows, same_length};
 
 /// model_points: (M, 3) model units; image_points: (M, 2) pixels; start: (yaw, pitch, roll
 /// degrees, ln scale, tx, ty pixels); yaw and pitch are held at `anchor` with weight `prior`
@@ -26,13 +25,7 @@ fn fit_pose(
         rows::<3>("model_points", &model_points)?,
         rows::<2>("image_points", &image_points)?,
     );
-    if x.len() != t.len() {
-        return Err(PyValueError::new_err(format!(
-            "model_points has {} points but image_points has {}",
-            x.len(),
-            t.len()
-        )));
-    }
+    same_length(&[("model_points", x.len()), ("image_points", t.len())])?;
     let settings = FitSettings {
         huber,
         prior,
