@@ -58,7 +58,7 @@ def test_follows_a_mouth_pushed_sideways_in_a_real_video(shared):
     # that also drops frames), and most mouth knots fail the flow's forward-backward check.
     # Without the region match the outer mouth's worst frame is off by 0.10-0.12 (NME) from
     # every start. With it, the worst frame swings from start to start (0.05-0.13 over ten
-    # starts with 0.2 px of noise): so compare over five starts.
+    # starts with 0.2 px of noise; 0.079 on average against 0.111): so compare over five.
     from facemime.io.video import VideoReader
     from facemime.track.contours import from_face_mesh as reference_contours
 
@@ -75,7 +75,7 @@ def test_follows_a_mouth_pushed_sideways_in_a_real_video(shared):
             errors = [group_nme(tracker.update(frame).contours, reference_contours(z["landmarks"][i]),
                                 GROUPS["mouth_outer"], float(z["iod"][i])) for i, frame in enumerate(frames[1:], 546)]
             out.append(max(errors))
-    assert np.mean(worst[0.5]) < 0.09 and min(worst[0.0]) > 0.095, worst
+    assert np.mean(worst[0.5]) < np.mean(worst[0.0]) - 0.015 and min(worst[0.0]) > 0.095, worst
 
 
 def outer_polygon(contours) -> np.ndarray:
