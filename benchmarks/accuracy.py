@@ -15,9 +15,14 @@ With ``--variants`` the tracker also runs with other image operators H (gradient
 luma only, colour only) to show why the default is what it is. With ``--starts N`` the default
 tracker also starts from N − 1 perturbed references (Gaussian noise of :data:`START_NOISE` px on
 every point, seeds 1..N−1): a face-pulling video's failures swing with such noise, and one start
-tells little about them.
+tells little about them. With ``--automatic`` it also starts from the automatic fit of the first
+frame, as ``facemime track`` does without ``--init``: a less precise start, on which settings
+that track well from the reference can fail (the inner lips' rigidity at 8 rather than 12 lost
+fewer frames on lp_d6 over 36 starts from the reference, but from lp_d3's automatic fit it put
+the outer lower lip on the chin for 30 frames).
 
     python benchmarks/accuracy.py [--data ../shared/data] [--videos lp_d0,vr_1] [--variants] [--starts 8]
+                                  [--automatic]
 
 Prints one table per feature group and, last, one JSON line with every figure.
 """
@@ -33,6 +38,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from facemime.fit.run import fit_actor, init_contours
 from facemime.io.video import VideoReader
 from facemime.metrics import group_nme, pooled_summary, resample, summarize
 from facemime.track import Tracker, TrackerParams
@@ -111,6 +117,8 @@ def main() -> None:
     ap.add_argument("--variants", action="store_true", help="also run other image operators H")
     ap.add_argument("--starts", type=int, default=1, help="starts of the default tracker: the reference and "
                     f"N-1 with {START_NOISE} px of noise on it")
+    ap.add_argument("--automatic", action="store_true", help="also start the default tracker from the automatic "
+                    "fit of the first frame (as `facemime track` without --init)")
     args = ap.parse_args()
     cv2.setNumThreads(1)
     methods = variants() if args.variants else {"facemime (directional, luma + colour)": TrackerParams()}
@@ -118,8 +126,9 @@ def main() -> None:
     series: dict[str, dict[str, list[np.ndarray]]] = {m: {g: [] for g in SCORED} for m in names}
     lost: dict[str, dict[str, int]] = {m: {} for m in methods}
     per_video: dict[str, dict] = {}
-    starts = {seed: {g: [] for g in SCORED} for seed in range(1, args.starts)}
-    starts_lost: dict[int, dict[str, int]] = {seed: {} for seed in starts}
+    labels: list[int | str] = list(range(1, args.starts)) + (["automatic"] if args.automatic else [])
+    starts = {label: {g: [] for g in SCORED} for label in labels}
+    starts_lost: dict[int | str, dict[str, int]] = {label: {} for label in labels}
     for video in args.videos.split(","):
         z = np.load(args.data / "video" / f"{video}.landmarks.npz")
         with VideoReader(args.data / "video" / f"{video}.mp4") as reader:
@@ -133,12 +142,15 @@ def main() -> None:
             t0 = time.perf_counter()
             runs[m], lost[m][video] = run_tracker(frames, init, params)
             print(f"{video}: {m}: {len(frames) / (time.perf_counter() - t0):.0f} frames/s", flush=True)
-        for seed in range(1, args.starts):
-            rng = np.random.default_rng(seed)
-            noisy = {n: c + rng.normal(0.0, START_NOISE, c.shape) for n, c in init.items()}
-            tracks, starts_lost[seed][video] = run_tracker(frames, noisy, TrackerParams())
+        for label in labels:
+            if label == "automatic":
+                other = init_contours(fit_actor(frames[0], f"the first frame of {video}")[0])
+            else:
+                rng = np.random.default_rng(label)
+                other = {n: c + rng.normal(0.0, START_NOISE, c.shape) for n, c in init.items()}
+            tracks, starts_lost[label][video] = run_tracker(frames, other, TrackerParams())
             for g, v in score(tracks, lm, valid, iod).items():
-                starts[seed][g].append(v)
+                starts[label][g].append(v)
         per_video[video] = {}
         for m, tracks in runs.items():
             scores = score(tracks, lm, valid, iod)
@@ -161,12 +173,13 @@ def main() -> None:
     spread += [{"seed": seed, "pooled": {g: pooled_summary(starts[seed][g]) for g in GROUPS},
                 "frames_with_lost": starts_lost[seed]} for seed in starts]
     if starts:
-        print(f"\nstarts of the default tracker (seed 0: the reference; others: {START_NOISE} px of noise on it)")
-        print("  seed  " + "  ".join(f"{g + ' mean / fail%':>26s}" for g in GROUPS) + "  frames with a lost feature")
+        print(f"\nstarts of the default tracker (seed 0: the reference; numbers: {START_NOISE} px of noise on it; "
+              "automatic: the fit of the first frame)")
+        print("       seed  " + "  ".join(f"{g + ' mean / fail%':>26s}" for g in GROUPS) + "  frames with a lost feature")
         for run in spread:
             figures = "  ".join(f"{run['pooled'][g]['mean']:17.4f} / {100 * run['pooled'][g]['failure_rate']:5.2f}"
                                 for g in GROUPS)
-            print(f"  {run['seed']:4d}  {figures}  {sum(run['frames_with_lost'].values())}")
+            print(f"  {run['seed']!s:>9s}  {figures}  {sum(run['frames_with_lost'].values())}")
     print(json.dumps({"pooled": pooled, "per_video": per_video, "frames_with_lost": lost,
                       "starts": spread[1:]}, allow_nan=True))
 
