@@ -38,11 +38,11 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from facemime.fit.run import fit_actor, init_contours
 from facemime.io.video import VideoReader
 from facemime.metrics import group_nme, pooled_summary, resample, summarize
 from facemime.track import Tracker, TrackerParams
 from facemime.track.contours import CONTOUR_NAMES, GROUPS, from_face_mesh
+from facemime.track.video import automatic_contours
 
 VIDEOS = ("lp_d0", "lp_d3", "lp_d6", "lp_d12", "vr_1", "vr_2")
 ROOT = Path(__file__).resolve().parents[1]
@@ -144,7 +144,7 @@ def main() -> None:
             print(f"{video}: {m}: {len(frames) / (time.perf_counter() - t0):.0f} frames/s", flush=True)
         for label in labels:
             if label == "automatic":
-                other = init_contours(fit_actor(frames[0], f"the first frame of {video}")[0])
+                other = automatic_contours(frames[0], f"the first frame of {video}")
             else:
                 rng = np.random.default_rng(label)
                 other = {n: c + rng.normal(0.0, START_NOISE, c.shape) for n, c in init.items()}

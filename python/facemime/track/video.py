@@ -9,6 +9,8 @@ from contextlib import nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from facemime.errors import InputFileError, InvalidInputError
 from facemime.fit.detect import NoFaceError
 from facemime.fit.run import fit_actor, init_contours
@@ -19,6 +21,13 @@ from facemime.progress import track as progress
 from facemime.track.contours import FEATURES
 from facemime.track.overlay import draw_contours
 from facemime.track.tracker import FrameResult, Tracker, TrackerParams
+
+
+def automatic_contours(frame: np.ndarray, what: str) -> dict[str, np.ndarray]:
+    """The contours to start tracking from when none are given: the generic head fitted to
+    ``frame`` (H, W, 3 uint8 RGB; ``what`` names it in errors), its mouth and brows projected,
+    name -> (K, 2) float64 pixels. Raises NoFaceError where no face is found."""
+    return init_contours(fit_actor(frame, what)[0])
 
 
 @dataclass
@@ -62,7 +71,7 @@ def track_video(video: str | Path, init: str | Path | None, out: str | Path, ove
                 if tracker is None:
                     if contours is None:
                         try:
-                            contours = init_contours(fit_actor(frame, f"the first frame of {video}")[0])
+                            contours = automatic_contours(frame, f"the first frame of {video}")
                         except NoFaceError as e:
                             raise NoFaceError(f"{e}; pass the contours with --init INIT.json") from None
                     tracker = Tracker(frame, contours, params)
