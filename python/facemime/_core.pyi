@@ -53,32 +53,32 @@ class FlowFrames:
         min_eigen: float,
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...
 
-def find_lip_edges(
-    frame: npt.NDArray[np.uint8],
-    colour: tuple[float, float, float],
-    points: npt.NDArray[np.float64],
-    normals: npt.NDArray[np.float64],
-    signs: npt.NDArray[np.float64],
-    expect: npt.NDArray[np.float64],
-    reach: float,
-    sigma: float,
-    min_step: float,
-) -> npt.NDArray[np.float64]: ...
-def lip_scores_near(
-    frame: npt.NDArray[np.uint8],
-    colour: tuple[float, float, float],
-    points: npt.NDArray[np.float64],
-) -> npt.NDArray[np.float64]: ...
 def lip_score_map(
     frame: npt.NDArray[np.uint8],
     colour: tuple[float, float, float],
     bounds: tuple[int, int, int, int],
 ) -> npt.NDArray[np.float32]: ...
-def normal_gaps(
-    points: npt.NDArray[np.float64],
-    normals: npt.NDArray[np.float64],
-    curve: npt.NDArray[np.float64],
-) -> npt.NDArray[np.float64]: ...
+class LipPlacer:
+    """Moves mouth knots onto lip edges; see ``facemime.track.lips.LipSearch``."""
+
+    def __init__(
+        self,
+        frame: npt.NDArray[np.uint8],
+        colour: tuple[float, float, float],
+        reach: float,
+        min_step: float,
+        index: list[list[int]],
+        signs: list[float],
+        edges: npt.NDArray[np.float64],
+    ) -> None: ...
+    def place(
+        self,
+        frame: npt.NDArray[np.uint8],
+        knots: npt.NDArray[np.float64],
+        unfollowed: npt.NDArray[np.bool_],
+        scale: float,
+    ) -> None: ...
+
 def robust_similarity(
     src: npt.NDArray[np.float64],
     dst: npt.NDArray[np.float64],

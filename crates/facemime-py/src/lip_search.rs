@@ -1,13 +1,15 @@
-//! Bindings of `facemime_core::lip_search`: the lip-edge search along the mouth knots' normals.
+//! Bindings of `facemime_core::lip_search` and `facemime_core::lip_placement`: the lip-edge
+//! search along the mouth knots' normals, and the tracker's placement of mouth knots there.
 
-use facemime_core::lip_search::{self, LipColour, Probe, SearchSettings};
+use facemime_core::lip_placement;
+use facemime_core::lip_search::{self, LipColour};
 use numpy::{
-    IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+    IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyReadwriteArray2,
 };
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
-use crate::points::{rows, same_length};
+use crate::points::rows;
 use crate::snake::rgb_view;
 
 /// The core's lip colour from (w_r, w_g, bias).
@@ -16,73 +18,6 @@ fn lip_colour(c: [f64; 3]) -> LipColour {
         weights: [c[0], c[1]],
         bias: c[2],
     }
-}
-
-/// frame: (H, W, 3) uint8 RGB; colour: (w_r, w_g, bias) of the lip score; points, normals:
-/// (K, 2) pixels and unit vectors; signs: (K,) +1 for a score rising along the normal, −1 for
-/// one falling; expect: (K,) offsets (px) to search nearest to; reach, sigma (px), min_step.
-/// Returns the (K,) offsets (px along the normals), NaN where no transition was found.
-#[pyfunction]
-#[allow(clippy::too_many_arguments)]
-fn find_lip_edges<'py>(
-    py: Python<'py>,
-    frame: PyReadonlyArray3<u8>,
-    colour: [f64; 3],
-    points: PyReadonlyArray2<f64>,
-    normals: PyReadonlyArray2<f64>,
-    signs: PyReadonlyArray1<f64>,
-    expect: PyReadonlyArray1<f64>,
-    reach: f64,
-    sigma: f64,
-    min_step: f64,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let img = rgb_view("frame", &frame)?;
-    let (at, normal) = (
-        rows::<2>("points", &points)?,
-        rows::<2>("normals", &normals)?,
-    );
-    let (signs, expect) = (signs.as_array(), expect.as_array());
-    let k = at.len();
-    same_length(&[
-        ("points", k),
-        ("normals", normal.len()),
-        ("signs", signs.len()),
-        ("expect", expect.len()),
-    ])?;
-    let probes: Vec<Probe> = (0..k)
-        .map(|i| Probe {
-            at: at[i],
-            normal: normal[i],
-            sign: signs[i],
-            expect: expect[i],
-        })
-        .collect();
-    let colour = lip_colour(colour);
-    let settings = SearchSettings {
-        reach,
-        sigma,
-        min_step,
-    };
-    let found = py
-        .detach(|| lip_search::find_edges(&img, &colour, &probes, &settings))
-        .map_err(CoreErr)?;
-    Ok(found.into_pyarray(py))
-}
-
-/// frame: (H, W, 3) uint8 RGB; colour: (w_r, w_g, bias) of the lip score; points: (K, 2)
-/// pixels. Returns the (K,) scores averaged over the 3×3 pixels nearest each point.
-#[pyfunction]
-fn lip_scores_near<'py>(
-    py: Python<'py>,
-    frame: PyReadonlyArray3<u8>,
-    colour: [f64; 3],
-    points: PyReadonlyArray2<f64>,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let img = rgb_view("frame", &frame)?;
-    let at = rows::<2>("points", &points)?;
-    let colour = lip_colour(colour);
-    let scores = lip_search::scores_near(&img, &colour, &at).map_err(CoreErr)?;
-    Ok(scores.into_pyarray(py))
 }
 
 /// frame: (H, W, 3) uint8 RGB; colour: (w_r, w_g, bias) of the lip score; bounds: (x0, y0, x1,
@@ -102,29 +37,69 @@ fn lip_score_map<'py>(
     Ok(map.into_pyarray(py))
 }
 
-/// points, normals: (K, 2) pixels and unit vectors; curve: (M, 2) pixels, a polyline.
-/// Returns the (K,) signed distances (px) along the normals to the curve's nearest crossing,
-/// NaN where a normal's line misses it.
-#[pyfunction]
-fn normal_gaps<'py>(
-    py: Python<'py>,
-    points: PyReadonlyArray2<f64>,
-    normals: PyReadonlyArray2<f64>,
-    curve: PyReadonlyArray2<f64>,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let (at, normal) = (
-        rows::<2>("points", &points)?,
-        rows::<2>("normals", &normals)?,
-    );
-    same_length(&[("points", at.len()), ("normals", normal.len())])?;
-    let curve = rows::<2>("curve", &curve)?;
-    Ok(lip_search::normal_gaps(&at, &normal, &curve).into_pyarray(py))
+/// See `facemime.track.lips.LipSearch` for the documented API.
+#[pyclass(module = "facemime._core")]
+pub struct LipPlacer {
+    placer: lip_placement::LipPlacer,
+}
+
+#[pymethods]
+impl LipPlacer {
+    /// frame: the first frame, (H, W, 3) uint8 RGB; colour: (w_r, w_g, bias) of its lip score;
+    /// reach: search range, ± px; min_step: smallest edge (score units per px); index: the knot
+    /// indices of the outer upper, outer lower, inner upper and inner lower lip; signs: per
+    /// curve, +1 where the score rises along the downward normal at its edge, −1 where it
+    /// falls; edges: (K, 2) pixels, the first frame's knots as settled on the image edges.
+    #[new]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        frame: PyReadonlyArray3<u8>,
+        colour: [f64; 3],
+        reach: f64,
+        min_step: f64,
+        index: [Vec<usize>; 4],
+        signs: [f64; 4],
+        edges: PyReadonlyArray2<f64>,
+    ) -> PyResult<Self> {
+        let img = rgb_view("frame", &frame)?;
+        let edges = rows::<2>("edges", &edges)?;
+        let colour = lip_colour(colour);
+        let placer = py
+            .detach(|| {
+                lip_placement::LipPlacer::new(&img, colour, reach, min_step, index, signs, &edges)
+            })
+            .map_err(CoreErr)?;
+        Ok(Self { placer })
+    }
+
+    /// frame: (H, W, 3) uint8 RGB; knots: (K, 2) pixels, moved in place; unfollowed: (K,)
+    /// bool, the knots the optical flow could not follow; scale: the head's scale relative to
+    /// the first frame.
+    fn place(
+        &self,
+        py: Python<'_>,
+        frame: PyReadonlyArray3<u8>,
+        mut knots: PyReadwriteArray2<f64>,
+        unfollowed: PyReadonlyArray1<bool>,
+        scale: f64,
+    ) -> PyResult<()> {
+        let img = rgb_view("frame", &frame)?;
+        let mut pts = rows::<2>("knots", &knots)?;
+        let unfollowed = unfollowed.as_array().to_vec();
+        py.detach(|| self.placer.place(&img, &mut pts, &unfollowed, scale))
+            .map_err(CoreErr)?;
+        let mut out = knots.as_array_mut();
+        for (mut row, p) in out.rows_mut().into_iter().zip(&pts) {
+            row[0] = p[0];
+            row[1] = p[1];
+        }
+        Ok(())
+    }
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(find_lip_edges, m)?)?;
-    m.add_function(wrap_pyfunction!(lip_scores_near, m)?)?;
+    m.add_class::<LipPlacer>()?;
     m.add_function(wrap_pyfunction!(lip_score_map, m)?)?;
-    m.add_function(wrap_pyfunction!(normal_gaps, m)?)?;
     Ok(())
 }
