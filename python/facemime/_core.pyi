@@ -52,6 +52,19 @@ class FlowFrames:
         epsilon: float,
         min_eigen: float,
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...
+    def follow(
+        self,
+        points: npt.NDArray[np.float64],
+        extra: npt.NDArray[np.float64],
+        limit: float,
+        min_points: int,
+        rounds: int,
+        iterations: int,
+        epsilon: float,
+        min_eigen: float,
+    ) -> tuple[
+        npt.NDArray[np.float64] | None, npt.NDArray[np.uint64], npt.NDArray[np.float64], npt.NDArray[np.float64]
+    ]: ...
 
 def lip_score_map(
     frame: npt.NDArray[np.uint8],

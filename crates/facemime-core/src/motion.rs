@@ -5,6 +5,9 @@
 //! Points are (x, y) pixels. The similarity is written as complex numbers, z ↦ a·z + b with
 //! z = x + iy; as a 2×3 matrix it is [[Re a, −Im a, Re b], [Im a, Re a, Im b]].
 
+use crate::error::Result;
+use crate::flow::{lucas_kanade, LkParams, Pyramid};
+
 /// Tukey's biweight constant (95 % efficiency on Gaussian residuals).
 const TUKEY: f64 = 4.685;
 /// Median absolute residual to the standard deviation of Gaussian residuals.
@@ -148,6 +151,73 @@ pub fn robust_similarity(
     ([[a.re, -a.im, b.re], [a.im, a.re, b.im]], inliers)
 }
 
+/// One frame's step of [`follow_rigid`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct RigidStep {
+    /// The head's similarity from the previous frame to the current one; None when fewer than
+    /// the minimum of points passed the forward-backward check or fit it.
+    pub similarity: Option<[[f64; 3]; 2]>,
+    /// With a similarity: the indices of the rigid points that fit it, and their positions in
+    /// the current frame (the others are to be dropped); else empty.
+    pub kept: Vec<usize>,
+    pub moved: Vec<[f64; 2]>,
+    /// Per extra point: its position in the current frame, None where the flow failed or its
+    /// forward-backward check.
+    pub extra: Vec<Option<[f64; 2]>>,
+}
+
+/// The head's motion from `prev`'s frame to `next`'s: the rigid `points` (pixels of the
+/// previous frame) followed by the Lucas-Kanade flow forwards and back; those that come back
+/// within `limit` px of where they started are fitted by [`robust_similarity`] (inliers within
+/// `limit` px, at most `rounds` rounds), which counts when at least `min_points` passed the
+/// check and fit it. The `extra` points are followed and checked alike (not fitted).
+#[allow(clippy::too_many_arguments)]
+pub fn follow_rigid(
+    prev: &Pyramid,
+    next: &Pyramid,
+    points: &[[f64; 2]],
+    extra: &[[f64; 2]],
+    lk: &LkParams,
+    limit: f64,
+    min_points: usize,
+    rounds: usize,
+) -> Result<RigidStep> {
+    let start: Vec<[f64; 2]> = points.iter().chain(extra).copied().collect();
+    let there = lucas_kanade(prev, next, &start, lk)?;
+    let ahead: Vec<[f64; 2]> = there.iter().map(|q| q.unwrap_or([f64::NAN; 2])).collect();
+    let back = lucas_kanade(next, prev, &ahead, lk)?;
+    let checked: Vec<Option<[f64; 2]>> = (0..start.len())
+        .map(|i| match (there[i], back[i]) {
+            (Some(q), Some(b)) => {
+                let d = [b[0] - start[i][0], b[1] - start[i][1]];
+                (d[0] * d[0] + d[1] * d[1] < limit * limit).then_some(q)
+            }
+            _ => None,
+        })
+        .collect();
+    let n = points.len();
+    let good: Vec<usize> = (0..n).filter(|&i| checked[i].is_some()).collect();
+    let mut step = RigidStep {
+        similarity: None,
+        kept: Vec::new(),
+        moved: Vec::new(),
+        extra: checked[n..].to_vec(),
+    };
+    if good.len() >= min_points {
+        let src: Vec<[f64; 2]> = good.iter().map(|&i| start[i]).collect();
+        let dst: Vec<[f64; 2]> = good.iter().map(|&i| checked[i].expect("checked")).collect();
+        let (m, inliers) = robust_similarity(&src, &dst, limit, rounds);
+        if inliers.iter().filter(|&&k| k).count() >= min_points {
+            step.similarity = Some(m);
+            for (j, _) in inliers.iter().enumerate().filter(|(_, &k)| k) {
+                step.kept.push(good[j]);
+                step.moved.push(dst[j]);
+            }
+        }
+    }
+    Ok(step)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -190,5 +260,30 @@ mod tests {
     fn median_of_even_count_is_the_mean_of_the_middle_pair() {
         assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
         assert_eq!(median(&mut [5.0, 1.0, 3.0]), 3.0);
+    }
+
+    #[test]
+    fn follow_rigid_finds_the_shift_and_checks_every_point() {
+        use crate::flow::tests::{pyramid, texture, PARAMS};
+        let (w, h) = (96, 96);
+        let (a, b) = (texture(w, h, 0.0, 0.0), texture(w, h, 1.5, -0.5));
+        let (pa, pb) = (pyramid(&a, w, h), pyramid(&b, w, h));
+        let points: Vec<[f64; 2]> = (0..9)
+            .map(|k| [30.0 + 6.0 * (k % 3) as f64, 30.0 + 6.0 * (k / 3) as f64])
+            .collect();
+        let extra = [[48.0, 50.0], [f64::NAN, 3.0], [-500.0, 40.0]];
+        let step = follow_rigid(&pa, &pb, &points, &extra, &PARAMS, 1.0, 6, 10).unwrap();
+        let m = step.similarity.expect("a similarity");
+        for p in &points {
+            let q = apply(&m, *p);
+            assert!((q[0] - p[0] - 1.5).abs() < 0.05 && (q[1] - p[1] + 0.5).abs() < 0.05);
+        }
+        assert_eq!(step.kept, (0..9).collect::<Vec<_>>());
+        let e = step.extra[0].expect("followed");
+        assert!((e[0] - 49.5).abs() < 0.05 && (e[1] - 49.5).abs() < 0.05);
+        assert_eq!(step.extra[1..], [None, None]);
+        // Fewer points than the minimum: no similarity, nothing kept.
+        let few = follow_rigid(&pa, &pb, &points[..5], &[], &PARAMS, 1.0, 6, 10).unwrap();
+        assert_eq!((few.similarity, few.kept.len()), (None, 0));
     }
 }

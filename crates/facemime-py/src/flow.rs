@@ -2,6 +2,7 @@
 //! (each built once, their memory reused) and the Lucas-Kanade flow between them.
 
 use facemime_core::flow::{self, LkParams, Pyramid};
+use facemime_core::motion;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -12,6 +13,26 @@ use crate::points::rows;
 /// The moved points and the mask of those followed.
 type Flow<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>);
 
+/// The head's step: its similarity or None, the kept rigid points' indices and positions, and
+/// the extra points' positions.
+type Step<'py> = (
+    Option<Bound<'py, PyArray2<f64>>>,
+    Bound<'py, PyArray1<usize>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+);
+
+/// (N, 2) float64 array of points, NaN rows for None.
+fn point_rows<'py>(py: Python<'py>, pts: &[Option<[f64; 2]>]) -> Bound<'py, PyArray2<f64>> {
+    let flat: Vec<f64> = pts
+        .iter()
+        .flat_map(|m| m.unwrap_or([f64::NAN; 2]))
+        .collect();
+    numpy::ndarray::Array2::from_shape_vec((pts.len(), 2), flat)
+        .expect("N x 2")
+        .into_pyarray(py)
+}
+
 /// See `facemime.track.flow` for the documented API.
 #[pyclass(module = "facemime._core")]
 pub struct FlowFrames {
@@ -19,6 +40,17 @@ pub struct FlowFrames {
     prev: Pyramid,
     cur: Pyramid,
     pushed: usize,
+}
+
+impl FlowFrames {
+    fn ready(&self) -> PyResult<()> {
+        if self.pushed < 2 {
+            return Err(PyValueError::new_err(
+                "the flow needs two frames; push another",
+            ));
+        }
+        Ok(())
+    }
 }
 
 #[pymethods]
@@ -67,11 +99,7 @@ impl FlowFrames {
         epsilon: f64,
         min_eigen: f64,
     ) -> PyResult<Flow<'py>> {
-        if self.pushed < 2 {
-            return Err(PyValueError::new_err(
-                "the flow needs two frames; push another",
-            ));
-        }
+        self.ready()?;
         let pts = rows::<2>("points", &points)?;
         let params = LkParams {
             iterations,
@@ -87,14 +115,51 @@ impl FlowFrames {
             .detach(|| flow::lucas_kanade(from, to, &pts, &params))
             .map_err(CoreErr)?;
         let ok: Vec<bool> = moved.iter().map(Option::is_some).collect();
-        let flat: Vec<f64> = moved
-            .iter()
-            .flat_map(|m| m.unwrap_or([f64::NAN; 2]))
-            .collect();
-        let out = numpy::ndarray::Array2::from_shape_vec((pts.len(), 2), flat)
-            .expect("N x 2")
-            .into_pyarray(py);
-        Ok((out, ok.into_pyarray(py)))
+        Ok((point_rows(py, &moved), ok.into_pyarray(py)))
+    }
+
+    /// points: (N, 2) rigid points and extra: (M, 2) other points, pixels in the previous
+    /// frame; limit: forward-backward and fit tolerance (px); min_points: fewest points for a
+    /// similarity; rounds: its fit's rounds at most. Returns (the 2×3 similarity or None, the
+    /// (K,) indices of the rigid points kept, their (K, 2) positions in the current frame, the
+    /// extra points' (M, 2) positions, NaN where the flow failed or its check).
+    #[pyo3(signature = (points, extra, limit, min_points, rounds, iterations, epsilon, min_eigen))]
+    #[allow(clippy::too_many_arguments)]
+    fn follow<'py>(
+        &self,
+        py: Python<'py>,
+        points: PyReadonlyArray2<f64>,
+        extra: PyReadonlyArray2<f64>,
+        limit: f64,
+        min_points: usize,
+        rounds: usize,
+        iterations: usize,
+        epsilon: f64,
+        min_eigen: f64,
+    ) -> PyResult<Step<'py>> {
+        self.ready()?;
+        let (pts, more) = (rows::<2>("points", &points)?, rows::<2>("extra", &extra)?);
+        let lk = LkParams {
+            iterations,
+            epsilon,
+            min_eigen,
+        };
+        let (prev, cur) = (&self.prev, &self.cur);
+        let step = py
+            .detach(|| motion::follow_rigid(prev, cur, &pts, &more, &lk, limit, min_points, rounds))
+            .map_err(CoreErr)?;
+        let similarity = step.similarity.map(|m| {
+            numpy::ndarray::Array2::from_shape_vec((2, 3), m.iter().flatten().copied().collect())
+                .expect("2 x 3")
+                .into_pyarray(py)
+        });
+        let moved: Vec<Option<[f64; 2]>> = step.moved.into_iter().map(Some).collect();
+        Ok((
+            similarity,
+            step.kept.into_pyarray(py),
+            point_rows(py, &moved),
+            point_rows(py, &step.extra),
+        ))
     }
 }
 

@@ -29,6 +29,7 @@ ZONES = (
 )
 FB_LIMIT = 1.0  # px: forward-backward error above this rejects a point
 MIN_POINTS = 6
+FIT_ROUNDS = 10  # rounds of the robust similarity fit at most
 DETECT_MARGIN = 8  # px around the zones for the corner measure (block 5, Sobel 3)
 NEXT_CORNER = [1, 2, 3, 0]  # each zone corner's successor
 
@@ -54,7 +55,7 @@ def zone_polygons(contours: Mapping[str, np.ndarray]) -> list[np.ndarray]:
     return polys
 
 
-def robust_similarity(src: np.ndarray, dst: np.ndarray, limit: float, rounds: int = 10) -> tuple[np.ndarray, np.ndarray]:
+def robust_similarity(src: np.ndarray, dst: np.ndarray, limit: float, rounds: int = FIT_ROUNDS) -> tuple[np.ndarray, np.ndarray]:
     """The 2×3 similarity (rotation, uniform scale, translation) mapping ``src`` (N, 2) onto
     ``dst`` (N, 2) px despite outliers, and the (N,) inlier mask (residual below ``limit`` px).
     Iteratively reweighted least squares with Tukey's biweight, started from the median
@@ -197,27 +198,17 @@ class HeadMotion:
         place = brow_similarity(self._contours0, contours)
         self._zones = [apply(place, z) for z in self._zones0]
         step, ok = IDENTITY.copy(), False
-        n_extra = 0 if extra is None else len(extra)
-        moved = None if extra is None else np.full((n_extra, 2), np.nan)
         extra_pts = np.zeros((0, 2)) if extra is None else np.asarray(extra, float).reshape(-1, 2)
+        moved = None if extra is None else np.full((len(extra_pts), 2), np.nan)
         self._flow.push(gray, self._crop_box(gray.shape, extra_pts))
         if len(self.points) >= MIN_POINTS:
-            p0 = np.concatenate([self.points, extra_pts])
-            p1, ok1 = self._flow.track(p0)
-            pb, ok2 = self._flow.track(p1, backward=True)
-            back = pb - p0  # NaN where lost, which fails the test
-            good = ok1 & ok2 & ((back * back).sum(axis=1) < FB_LIMIT**2)
-            n = len(self.points)
+            fit, kept, dst, followed = self._flow.follow(self.points, extra_pts, FB_LIMIT, MIN_POINTS, FIT_ROUNDS)
             if moved is not None:
-                moved[good[n:]] = p1[n:][good[n:]]
-            good = good[:n]
-            src, dst = p0[:n][good], p1[:n][good]
-            if len(src) >= MIN_POINTS:
-                m, keep = robust_similarity(src, dst, FB_LIMIT)
-                if keep.sum() >= MIN_POINTS:
-                    step, ok = m, True
-                    self._keep(np.flatnonzero(good)[keep])
-                    self.points = dst[keep].astype(np.float32)
+                moved = followed
+            if fit is not None:
+                step, ok = fit, True
+                self._keep(kept)
+                self.points = dst.astype(np.float32)
         if not ok:
             step, ok = self._coarse_shift(gray)
         self.total = compose(step, self.total)

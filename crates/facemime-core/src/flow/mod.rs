@@ -382,17 +382,17 @@ fn track_level(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    const PARAMS: LkParams = LkParams {
+    pub(crate) const PARAMS: LkParams = LkParams {
         iterations: 30,
         epsilon: 0.01,
         min_eigen: 0.1024,
     };
 
     /// A smooth, textured w×h image (blobs of several sizes) shifted by (dx, dy) pixels.
-    fn texture(w: usize, h: usize, dx: f64, dy: f64) -> Vec<u8> {
+    pub(crate) fn texture(w: usize, h: usize, dx: f64, dy: f64) -> Vec<u8> {
         let mut out = Vec::with_capacity(w * h);
         for y in 0..h {
             for x in 0..w {
@@ -407,7 +407,7 @@ mod tests {
         out
     }
 
-    fn pyramid(img: &[u8], w: usize, h: usize) -> Pyramid {
+    pub(crate) fn pyramid(img: &[u8], w: usize, h: usize) -> Pyramid {
         Pyramid::build(img, w, h, [0, 0, w, h], 5, 21).unwrap()
     }
 
