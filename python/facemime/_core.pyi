@@ -92,6 +92,7 @@ class LipPlacer:
         scale: float,
     ) -> None: ...
 
+def inside_quads(points: npt.NDArray[np.float64], quads: npt.NDArray[np.float64]) -> npt.NDArray[np.bool_]: ...
 def robust_similarity(
     src: npt.NDArray[np.float64],
     dst: npt.NDArray[np.float64],
@@ -107,6 +108,13 @@ def fit_pose(
     huber: float,
     iterations: int,
 ) -> tuple[float, float, float, float, float, float]: ...
+
+def affine_rest(
+    carried: npt.NDArray[np.float64],
+    start: npt.NDArray[np.float64],
+    groups: list[list[int]],
+    amount: float,
+) -> npt.NDArray[np.float64]: ...
 
 FIELD_CHANNELS: int
 

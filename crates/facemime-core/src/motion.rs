@@ -218,6 +218,22 @@ pub fn follow_rigid(
     Ok(step)
 }
 
+/// Which of `points` lie inside (or on the border of) any of the convex quadrilaterals
+/// `quads` (corners in order, either winding).
+pub fn inside_quads(points: &[[f64; 2]], quads: &[[[f64; 2]; 4]]) -> Vec<bool> {
+    let inside = |p: &[f64; 2], q: &[[f64; 2]; 4]| {
+        let cross: [f64; 4] = std::array::from_fn(|k| {
+            let (a, b) = (q[k], q[(k + 1) % 4]);
+            (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
+        });
+        cross.iter().all(|&c| c >= 0.0) || cross.iter().all(|&c| c <= 0.0)
+    };
+    points
+        .iter()
+        .map(|p| quads.iter().any(|q| inside(p, q)))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -285,5 +301,18 @@ mod tests {
         // Fewer points than the minimum: no similarity, nothing kept.
         let few = follow_rigid(&pa, &pb, &points[..5], &[], &PARAMS, 1.0, 6, 10).unwrap();
         assert_eq!((few.similarity, few.kept.len()), (None, 0));
+    }
+
+    #[test]
+    fn inside_quads_takes_either_winding_and_the_border() {
+        let square = [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]];
+        let mut reversed = square;
+        reversed.reverse();
+        let far = [[10.0, 10.0], [12.0, 10.0], [12.0, 12.0], [10.0, 12.0]];
+        let pts = [[1.0, 1.0], [2.0, 1.0], [3.0, 1.0], [11.0, 11.5]];
+        for q in [square, reversed] {
+            assert_eq!(inside_quads(&pts, &[q, far]), [true, true, false, true]);
+        }
+        assert_eq!(inside_quads(&pts, &[]), [false; 4]);
     }
 }

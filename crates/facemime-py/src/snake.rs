@@ -311,8 +311,39 @@ fn frame_field<'py>(
     Ok(out)
 }
 
+/// carried, start: (K, 2) pixels; groups: lists of knot indices; amount: 0..1. Returns the
+/// (K, 2) rest knots: `carried` with each group moved `amount` of the way to its affine
+/// least-squares fit to `start`.
+#[pyfunction]
+fn affine_rest<'py>(
+    py: Python<'py>,
+    carried: PyReadonlyArray2<f64>,
+    start: PyReadonlyArray2<f64>,
+    groups: Vec<Vec<usize>>,
+    amount: f64,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (a, b) = (rows::<2>("carried", &carried)?, rows::<2>("start", &start)?);
+    if a.len() != b.len() {
+        return Err(err(format!(
+            "carried has {} knots but start has {}",
+            a.len(),
+            b.len()
+        )));
+    }
+    if let Some(&k) = groups.iter().flatten().find(|&&k| k >= a.len()) {
+        return Err(err(format!("knot index {k} is past the {} knots", a.len())));
+    }
+    let slices: Vec<&[usize]> = groups.iter().map(Vec::as_slice).collect();
+    let rest = snake::affine_rest(&a, &b, &slices, amount);
+    let flat: Vec<f64> = rest.iter().flatten().copied().collect();
+    Ok(numpy::ndarray::Array2::from_shape_vec((a.len(), 2), flat)
+        .expect("K x 2")
+        .into_pyarray(py))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<SnakeSolver>()?;
+    m.add_function(wrap_pyfunction!(affine_rest, m)?)?;
     m.add_function(wrap_pyfunction!(frame_field, m)?)?;
     m.add("FIELD_CHANNELS", FIELD_CHANNELS)?;
     Ok(())

@@ -31,7 +31,6 @@ FB_LIMIT = 1.0  # px: forward-backward error above this rejects a point
 MIN_POINTS = 6
 FIT_ROUNDS = 10  # rounds of the robust similarity fit at most
 DETECT_MARGIN = 8  # px around the zones for the corner measure (block 5, Sobel 3)
-NEXT_CORNER = [1, 2, 3, 0]  # each zone corner's successor
 
 
 def face_frame(contours: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
@@ -144,11 +143,7 @@ class HeadMotion:
 
     def _inside(self, pts: np.ndarray) -> np.ndarray:
         """Which of ``pts`` (N, 2) lie in a zone (convex quadrilaterals, either winding)."""
-        polys = np.stack(self._zones)  # (Z, 4, 2)
-        edges = polys[:, NEXT_CORNER] - polys
-        rel = pts[:, None, None, :] - polys[None]  # (N, Z, 4, 2)
-        cross = edges[..., 0] * rel[..., 1] - edges[..., 1] * rel[..., 0]
-        return ((cross >= 0).all(axis=2) | (cross <= 0).all(axis=2)).any(axis=1)
+        return _core.inside_quads(as_points(pts), np.stack(self._zones))
 
     def _crop_box(self, shape: tuple[int, ...], extra: np.ndarray) -> tuple[int, int, int, int]:
         """The part of the frame the flow uses: the zones, points and ``extra`` with room for

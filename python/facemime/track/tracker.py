@@ -277,6 +277,7 @@ class Tracker:
         self._down0 = self._mouth_down(self._knots0)
         self._features = {f: np.unique(np.concatenate([self._index[n] for n in names])) for f, names in FEATURES.items()}
         self._mouth_knots = np.unique(np.concatenate([self._features["mouth_outer"], self._features["mouth_inner"]]))
+        self._affine_groups = [[int(i) for i in self._features[f]] for f in ("mouth_outer", "mouth_inner")]
         self._bands = (self._mouth_knots, np.unique(np.concatenate([self._features["brow_left"], self._features["brow_right"]])))
         self._banded = np.concatenate(self._bands)
         self._mouth_rows = [i for i, n in enumerate(CONTOUR_NAMES) if n.startswith("mouth")]
@@ -546,22 +547,9 @@ class Tracker:
 
     def _mouth_rest(self, carried: np.ndarray, start: np.ndarray) -> np.ndarray:
         """The rest knots: ``carried`` (the first frame's, moved by the head) with each mouth
-        feature moved ``mouth_affine`` of the way to its affine least-squares fit to ``start``."""
-        amount = self.params.mouth_affine
-        rest = carried.copy()
-        for idx in (self._features["mouth_outer"], self._features["mouth_inner"]):
-            # Least squares about the centroids: the linear part from the centred points (by
-            # the normal equations, or lstsq's minimum-norm answer when they are singular).
-            a, b = carried[idx], start[idx]
-            ca, cb = a.sum(axis=0) / len(idx), b.sum(axis=0) / len(idx)  # (= mean, less overhead)
-            d = a - ca
-            gram = d.T @ d
-            if gram[0, 0] * gram[1, 1] - gram[0, 1] ** 2 > 1e-9 * (gram[0, 0] + gram[1, 1]) ** 2:
-                linear = np.linalg.solve(gram, d.T @ (b - cb))
-            else:
-                linear = np.linalg.lstsq(d, b - cb, rcond=None)[0]
-            rest[idx] += amount * (d @ linear + cb - a)
-        return rest
+        feature moved ``mouth_affine`` of the way to its affine least-squares fit to ``start``
+        (``facemime._core.affine_rest``)."""
+        return _core.affine_rest(carried, start, self._affine_groups, self.params.mouth_affine)
 
     def _shape_ok(self, knots: np.ndarray, rest: np.ndarray, names: tuple[str, str]) -> bool:
         """The upper curve's chord stays within a factor 2 of its rest chord (the inner mouth's
