@@ -6,7 +6,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
-use crate::points::rows;
+use crate::points::{array, rows};
 
 /// Splits a concatenated array into consecutive runs of the given lengths.
 fn runs<T: Clone>(name: &str, all: &[T], lengths: &[u32]) -> PyResult<Vec<Vec<T>>> {
@@ -78,11 +78,7 @@ fn elastic_adjust<'py>(
     let report = py
         .detach(|| adjust::elastic(&mut pts, &contours, &settings))
         .map_err(CoreErr::from)?;
-    let flat: Vec<f64> = pts.iter().flat_map(|p| [p[0], p[1]]).collect();
-    let out = numpy::ndarray::Array2::from_shape_vec((pts.len(), 2), flat)
-        .expect("N x 2")
-        .into_pyarray(py);
-    Ok((out, report.residuals.into_pyarray(py)))
+    Ok((array(py, &pts), report.residuals.into_pyarray(py)))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

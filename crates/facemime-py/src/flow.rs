@@ -8,7 +8,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
-use crate::points::rows;
+use crate::points::{array, rows};
 
 /// The moved points and the mask of those followed.
 type Flow<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>);
@@ -24,13 +24,8 @@ type Step<'py> = (
 
 /// (N, 2) float64 array of points, NaN rows for None.
 fn point_rows<'py>(py: Python<'py>, pts: &[Option<[f64; 2]>]) -> Bound<'py, PyArray2<f64>> {
-    let flat: Vec<f64> = pts
-        .iter()
-        .flat_map(|m| m.unwrap_or([f64::NAN; 2]))
-        .collect();
-    numpy::ndarray::Array2::from_shape_vec((pts.len(), 2), flat)
-        .expect("N x 2")
-        .into_pyarray(py)
+    let rows: Vec<[f64; 2]> = pts.iter().map(|m| m.unwrap_or([f64::NAN; 2])).collect();
+    array(py, &rows)
 }
 
 /// See `facemime.track.flow` for the documented API.
@@ -148,16 +143,10 @@ impl FlowFrames {
         let step = py
             .detach(|| motion::follow_rigid(prev, cur, &pts, &more, &lk, limit, min_points, rounds))
             .map_err(CoreErr)?;
-        let similarity = step.similarity.map(|m| {
-            numpy::ndarray::Array2::from_shape_vec((2, 3), m.iter().flatten().copied().collect())
-                .expect("2 x 3")
-                .into_pyarray(py)
-        });
-        let moved: Vec<Option<[f64; 2]>> = step.moved.into_iter().map(Some).collect();
         Ok((
-            similarity,
+            step.similarity.map(|m| array(py, &m)),
             step.kept.into_pyarray(py),
-            point_rows(py, &moved),
+            array(py, &step.moved),
             point_rows(py, &step.extra),
         ))
     }

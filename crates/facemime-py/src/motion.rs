@@ -5,7 +5,7 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyReadonlyArray3}
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::points::rows;
+use crate::points::{array, rows};
 
 /// The 2×3 similarity and the inlier mask.
 type Fit<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>);
@@ -29,11 +29,7 @@ fn robust_similarity<'py>(
         )));
     }
     let (m, inliers) = py.detach(|| motion::robust_similarity(&s, &d, limit, rounds));
-    let flat: Vec<f64> = m.iter().flatten().copied().collect();
-    let out = numpy::ndarray::Array2::from_shape_vec((2, 3), flat)
-        .expect("2 x 3")
-        .into_pyarray(py);
-    Ok((out, inliers.into_pyarray(py)))
+    Ok((array(py, &m), inliers.into_pyarray(py)))
 }
 
 /// points: (N, 2) pixels; quads: (Z, 4, 2) convex quadrilaterals, corners in order. Returns

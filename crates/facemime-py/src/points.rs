@@ -1,6 +1,6 @@
 //! Point arrays from numpy: (K, 2) pixel or (K, 3) model coordinates as fixed-size rows.
 
-use numpy::PyReadonlyArray2;
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -31,4 +31,13 @@ pub fn same_length(arrays: &[(&str, usize)]) -> PyResult<()> {
         names.join(", "),
         lengths.join(", ")
     )))
+}
+
+/// A (K, D) float64 array of fixed-size rows (a point array, or a matrix such as the 2×3
+/// similarity as its two rows).
+pub fn array<'py, const D: usize>(py: Python<'py>, rows: &[[f64; D]]) -> Bound<'py, PyArray2<f64>> {
+    let flat: Vec<f64> = rows.iter().flatten().copied().collect();
+    numpy::ndarray::Array2::from_shape_vec((rows.len(), D), flat)
+        .expect("K x D")
+        .into_pyarray(py)
 }

@@ -13,7 +13,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
-use crate::points::rows;
+use crate::points::{array, rows};
 
 fn err(msg: String) -> PyErr {
     PyValueError::new_err(msg)
@@ -160,10 +160,8 @@ impl SnakeSolver {
             None => vec![true; self.problem.n_curves()],
         };
         let sol = py.detach(|| frame.run(|input| self.problem.solve_some(input, &mask)))?;
-        let flat: Vec<f64> = sol.knots.iter().flatten().copied().collect();
-        let knots = ndarray::Array2::from_shape_vec((sol.knots.len(), 2), flat).expect("K x 2");
         Ok((
-            knots.into_pyarray(py),
+            array(py, &sol.knots),
             sol.iterations,
             sol.energy,
             sol.response.into_pyarray(py),
@@ -334,11 +332,7 @@ fn affine_rest<'py>(
         return Err(err(format!("knot index {k} is past the {} knots", a.len())));
     }
     let slices: Vec<&[usize]> = groups.iter().map(Vec::as_slice).collect();
-    let rest = snake::affine_rest(&a, &b, &slices, amount);
-    let flat: Vec<f64> = rest.iter().flatten().copied().collect();
-    Ok(numpy::ndarray::Array2::from_shape_vec((a.len(), 2), flat)
-        .expect("K x 2")
-        .into_pyarray(py))
+    Ok(array(py, &snake::affine_rest(&a, &b, &slices, amount)))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
