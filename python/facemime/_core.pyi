@@ -123,7 +123,7 @@ def frame_field(
     prev: npt.NDArray[np.uint8] | None,
     region: tuple[int, int, int, int],
     sigma: float,
-    bands: list[tuple[int, int]] | None = None,
+    bands: list[tuple[int, int, int, int]] | None = None,
     out: npt.NDArray[np.float32] | None = None,
 ) -> npt.NDArray[np.float32]: ...
 

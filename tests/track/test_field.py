@@ -51,13 +51,15 @@ def test_the_region_covers_the_points_with_their_margin_inside_the_image():
 
 def test_a_reused_buffer_gets_the_same_field_whatever_it_held(frames):
     prev, frame = frames
-    box, bands = (150, 200, 400, 480), [(210, 260), (400, 470)]
+    box, bands = (150, 200, 400, 480), [(0, 210, 512, 260), (220, 400, 330, 470)]
     want = build_field(frame, None, box, 1.5, bands)
     buffer = np.full((280, 250, 6), np.nan, np.float32)
     got = build_field(frame, None, box, 1.5, bands, out=buffer)
     assert got is buffer
     np.testing.assert_array_equal(got, want)
-    assert not got[100:140].any()  # rows between the bands are 0, not what the buffer held
+    # Pixels outside the bands are 0, not what the buffer held.
+    assert not got[100:140].any() and not got[200:270, :70].any() and not got[200:270, 180:].any()
+    np.testing.assert_array_equal(got[210:260, 80:170], build_field(frame, None, box, 1.5)[210:260, 80:170])
 
 
 def test_a_buffer_of_the_wrong_shape_is_refused(frames):

@@ -262,7 +262,7 @@ pub(crate) fn rgb_view<'a>(
 }
 
 /// The (y1 − y0, x1 − x0, FIELD_CHANNELS) float32 field of `frame` over `region`
-/// (x0, y0, x1, y1), only in the rows of `bands` ((b0, b1) frame rows) when given; see
+/// (x0, y0, x1, y1), only inside `bands` ((x0, y0, x1, y1) frame rectangles) when given; see
 /// `facemime.track.field`. Written into `out` (a C-contiguous array of that shape, returned)
 /// when given, else into a new array.
 #[pyfunction]
@@ -273,7 +273,7 @@ fn frame_field<'py>(
     prev: Option<PyReadonlyArray3<u8>>,
     region: [usize; 4],
     sigma: f64,
-    bands: Option<Vec<[usize; 2]>>,
+    bands: Option<Vec<[usize; 4]>>,
     out: Option<Bound<'py, PyArray3<f32>>>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
     let img = rgb_view("frame", &frame)?;

@@ -25,11 +25,13 @@ def region(points: np.ndarray, margin: float, width: int, height: int) -> tuple[
 
 
 def build_field(frame: np.ndarray, prev: np.ndarray | None, box: tuple[int, int, int, int], sigma: float,
-                bands: list[tuple[int, int]] | None = None, out: np.ndarray | None = None) -> np.ndarray:
+                bands: list[tuple[int, int, int, int]] | None = None, out: np.ndarray | None = None) -> np.ndarray:
     """The (h, w, 6) float32 field of ``frame`` (H, W, 3) uint8 RGB over ``box``
     (x0, y0, x1, y1), exclusive ends, smoothed by a Gaussian of ``sigma`` px; ``prev`` is the
-    previous frame (or None: L_prev = L). With ``bands``, (y0, y1) frame rows, only the box's
-    rows inside a band are computed (the same values) and the others are 0. Written into
-    ``out`` when given (a C-contiguous float32 array of that shape; its values are replaced)."""
+    previous frame (or None: L_prev = L). With ``bands``, (x0, y0, x1, y1) frame rectangles,
+    exclusive ends, only the box's pixels inside a band are computed (the same values) and the
+    others are 0 (in a row that two bands share, all from the one's left to the other's right
+    are computed). Written into ``out`` when given (a C-contiguous float32 array of that
+    shape; its values are replaced)."""
     before = None if prev is None else np.ascontiguousarray(prev)
     return _core.frame_field(np.ascontiguousarray(frame), before, box, sigma, bands, out)

@@ -278,8 +278,9 @@ class Tracker:
         self._features = {f: np.unique(np.concatenate([self._index[n] for n in names])) for f, names in FEATURES.items()}
         self._mouth_knots = np.unique(np.concatenate([self._features["mouth_outer"], self._features["mouth_inner"]]))
         self._affine_groups = [[int(i) for i in self._features[f]] for f in ("mouth_outer", "mouth_inner")]
-        self._bands = (self._mouth_knots, np.unique(np.concatenate([self._features["brow_left"], self._features["brow_right"]])))
-        self._banded = np.concatenate(self._bands)
+        # The field's bands: the mouth's knots with its solver passes, the brows' with one.
+        brows = np.unique(np.concatenate([self._features["brow_left"], self._features["brow_right"]]))
+        self._bands = ((self._mouth_knots, p.mouth_passes), (brows, 1))
         self._mouth_rows = [i for i, n in enumerate(CONTOUR_NAMES) if n.startswith("mouth")]
         self._feature_rows = {f: np.array([CONTOUR_NAMES.index(n) for n in names]) for f, names in FEATURES.items()}
         # Curve masks of the features solved on their own: the mouth's second pass, a brow found again.
@@ -297,7 +298,7 @@ class Tracker:
         # and report them shifted back by that offset (which turns and scales with the head).
         edges = self._knots0
         for _ in range(p.calibration_passes):
-            edges = self._solve(frame, edges, self._knots0, self._down0, self._targets0)[0]
+            edges = self._solve(self._field(frame, edges), edges, self._knots0, self._down0, self._targets0)[0]
         self._offset = edges - self._knots0
         self._knots0 = edges
         self._knots = edges.copy()
@@ -352,20 +353,18 @@ class Tracker:
         return np.array([-along[1], along[0]])
 
     def _field(self, frame: np.ndarray, knots: np.ndarray,
-               bands_of: tuple[np.ndarray, ...] | None = None) -> tuple[np.ndarray, tuple[float, float]]:
-        """The image field around ``knots``, wide enough for one solver pass from them; with
-        ``bands_of``, knot index arrays, around those knots only."""
+               bands: tuple[tuple[np.ndarray, int], ...] | None = None) -> tuple[np.ndarray, tuple[float, float]]:
+        """The image field the solver reads around ``knots``: (field, origin of its box). Each of
+        ``bands``, (knot indices, solver passes), is the box around those knots that so many
+        passes from them can read (default: the mouth's passes and one for the brows). The field
+        is valid until the next call (one buffer, reused)."""
         p = self.params
-        margin = p.delta0 / (1.0 - p.sigma) + 4.0 * p.smoothing + 2.0
-        banded = self._banded if bands_of is None else np.concatenate(bands_of)
-        bands_of = self._bands if bands_of is None else bands_of
-        box = region(knots[banded], margin, self.width, self.height)
-        # The snakes read the image only near the knots: the rows of the brows and of the
-        # mouth, not the eyes and nose between them.
-        bands = []
-        for idx in bands_of:
-            ys = knots[idx, 1]
-            bands.append((max(int(np.floor(ys.min() - margin)), 0), max(int(np.ceil(ys.max() + margin)) + 1, 0)))
+        reach = p.delta0 / (1.0 - p.sigma)
+        # The snakes read the image only near the knots: around the brows and around the mouth,
+        # not the eyes and nose between them.
+        boxes = [region(knots[idx], passes * reach + 4.0 * p.smoothing + 2.0, self.width, self.height)
+                 for idx, passes in bands or self._bands]
+        box = (min(b[0] for b in boxes), min(b[1] for b in boxes), max(b[2] for b in boxes), max(b[3] for b in boxes))
         prev = self._prev if max(p.mouth.gamma, p.mouth_inner.gamma, p.brows.gamma) > 0 else None
         # One buffer reused frame after frame: a fresh megabyte-sized array each frame cost
         # more in page faults than filling it.
@@ -373,26 +372,25 @@ class Tracker:
         if self._field_buffer.size < size:
             self._field_buffer = np.empty(size + size // 4, np.float32)
         out = self._field_buffer[:size].reshape(box[3] - box[1], box[2] - box[0], _core.FIELD_CHANNELS)
-        return build_field(frame, prev, box, p.smoothing, bands, out), (float(box[0]), float(box[1]))
+        return build_field(frame, prev, box, p.smoothing, boxes, out), (float(box[0]), float(box[1]))
 
     def _responses(self, frame: np.ndarray, start: np.ndarray, rest: np.ndarray, down: np.ndarray, targets: np.ndarray) -> np.ndarray:
         fld, origin = self._field(frame, start)
         _, resp = self._solver.evaluate(fld, origin, (self.width, self.height), start, rest, tuple(down), targets)
         return resp
 
-    def _solve(self, frame: np.ndarray, start: np.ndarray, rest: np.ndarray, down: np.ndarray, targets: np.ndarray,
-               part: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, int, np.ndarray]:
-        """One solver pass from ``start`` on ``frame``'s field; with ``part`` = (knot indices, a
-        mask over CONTOUR_NAMES), for those curves only, on the field around those knots (the
-        others stay at ``start``, their responses NaN)."""
-        fld, origin = self._field(frame, start, None if part is None else (part[0],))
-        knots, iters, _, resp = self._solver.solve(fld, origin, (self.width, self.height), start, rest, tuple(down),
-                                                   targets, None if part is None else part[1])
+    def _solve(self, field: tuple[np.ndarray, tuple[float, float]], start: np.ndarray, rest: np.ndarray,
+               down: np.ndarray, targets: np.ndarray, curves: np.ndarray | None = None) -> tuple[np.ndarray, int, np.ndarray]:
+        """One solver pass from ``start`` on ``field`` (:meth:`_field`); with ``curves``, a mask
+        over CONTOUR_NAMES, for those curves only (the others stay at ``start``, their
+        responses NaN)."""
+        knots, iters, _, resp = self._solver.solve(*field, (self.width, self.height), start, rest, tuple(down),
+                                                   targets, curves)
         return knots, iters, resp
 
     def _ratio(self, resp: np.ndarray) -> np.ndarray:
         """Edge responses as fractions of the first frame's, clipped to 0..1 (the confidence)."""
-        return np.clip(resp / self._response0, 0.0, 1.0)
+        return np.minimum(np.maximum(resp / self._response0, 0.0), 1.0)  # = np.clip, less overhead
 
     def update(self, frame: np.ndarray) -> FrameResult:
         """Track one more frame, (H, W, 3) uint8 RGB of the first frame's size."""
@@ -417,31 +415,32 @@ class Tracker:
         if flow is not None:
             followed = np.isfinite(flow[:, 0])
             start[followed] = flow[followed]
-            if followed[self._mouth_knots].mean() < p.mouth_patch:
+            if np.count_nonzero(followed[self._mouth_knots]) < p.mouth_patch * len(self._mouth_knots):
                 self._mouth_sideways(gray, start, followed, step, down, reach)
             if self._lips is not None:
                 self._lips.move(frame, start, ~followed, scale)
-        start = np.clip(start, 0.0, bounds_hi)
+        start = np.minimum(np.maximum(start, 0.0), bounds_hi)  # = np.clip, less overhead
         carried = motion.apply(total, self._knots0)
         rest = self._mouth_rest(carried, start)
         targets = self._targets0 * scale
-        knots, iters, resp = self._solve(frame, start, rest, down, targets)
+        image = self._field(frame, start)  # wide enough for all of the mouth's passes
+        knots, iters, resp = self._solve(image, start, rest, down, targets)
         before = start
         for _ in range(p.mouth_passes - 1):
             if np.abs(knots[self._mouth_knots] - before[self._mouth_knots]).max() < FAST * reach:
                 break
             before = knots.copy()
-            again, more, again_resp = self._solve(frame, before, rest, down, targets,
-                                                  (self._mouth_knots, self._mouth_curves))
+            again, more, again_resp = self._solve(image, before, rest, down, targets, self._mouth_curves)
             knots[self._mouth_knots] = again[self._mouth_knots]
             resp[self._mouth_rows] = again_resp[self._mouth_rows]
             iters += more
         self._centre_inner(knots, rest, down)
         confidence, lost = {}, []
         ratio = self._ratio(resp)
+        ratios = ratio.tolist()
         for feature, names in FEATURES.items():
             rows, idx = self._feature_rows[feature], self._features[feature]
-            conf = float(ratio[rows].mean())
+            conf = (ratios[rows[0]] + ratios[rows[1]]) / 2.0  # = ratio[rows].mean(), less overhead
             fallback = carried
             shape_ok = self._shape_ok(knots, carried, names)
             search = self._brow_search.get(feature)
@@ -451,8 +450,8 @@ class Tracker:
                     fallback = knots.copy()
                     fallback[idx] = found
                     if np.abs(found - knots[idx]).max() >= AGREE * reach:
-                        again, more, again_resp = self._solve(frame, fallback, rest, down, targets,
-                                                              (idx, self._feature_curves[feature]))
+                        again, more, again_resp = self._solve(self._field(frame, fallback, ((idx, 1),)), fallback,
+                                                              rest, down, targets, self._feature_curves[feature])
                         iters += more
                         conf_again = float(self._ratio(again_resp)[rows].mean())
                         if conf_again > conf or not shape_ok:
@@ -513,7 +512,8 @@ class Tracker:
         placed = knots.copy()
         placed[mouth] = found.apply(expected[mouth], polygon.mean(axis=0))
         rest = self._mouth_rest(carried, placed)
-        settled, iters, resp = self._solve(frame, placed, rest, down, targets, (mouth, self._mouth_curves))
+        settled, iters, resp = self._solve(self._field(frame, placed, ((mouth, 1),)), placed, rest, down, targets,
+                                           self._mouth_curves)
         self._centre_inner(settled, rest, down)
         ratio = self._ratio(resp)
         features = ("mouth_outer", "mouth_inner")
@@ -531,8 +531,10 @@ class Tracker:
         hold them sideways; in place)."""
         along = np.array([down[1], -down[0]])
         inner, outer = self._features["mouth_inner"], self._features["mouth_outer"]
-        mean = lambda pts, idx: pts[idx].sum(axis=0) / len(idx)  # noqa: E731 (= ndarray.mean, less overhead)
-        drift = (mean(knots, inner) - mean(knots, outer)) - (mean(rest, inner) - mean(rest, outer))
+        both = np.concatenate((knots, rest), axis=1)
+        # Each feature's mean knot and mean rest knot (= ndarray.mean, less overhead).
+        mi, mo = both[inner].sum(axis=0) / len(inner), both[outer].sum(axis=0) / len(outer)
+        drift = (mi[:2] - mo[:2]) - (mi[2:] - mo[2:])
         knots[inner] -= CENTRING * (drift @ along) * along
 
     def _uncross(self, knots: np.ndarray, down: np.ndarray) -> None:
@@ -555,7 +557,8 @@ class Tracker:
         """The upper curve's chord stays within a factor 2 of its rest chord (the inner mouth's
         may shrink to :data:`NARROWEST` of it: a mouth rounding into an "O" opens only in the
         middle of the line where the lips met)."""
-        first, last = self._index[names[0]][[0, -1]]
+        curve = self._index[names[0]]
+        first, last = curve[0], curve[-1]
         chord = _length(knots[last] - knots[first])
         rest_chord = _length(rest[last] - rest[first])
         least = NARROWEST if names[0] == "mouth_inner_upper" else 0.5

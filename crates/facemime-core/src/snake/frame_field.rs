@@ -18,15 +18,16 @@ pub const MAX_SIGMA: f64 = 16.0;
 /// Writes into `out` the region `[x0, y0, x1, y1)` (pixels, exclusive ends) of `frame` as a
 /// row-major (y1 − y0, x1 − x0, [`FIELD_CHANNELS`]) float32 field smoothed by a Gaussian of
 /// `sigma` pixels. `frame` and `prev` are (H, W, 3) RGB; without `prev`, L′ = L. With `bands`,
-/// frame rows `[b0, b1)`, only the rows of the region inside a band are computed (the same
-/// values as without) and the others are set to 0: the snakes of a frame read two bands, brows
-/// and mouth. `out` may hold anything before: the tracker reuses one buffer frame after frame.
+/// frame rectangles `[bx0, by0, bx1, by1)`, only the region's pixels inside a band are computed
+/// (the same values as without) and the others are set to 0: the snakes of a frame read two
+/// bands, around the brows and around the mouth. `out` may hold anything before: the tracker
+/// reuses one buffer frame after frame.
 pub fn frame_field(
     frame: &ImageRef,
     prev: Option<&ImageRef>,
     region: [usize; 4],
     sigma: f64,
-    bands: Option<&[[usize; 2]]>,
+    bands: Option<&[[usize; 4]]>,
     out: &mut [f32],
 ) -> Result<()> {
     let size = field_shape(frame, prev, region, sigma)?.iter().product();
@@ -36,11 +37,19 @@ pub fn frame_field(
             out.len()
         );
     }
-    let [_, y0, _, y1] = region;
-    let wanted: Vec<bool> = match bands {
-        None => vec![true; y1 - y0],
+    let [x0, y0, x1, y1] = region;
+    let wanted: Vec<Span> = match bands {
+        None => vec![[0, x1 - x0]; y1 - y0],
         Some(b) => (y0..y1)
-            .map(|y| b.iter().any(|&[b0, b1]| (b0..b1).contains(&y)))
+            .map(|y| {
+                let mut span = NONE;
+                for &[bx0, by0, bx1, by1] in b {
+                    if (by0..by1).contains(&y) {
+                        join(&mut span, bx0.clamp(x0, x1) - x0, bx1.clamp(x0, x1) - x0);
+                    }
+                }
+                span
+            })
             .collect(),
     };
     #[cfg(target_arch = "x86_64")]
@@ -57,22 +66,44 @@ pub fn frame_field(
     Ok(())
 }
 
-/// The rows each stage needs for the output rows `wanted`: (rows smoothed, rows blurred
-/// across), through the mirrored borders.
-fn needed(wanted: &[bool], radius: usize) -> (Vec<bool>, Vec<bool>) {
+/// The columns `[c0, c1)` of one region row that a stage computes; empty when c0 ≥ c1.
+type Span = [usize; 2];
+
+const NONE: Span = [0, 0];
+
+/// Grows `span` to cover the columns `[c0, c1)` too (one span per row: the smallest that
+/// holds both).
+fn join(span: &mut Span, c0: usize, c1: usize) {
+    if c0 >= c1 {
+        return;
+    }
+    *span = if span[0] >= span[1] {
+        [c0, c1]
+    } else {
+        [span[0].min(c0), span[1].max(c1)]
+    };
+}
+
+/// The spans each stage needs for the output spans `wanted` of a region `w` columns wide,
+/// through the mirrored borders: (smoothed, blurred across, converted to planes).
+fn needed(wanted: &[Span], radius: usize, w: usize) -> (Vec<Span>, Vec<Span>, Vec<Span>) {
     let h = wanted.len();
-    let reach = |rows: &[bool], by: usize| -> Vec<bool> {
-        let mut out = vec![false; h];
-        for y in (0..h).filter(|&y| rows[y]) {
-            for k in -(by as isize)..=by as isize {
-                out[reflect101(y as isize + k, h)] = true;
+    let reach = |spans: &[Span], rows: usize, cols: usize| -> Vec<Span> {
+        let mut out = vec![NONE; h];
+        for (y, &[c0, c1]) in spans.iter().enumerate().filter(|(_, s)| s[0] < s[1]) {
+            let (c0, c1) = (c0.saturating_sub(cols), (c1 + cols).min(w));
+            for k in -(rows as isize)..=rows as isize {
+                join(&mut out[reflect101(y as isize + k, h)], c0, c1);
             }
         }
         out
     };
-    let smoothed = reach(wanted, 1);
-    let across = reach(&smoothed, radius);
-    (smoothed, across)
+    // The derivatives read one row and one column around each output pixel, the vertical
+    // blur `radius` rows, the horizontal blur `radius` columns.
+    let smoothed = reach(wanted, 1, 1);
+    let across = reach(&smoothed, radius, 0);
+    let planes = reach(&across, 0, radius);
+    (smoothed, across, planes)
 }
 
 /// The (rows, columns, channels) shape of [`frame_field`]'s output, once its arguments are
@@ -153,46 +184,49 @@ fn weighted(out: &mut [f32], taps: &[f32], rows: &[&[f32]]) {
 /// Outputs per block of [`weighted`]: four AVX2 registers (two AVX-512 ones).
 const BLOCK: usize = 64;
 
-/// Smooths the (h, w) plane `img` in place with the separable `taps`, in the rows `smoothed`
-/// (reading the rows `across`, which must hold all that they reach); `pad` and `rows` are
+/// Smooths the (h, w) plane `img` in place with the separable `taps`, in the spans `smoothed`
+/// (reading the spans `across`, which must hold all that they reach); `pad` and `rows` are
 /// scratch.
 #[inline(always)]
 fn blur(
     img: &mut [f32],
     w: usize,
     taps: &[f32],
-    smoothed: &[bool],
-    across: &[bool],
+    smoothed: &[Span],
+    across: &[Span],
     pad: &mut Vec<f32>,
     rows: &mut Vec<f32>,
 ) {
     let (r, h) = (taps.len() / 2, smoothed.len());
-    pad.resize(w + 2 * r, 0.0);
     rows.resize(w * h, 0.0);
-    for y in (0..h).filter(|&y| across[y]) {
+    for (y, &[c0, c1]) in across.iter().enumerate().filter(|(_, s)| s[0] < s[1]) {
         let line = &img[y * w..][..w];
-        pad[r..r + w].copy_from_slice(line);
-        for i in 0..r {
-            pad[i] = line[reflect101(i as isize - r as isize, w)];
-            pad[r + w + i] = line[reflect101((w + i) as isize, w)];
+        let n = c1 - c0;
+        pad.resize(n + 2 * r, 0.0);
+        if c0 >= r && c1 + r <= w {
+            pad.copy_from_slice(&line[c0 - r..c1 + r]);
+        } else {
+            for (i, v) in pad.iter_mut().enumerate() {
+                *v = line[reflect101((c0 + i) as isize - r as isize, w)];
+            }
         }
-        let shifted: Vec<&[f32]> = (0..taps.len()).map(|t| &pad[t..][..w]).collect();
-        weighted(&mut rows[y * w..][..w], taps, &shifted);
+        let shifted: Vec<&[f32]> = (0..taps.len()).map(|t| &pad[t..][..n]).collect();
+        weighted(&mut rows[y * w + c0..][..n], taps, &shifted);
     }
-    for y in (0..h).filter(|&y| smoothed[y]) {
+    for (y, &[c0, c1]) in smoothed.iter().enumerate().filter(|(_, s)| s[0] < s[1]) {
         let around: Vec<&[f32]> = (0..taps.len())
-            .map(|t| &rows[reflect101((y + t) as isize - r as isize, h) * w..][..w])
+            .map(|t| &rows[reflect101((y + t) as isize - r as isize, h) * w + c0..][..c1 - c0])
             .collect();
-        weighted(&mut img[y * w..][..w], taps, &around);
+        weighted(&mut img[y * w + c0..][..c1 - c0], taps, &around);
     }
 }
 
-/// Luma and R − G planes of the region of `frame`, in its rows `rows` (the others 0).
+/// Luma and R − G planes of the region of `frame`, in its spans `spans` (the rest as it was).
 #[inline(always)]
 fn planes(
     frame: &ImageRef,
     region: [usize; 4],
-    rows: &[bool],
+    spans: &[Span],
     luma: &mut Vec<f32>,
     mut chroma: Option<&mut Vec<f32>>,
 ) {
@@ -202,14 +236,14 @@ fn planes(
     if let Some(c) = chroma.as_deref_mut() {
         c.resize(w * (y1 - y0), 0.0);
     }
-    for y in (y0..y1).filter(|&y| rows[y - y0]) {
-        let row = &frame.data[(y * frame.width + x0) * 3..][..w * 3];
-        let at = (y - y0) * w;
-        for (l, p) in luma[at..at + w].iter_mut().zip(row.chunks_exact(3)) {
+    for (y, &[c0, c1]) in spans.iter().enumerate().filter(|(_, s)| s[0] < s[1]) {
+        let row = &frame.data[((y0 + y) * frame.width + x0 + c0) * 3..][..(c1 - c0) * 3];
+        let at = y * w + c0;
+        for (l, p) in luma[at..at + c1 - c0].iter_mut().zip(row.chunks_exact(3)) {
             *l = 0.299 * p[0] as f32 + 0.587 * p[1] as f32 + 0.114 * p[2] as f32;
         }
         if let Some(c) = chroma.as_deref_mut() {
-            for (c, p) in c[at..at + w].iter_mut().zip(row.chunks_exact(3)) {
+            for (c, p) in c[at..at + c1 - c0].iter_mut().zip(row.chunks_exact(3)) {
                 *c = p[0] as f32 - p[1] as f32;
             }
         }
@@ -232,20 +266,21 @@ thread_local! {
     static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
 }
 
-/// [`frame_field`] once its arguments are checked; `wanted`: the region's rows to compute.
+/// [`frame_field`] once its arguments are checked; `wanted`: per region row, the columns to
+/// compute.
 #[inline(always)]
 fn build(
     frame: &ImageRef,
     prev: Option<&ImageRef>,
     region: [usize; 4],
     sigma: f64,
-    wanted: &[bool],
+    wanted: &[Span],
     out: &mut [f32],
 ) {
     let [x0, y0, x1, y1] = region;
     let (w, h) = (x1 - x0, y1 - y0);
     let taps = gaussian(sigma);
-    let (smoothed, across) = needed(wanted, taps.len() / 2);
+    let (smoothed, across, converted) = needed(wanted, taps.len() / 2, w);
     // Taken out and put back rather than borrowed in `SCRATCH.with(|s| ...)`, and no
     // `prev.map(|p| ...)`: a closure would not inherit `build_avx2`'s target feature.
     let mut scratch = SCRATCH.take();
@@ -256,12 +291,12 @@ fn build(
         pad,
         rows,
     } = &mut scratch;
-    planes(frame, region, &across, luma, Some(chroma));
+    planes(frame, region, &converted, luma, Some(chroma));
     for plane in [&mut *luma, &mut *chroma] {
         blur(plane, w, &taps, &smoothed, &across, pad, rows);
     }
     if let Some(p) = prev {
-        planes(p, region, &across, prev_luma, None);
+        planes(p, region, &converted, prev_luma, None);
         blur(prev_luma, w, &taps, &smoothed, &across, pad, rows);
     }
     let (luma, chroma) = (&*luma, &*chroma);
@@ -275,31 +310,41 @@ fn build(
     fn line(plane: &[f32], w: usize, y: usize) -> &[f32] {
         &plane[y * w..][..w]
     }
-    for (y, (o, &want)) in out
+    for (y, (o, &[c0, c1])) in out
         .chunks_exact_mut(w * FIELD_CHANNELS)
         .zip(wanted)
         .enumerate()
     {
-        if !want {
+        if c0 >= c1 {
             o.fill(0.0);
             continue;
         }
+        o[..c0 * FIELD_CHANNELS].fill(0.0);
+        o[c1 * FIELD_CHANNELS..].fill(0.0);
         // Central differences with mirrored borders: across an edge both neighbours are the
         // same pixel, so the first and last columns (and rows) get 0.
         let (up, down) = (reflect101(y as isize - 1, h), reflect101(y as isize + 1, h));
+        let (i0, i1) = (c0.max(1), c1.min(w - 1));
         let [dlx, dly, dcx, dcy] = &mut d;
         for (plane, dx, dy) in [(luma, dlx, dly), (chroma, dcx, dcy)] {
             let l = line(plane, w, y);
-            for ((o, a), b) in dx[1..w - 1].iter_mut().zip(&l[2..]).zip(l) {
-                *o = 0.5 * (a - b);
+            dx[0] = 0.0;
+            dx[w - 1] = 0.0;
+            if i0 < i1 {
+                for ((o, a), b) in dx[i0..i1].iter_mut().zip(&l[i0 + 1..]).zip(&l[i0 - 1..]) {
+                    *o = 0.5 * (a - b);
+                }
             }
             let (u, v) = (line(plane, w, up), line(plane, w, down));
-            for ((o, a), b) in dy.iter_mut().zip(v).zip(u) {
+            for ((o, a), b) in dy[c0..c1].iter_mut().zip(&v[c0..]).zip(&u[c0..]) {
                 *o = 0.5 * (a - b);
             }
         }
         let (l, lp) = (line(luma, w, y), line(before, w, y));
-        for (x, px) in o.chunks_exact_mut(FIELD_CHANNELS).enumerate() {
+        for (px, x) in o[c0 * FIELD_CHANNELS..c1 * FIELD_CHANNELS]
+            .chunks_exact_mut(FIELD_CHANNELS)
+            .zip(c0..)
+        {
             px.copy_from_slice(&[d[0][x], d[1][x], d[2][x], d[3][x], l[x], lp[x]]);
         }
     }
@@ -314,7 +359,7 @@ fn build_avx2(
     prev: Option<&ImageRef>,
     region: [usize; 4],
     sigma: f64,
-    wanted: &[bool],
+    wanted: &[Span],
     out: &mut [f32],
 ) {
     build(frame, prev, region, sigma, wanted, out)
@@ -328,7 +373,7 @@ fn build_avx512(
     prev: Option<&ImageRef>,
     region: [usize; 4],
     sigma: f64,
-    wanted: &[bool],
+    wanted: &[Span],
     out: &mut [f32],
 ) {
     build(frame, prev, region, sigma, wanted, out)
@@ -344,7 +389,7 @@ mod tests {
         prev: Option<&ImageRef>,
         region: [usize; 4],
         sigma: f64,
-        bands: Option<&[[usize; 2]]>,
+        bands: Option<&[[usize; 4]]>,
     ) -> Result<Vec<f32>> {
         let size = (region[2] - region[0]) * (region[3] - region[1]) * FIELD_CHANNELS;
         let mut out = vec![f32::NAN; size];
@@ -419,8 +464,14 @@ mod tests {
         let data = textured(64, 48);
         let img = ImageRef::new(&data, 64, 48, 3).unwrap();
         let region = [3, 2, 61, 45];
-        let bands = [[10, 14], [40, 60]];
-        let wanted: Vec<bool> = (2..45).map(|y| (10..14).contains(&y) || y >= 40).collect();
+        let bands = [[0, 10, 64, 14], [20, 40, 50, 60]];
+        let wanted: Vec<Span> = (2..45)
+            .map(|y| match y {
+                10..14 => [0, 58],
+                40.. => [17, 47],
+                _ => NONE,
+            })
+            .collect();
         let mut portable = vec![f32::NAN; 58 * 43 * FIELD_CHANNELS];
         build(&img, Some(&img), region, 1.5, &wanted, &mut portable);
         let got = field(&img, Some(&img), region, 1.5, Some(&bands)).unwrap();
@@ -429,7 +480,7 @@ mod tests {
         #[cfg(target_arch = "x86_64")]
         {
             type Build =
-                unsafe fn(&ImageRef, Option<&ImageRef>, [usize; 4], f64, &[bool], &mut [f32]);
+                unsafe fn(&ImageRef, Option<&ImageRef>, [usize; 4], f64, &[Span], &mut [f32]);
             let builds: [(&str, bool, Build); 2] = [
                 (
                     "avx2",
@@ -454,21 +505,39 @@ mod tests {
     }
 
     #[test]
-    fn bands_compute_the_same_rows_and_leave_the_others_zero() {
+    fn bands_compute_the_same_pixels_and_leave_the_others_zero() {
         let data = textured(50, 60);
         let img = ImageRef::new(&data, 50, 60, 3).unwrap();
         let region = [4, 3, 46, 57];
         let full = field(&img, Some(&img), region, 1.5, None).unwrap();
-        // One band at the region's top edge, one inside, one past its bottom.
-        let bands = [[0, 5], [20, 24], [55, 70]];
+        // Bands at the region's top-left corner, inside it, past its bottom-right corner, and
+        // two that share rows.
+        let bands = [
+            [0, 0, 12, 5],
+            [20, 20, 30, 24],
+            [40, 55, 60, 70],
+            [6, 30, 10, 36],
+            [25, 33, 33, 40],
+        ];
         let part = field(&img, Some(&img), region, 1.5, Some(&bands)).unwrap();
-        let row = FIELD_CHANNELS * (region[2] - region[0]);
-        for (i, (a, b)) in full.chunks(row).zip(part.chunks(row)).enumerate() {
-            let y = i + region[1];
-            if bands.iter().any(|&[b0, b1]| (b0..b1).contains(&y)) {
-                assert_eq!(a, b, "row {y}");
-            } else {
-                assert!(b.iter().all(|&v| v == 0.0), "row {y}");
+        let inside = |x: usize, y: usize| {
+            bands
+                .iter()
+                .any(|b| (b[0]..b[2]).contains(&x) && (b[1]..b[3]).contains(&y))
+        };
+        let w = region[2] - region[0];
+        for (i, (a, b)) in full
+            .chunks(FIELD_CHANNELS)
+            .zip(part.chunks(FIELD_CHANNELS))
+            .enumerate()
+        {
+            let (x, y) = (i % w + region[0], i / w + region[1]);
+            if inside(x, y) {
+                assert_eq!(a, b, "pixel ({x}, {y})");
+            } else if !(30..40).contains(&y) {
+                // (Rows that two bands share are computed from the one's left to the other's
+                // right.)
+                assert!(b.iter().all(|&v| v == 0.0), "pixel ({x}, {y})");
             }
         }
     }
@@ -481,17 +550,17 @@ mod tests {
             textured(50, 60),
             rgb(50, 60, |x, y| [(x * y % 256) as u8, 200, 3]),
         );
-        let field = |d: &[u8], region, bands: Option<&[[usize; 2]]>| {
+        let field = |d: &[u8], region, bands: Option<&[[usize; 4]]>| {
             let img = ImageRef::new(d, 50, 60, 3).unwrap();
             field(&img, Some(&img), region, 1.5, bands).unwrap()
         };
-        let bands = [[8, 12], [30, 41]];
+        let bands = [[0, 8, 60, 12], [12, 30, 30, 41]];
         let moved = data.clone();
         let fresh = std::thread::spawn(move || field(&moved, [4, 3, 46, 57], Some(&bands)))
             .join()
             .unwrap();
         field(&other, [0, 0, 50, 60], None);
-        field(&other, [10, 5, 30, 50], Some(&[[9, 40]]));
+        field(&other, [10, 5, 30, 50], Some(&[[0, 9, 60, 40]]));
         assert_eq!(field(&data, [4, 3, 46, 57], Some(&bands)), fresh);
     }
 
