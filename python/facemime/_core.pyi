@@ -155,6 +155,7 @@ class SnakeSolver:
         down: tuple[float, float],
         pair_targets: npt.NDArray[np.float64],
         curves: npt.NDArray[np.bool_] | None = None,
+        held: npt.NDArray[np.bool_] | None = None,
     ) -> tuple[npt.NDArray[np.float64], int, float, npt.NDArray[np.float64]]: ...
     def evaluate(
         self,

@@ -60,9 +60,10 @@ def test_no_coordinate_moves_more_than_the_solver_bound_per_pass_in_a_frame(mout
     # The brows get one solver pass per frame, the mouth ``mouth_passes``: each pass moves a
     # coordinate at most δ0/(1−σ); a motion faster than that uses the mouth's extra passes.
     # A brow that this fast motion loses jumps back to its rest shape instead (not a pass); the
-    # wide searches for a brow or a mouth lost, which are not solver passes either, are off.
+    # wide searches for a brow, a mouth or an inner mouth lost, which are not solver passes
+    # either, are off.
     params = TrackerParams(motion=False, delta0=1.0, sigma=0.6, mouth_passes=mouth_passes, brow_search=0.0,
-                           mouth_relocate=0)
+                           mouth_relocate=0, inner_search=0)
     bound = params.delta0 / (1.0 - params.sigma)
     frame0, truth0 = band_face()
     tracker = Tracker(frame0, truth0, params)
@@ -130,6 +131,27 @@ def test_editing_a_result_does_not_change_the_track():
         for name in CONTOUR_NAMES:
             np.testing.assert_array_equal(got[name], want[name])
             got[name] += 40.0  # a caller drawing or smoothing in place
+
+def test_a_lost_inner_mouth_is_looked_for_up_and_down_the_face():
+    # The line where thick lips meet drops 20 px in the middle within a frame, more than a
+    # solver pass reaches (6 px), with nothing (no knot flow, no lip search) to carry the inner
+    # curves there: left alone they lose it; the search finds the lips' edges below.
+    def track(inner_search):
+        params = TrackerParams(knot_flow=False, lip_reach=0.0, mouth_passes=1, inner_search=inner_search)
+        tracker = Tracker(*band_face(lips=2.5), params)
+        frame, truth = band_face(lips=2.5, parting=20.0, noise=1.0)
+        result = tracker.update(frame)
+        error = max(curve_error(result.contours[n], truth[n]) for n in FEATURES["mouth_inner"])
+        return result, error
+
+    alone, alone_error = track(0)
+    searched, searched_error = track(3)
+    assert "mouth_inner" in alone.lost and alone_error > 10.0
+    assert searched.lost == [] and searched.confidence["mouth_inner"] > 2 * alone.confidence["mouth_inner"]
+    assert searched_error < 0.5 * alone_error
+    for name in FEATURES["mouth_outer"]:  # the outer mouth stays where the solver put it
+        np.testing.assert_array_equal(searched.contours[name], alone.contours[name])
+
 
 def test_a_lost_brow_goes_back_to_its_rest_shape_and_is_found_again():
     frame0, truth0 = band_face()

@@ -133,9 +133,10 @@ impl SnakeSolver {
     }
 
     /// Solves one frame; returns (knots (K, 2), iterations, energy, response (C,)). With
-    /// `curves`, a (C,) bool mask, only the features of the flagged curves are solved (see
+    /// `curves`, a (C,) bool mask, only the features of the flagged curves are solved; with
+    /// `held`, a (K,) bool mask, the flagged knots stay at the start (see
     /// `Problem::solve_some`).
-    #[pyo3(signature = (field, origin, bounds, start, rest, down, pair_targets, curves=None))]
+    #[pyo3(signature = (field, origin, bounds, start, rest, down, pair_targets, curves=None, held=None))]
     #[allow(clippy::too_many_arguments, clippy::type_complexity)]
     fn solve<'py>(
         &self,
@@ -148,6 +149,7 @@ impl SnakeSolver {
         down: (f64, f64),
         pair_targets: PyReadonlyArray1<f64>,
         curves: Option<PyReadonlyArray1<bool>>,
+        held: Option<PyReadonlyArray1<bool>>,
     ) -> PyResult<(
         Bound<'py, PyArray2<f64>>,
         usize,
@@ -159,7 +161,9 @@ impl SnakeSolver {
             Some(m) => m.as_array().to_vec(),
             None => vec![true; self.problem.n_curves()],
         };
-        let sol = py.detach(|| frame.run(|input| self.problem.solve_some(input, &mask)))?;
+        let held = held.map(|h| h.as_array().to_vec());
+        let sol = py
+            .detach(|| frame.run(|input| self.problem.solve_some(input, &mask, held.as_deref())))?;
         Ok((
             array(py, &sol.knots),
             sol.iterations,

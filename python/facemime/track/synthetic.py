@@ -23,15 +23,17 @@ def _curve(x0: float, x1: float, y: float, bulge: float, count: int, centre: np.
 
 
 def band_face_contours(shift: tuple[float, float] = (0.0, 0.0), opening: float = 0.0, bend: float = 0.0,
-                       brow_raise: float = 0.0, lips: float = 1.0, size: tuple[int, int] = (256, 256)) -> dict[str, np.ndarray]:
+                       brow_raise: float = 0.0, lips: float = 1.0, size: tuple[int, int] = (256, 256),
+                       parting: float = 0.0) -> dict[str, np.ndarray]:
     """The true contours of :func:`band_face` (same arguments)."""
     c = np.array([size[0] / 2.0 + shift[0], size[1] / 2.0 + shift[1]])
     my = 40.0
+    # The inner curves' middle moves ``parting`` px down, their corners stay.
     out = {
         "mouth_outer_upper": _curve(-40, 40, my, 9 * lips + 0.3 * opening + bend, 11, c),
         "mouth_outer_lower": _curve(-40, 40, my, -(11 * lips + 0.7 * opening) + bend, 11, c),
-        "mouth_inner_upper": _curve(-40, 40, my, 0.3 * opening + bend, 11, c),
-        "mouth_inner_lower": _curve(-40, 40, my, -0.7 * opening + bend, 11, c),
+        "mouth_inner_upper": _curve(-40, 40, my, 0.3 * opening + bend - parting, 11, c),
+        "mouth_inner_lower": _curve(-40, 40, my, -0.7 * opening + bend - parting, 11, c),
     }
     for side, (x0, x1) in (("right", (-68, -18)), ("left", (18, 68))):
         y = -50.0 - brow_raise
@@ -42,19 +44,21 @@ def band_face_contours(shift: tuple[float, float] = (0.0, 0.0), opening: float =
 
 def band_face(shift: tuple[float, float] = (0.0, 0.0), opening: float = 0.0, bend: float = 0.0,
               brow_raise: float = 0.0, lips: float = 1.0, size: tuple[int, int] = (256, 256), noise: float = 0.0,
-              seed: int = 0) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+              seed: int = 0, parting: float = 0.0) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Render the synthetic face; returns ((H, W, 3) uint8 RGB frame, true contours).
 
     ``shift`` moves the whole face (px); ``opening`` opens the mouth (px); ``bend`` raises the
     middle of all mouth curves (px, a smile is negative); ``brow_raise`` lifts both brows (px);
-    ``lips`` scales the lips' thickness; ``noise`` adds Gaussian noise of that standard deviation (levels).
+    ``lips`` scales the lips' thickness; ``parting`` moves the line where the lips meet down in
+    the middle (px), the outer lips staying; ``noise`` adds Gaussian noise of that standard
+    deviation (levels).
 
     >>> frame, contours = band_face(opening=4.0)
     >>> frame.shape, contours["mouth_outer_upper"].shape
     ((256, 256, 3), (11, 2))
     """
     w, h = size
-    contours = band_face_contours(shift, opening, bend, brow_raise, lips, size)
+    contours = band_face_contours(shift, opening, bend, brow_raise, lips, size, parting)
     img = np.empty((h, w, 3), np.uint8)
     img[:] = SKIN
     c = np.array([w / 2.0 + shift[0], h / 2.0 + shift[1]])

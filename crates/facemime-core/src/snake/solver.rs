@@ -161,20 +161,33 @@ impl Problem {
 
     /// Runs the solver on one frame.
     pub fn solve(&self, input: &FrameInput<'_>) -> Result<Solution> {
-        self.solve_some(input, &vec![true; self.curves.len()])
+        self.solve_some(input, &vec![true; self.curves.len()], None)
     }
 
     /// Runs the solver on one frame for the features (groups of coupled curves) of the curves
     /// flagged in `curves` only: the other features' knots stay at the start, their curves are
     /// not evaluated and their response is NaN. Each solved feature gets exactly the knots,
     /// iterations and response it gets from [`Problem::solve`]; the energy is the solved
-    /// features'.
-    pub fn solve_some(&self, input: &FrameInput<'_>, curves: &[bool]) -> Result<Solution> {
+    /// features'. The knots flagged in `held`, if given (one flag per knot), stay at the start
+    /// too: their curves still read the image and pull on the others through the couplings.
+    pub fn solve_some(
+        &self,
+        input: &FrameInput<'_>,
+        curves: &[bool],
+        held: Option<&[bool]>,
+    ) -> Result<Solution> {
         if curves.len() != self.curves.len() {
             return invalid!(
                 "the curve mask must have {} values, got {}",
                 self.curves.len(),
                 curves.len()
+            );
+        }
+        if let Some(h) = held.filter(|h| h.len() != self.n_knots) {
+            return invalid!(
+                "the held-knot mask must have {} values, got {}",
+                self.n_knots,
+                h.len()
             );
         }
         let mut moving = vec![false; self.n_groups];
@@ -191,8 +204,13 @@ impl Problem {
         let mut iterations = 0;
         let mut before = ws.group_energy.clone();
         while iterations < s.iterations && moving.contains(&true) {
-            for ((k, g), &group) in knots.iter_mut().zip(&ws.grad).zip(&self.knot_group) {
-                if moving[group] {
+            for (i, ((k, g), &group)) in knots
+                .iter_mut()
+                .zip(&ws.grad)
+                .zip(&self.knot_group)
+                .enumerate()
+            {
+                if moving[group] && !held.is_some_and(|h| h[i]) {
                     k[0] = (k[0] - step * sign(g[0])).clamp(0.0, xmax);
                     k[1] = (k[1] - step * sign(g[1])).clamp(0.0, ymax);
                 }
@@ -569,14 +587,25 @@ mod tests {
         start.extend(line(30.0, 10.0, 5));
         let input = plain_input(field, &start);
         let joint = problem.solve(&input).unwrap();
-        let some = problem.solve_some(&input, &[false, true]).unwrap();
+        let some = problem.solve_some(&input, &[false, true], None).unwrap();
         assert_eq!(&some.knots[..5], &start[..5]);
         assert_eq!(&some.knots[5..], &joint.knots[5..]);
         assert_ne!(&joint.knots[5..], &start[5..]);
         assert!(some.response[0].is_nan());
         assert_eq!(some.response[1], joint.response[1]);
         assert_eq!(some.iterations, joint.iterations);
-        assert!(problem.solve_some(&input, &[true]).is_err());
+        assert!(problem.solve_some(&input, &[true], None).is_err());
+        assert!(problem
+            .solve_some(&input, &[true, true], Some(&[false]))
+            .is_err());
+        // Held knots stay at the start; the others of their curve still move.
+        let mut held = [true; 10];
+        held[6..].fill(false);
+        let some = problem
+            .solve_some(&input, &[true, true], Some(&held))
+            .unwrap();
+        assert_eq!(&some.knots[..6], &start[..6]);
+        assert!(some.knots[6..].iter().zip(&start[6..]).all(|(k, s)| k != s));
     }
 
     #[test]
