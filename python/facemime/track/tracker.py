@@ -300,6 +300,7 @@ class Tracker:
         self._bands = ((self._mouth_knots, p.mouth_passes), (brows, 1))
         self._mouth_rows = [i for i, n in enumerate(CONTOUR_NAMES) if n.startswith("mouth")]
         self._feature_rows = {f: np.array([CONTOUR_NAMES.index(n) for n in names]) for f, names in FEATURES.items()}
+        self._upper_rows, self._lower_rows = np.array(list(self._feature_rows.values())).T
         # Curve masks of the features solved on their own: the mouth's second pass, a brow found again.
         self._feature_curves = {f: np.isin(np.arange(len(CONTOUR_NAMES)), rows) for f, rows in self._feature_rows.items()}
         self._mouth_curves = np.isin(np.arange(len(CONTOUR_NAMES)), self._mouth_rows)
@@ -411,6 +412,10 @@ class Tracker:
         """Edge responses as fractions of the first frame's, clipped to 0..1 (the confidence)."""
         return np.minimum(np.maximum(resp / self._response0, 0.0), 1.0)  # = np.clip, less overhead
 
+    def _confidences(self, ratio: np.ndarray) -> dict[str, float]:
+        """Each feature's confidence: the mean of its two curves' ``ratio`` (:meth:`_ratio`)."""
+        return dict(zip(FEATURES, ((ratio[self._upper_rows] + ratio[self._lower_rows]) / 2.0).tolist()))
+
     def update(self, frame: np.ndarray) -> FrameResult:
         """Track one more frame, (H, W, 3) uint8 RGB of the first frame's size."""
         frame = _rgb("frame", frame)
@@ -456,10 +461,10 @@ class Tracker:
         self._centre_inner(knots, rest, down)
         confidence, lost = {}, []
         ratio = self._ratio(resp)
-        ratios = ratio.tolist()
+        confidences = self._confidences(ratio)
         for feature, names in FEATURES.items():
             rows, idx = self._feature_rows[feature], self._features[feature]
-            conf = (ratios[rows[0]] + ratios[rows[1]]) / 2.0  # = ratio[rows].mean(), less overhead
+            conf = confidences[feature]
             fallback = carried
             shape_ok = self._shape_ok(knots, carried, names)
             search = self._brow_search.get(feature)
@@ -472,7 +477,7 @@ class Tracker:
                         again, more, again_resp = self._solve(self._field(frame, fallback, ((idx, 1),)), fallback,
                                                               rest, down, targets, self._feature_curves[feature])
                         iters += more
-                        conf_again = float(self._ratio(again_resp)[rows].mean())
+                        conf_again = self._confidences(self._ratio(again_resp))[feature]
                         if conf_again > conf or not shape_ok:
                             knots[idx], conf = again[idx], conf_again
                             shape_ok = self._shape_ok(knots, carried, names)
@@ -535,11 +540,9 @@ class Tracker:
         # One field for every trial: a trial moves a knot at most inner_search reaches and its
         # pass one more.
         image = self._field(frame, knots, ((self._mouth_knots, p.inner_search + 1),))
-        rows = self._feature_rows["mouth_inner"]
-        confidence = lambda r: float(r[rows].mean())  # noqa: E731
         held = np.ones(len(knots), bool)
         held[inner] = False
-        placed, best, iters = knots.copy(), confidence(ratio), 0
+        placed, best, iters = knots.copy(), self._confidences(ratio)["mouth_inner"], 0
         for name in FEATURES["mouth_inner"]:
             idx, found = self._index[name][1:-1], None
             for steps in range(-p.inner_search, p.inner_search + 1):
@@ -549,7 +552,7 @@ class Tracker:
                 trial[idx] += steps * reach * down
                 settled, more, resp = self._solve(image, trial, rest, down, targets, self._mouth_curves, held)
                 iters += more
-                if (conf := confidence(self._ratio(resp))) > best:
+                if (conf := self._confidences(self._ratio(resp))["mouth_inner"]) > best:
                     found, best = settled[inner], conf
             if found is not None:
                 placed[inner] = found
@@ -580,9 +583,8 @@ class Tracker:
         settled, iters, resp = self._solve(self._field(frame, placed, ((mouth, 1),)), placed, rest, down, targets,
                                            self._mouth_curves)
         self._centre_inner(settled, rest, down)
-        ratio = self._ratio(resp)
         features = ("mouth_outer", "mouth_inner")
-        confidence = {f: float(ratio[self._feature_rows[f]].mean()) for f in features}
+        confidence = {f: c for f, c in self._confidences(self._ratio(resp)).items() if f in features}
         if all(confidence[f] >= self.params.lost_response and self._shape_ok(settled, carried, FEATURES[f])
                for f in features):
             knots[mouth] = settled[mouth]
