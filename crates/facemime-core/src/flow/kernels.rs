@@ -1,7 +1,18 @@
 //! The per-window arithmetic of the Lucas-Kanade flow, [`LANES`] columns at a time: a portable
-//! version and an AVX2 one that computes the same values bit for bit (the same operations in
-//! the same order, no fused multiply-add). Window rows are `cols` values long, a multiple of
-//! [`LANES`]; each lane keeps its own partial sums, added up in lane order at the end.
+//! version and an AVX2 one that compute the same values bit for bit (the same operations in
+//! the same order; products are added with fused multiply-adds, `f32::mul_add` in the portable
+//! version).
+//!
+//! The kernels are bound by their loads and by the latency of their sums, so each reads a plane
+//! row once per block of [`LANES`] columns and keeps what the next row needs in registers:
+//! bilinear sampling is done along the row, then across rows; the Scharr derivatives are a row
+//! difference and a row smoothing, then the same across rows. A block's rows are walked top to
+//! bottom, the blocks left to right; lane l of a sum adds up, in that order, the terms of the
+//! columns ≡ l (mod [`LANES`]) (in [`correlate`], even and odd rows apart, then the two), and
+//! the lanes are added up pairwise at the end (see [`sum`]).
+//!
+//! The window is `win` × `win` pixels. Its buffers have rows of [`Shape::cols`] values, the
+//! side rounded up to [`LANES`]; columns past the side are dead (derivatives 0) and add nothing.
 
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
@@ -9,179 +20,225 @@ use std::arch::x86_64::*;
 /// Width of the partial sums.
 pub const LANES: usize = 8;
 
-/// Bilinear samples of a padded plane P: the sample at window (row r, column c) is
-/// `w[0]·P[a] + w[1]·P[a+1] + w[2]·P[a+s] + w[3]·P[a+s+1]`,
-/// with s = stride and a = start + r·s + c.
+/// The buffers' layout for a window side.
+#[derive(Clone, Copy, Debug)]
+pub struct Shape {
+    /// Window side (pixels).
+    pub win: usize,
+    /// Row length of the derivatives: `win` rounded up to [`LANES`].
+    pub cols: usize,
+    /// Row length of the grown window's samples: room for the `cols` + 2 values the
+    /// derivatives read (those past the sampled ones only feed dead columns).
+    pub ecols: usize,
+}
+
+impl Shape {
+    pub fn new(win: usize) -> Self {
+        let cols = win.div_ceil(LANES) * LANES;
+        Self {
+            win,
+            cols,
+            ecols: cols + LANES,
+        }
+    }
+
+    /// Columns sampled per row of the grown window: `win` + 2 rounded up to [`LANES`].
+    fn sampled(&self) -> usize {
+        (self.win + 2).div_ceil(LANES) * LANES
+    }
+
+    /// Mirrored pixels a plane needs on every side for windows whose corner's integer part
+    /// lies in [−`win`, size): the kernels read from one pixel left of (above) the corner to
+    /// `win` + 1 pixels below it and `cols` pixels right of it (sampling the grown window,
+    /// [`Shape::sampled`] − 1).
+    pub fn pad(&self) -> usize {
+        (self.win + 1).max(self.cols).max(self.sampled() - 1)
+    }
+}
+
+/// Bilinear samples of a padded plane P: with a = start + r·s + c and s = stride, the sample
+/// at window (row r, column c) is `wy[0]·h(a) + wy[1]·h(a + s)`, where
+/// `h(i) = wx[0]·P[i] + wx[1]·P[i + 1]`.
 #[derive(Clone, Copy)]
 pub struct Grid<'a> {
     pub plane: &'a [f32],
     pub start: usize,
     pub stride: usize,
-    pub w: [f32; 4],
+    pub wx: [f32; 2],
+    pub wy: [f32; 2],
 }
 
 impl Grid<'_> {
-    /// The two plane rows that window row `r` interpolates between, `len` + 1 values each.
-    fn rows(&self, r: usize, len: usize) -> (&[f32], &[f32]) {
-        let at = self.start + r * self.stride;
-        (
-            &self.plane[at..][..len + 1],
-            &self.plane[at + self.stride..][..len + 1],
-        )
+    /// Plane row `r` of the grid from column `k`, `len` + 1 values.
+    fn row(&self, r: usize, k: usize, len: usize) -> &[f32] {
+        &self.plane[self.start + r * self.stride + k..][..len + 1]
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 fn has_avx2() -> bool {
-    std::arch::is_x86_feature_detected!("avx2")
+    std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
 }
 
+/// The lanes' total, in f64: lanes l and l + 4, then those sums two apart, then the two.
 fn sum(a: [f32; LANES]) -> f64 {
-    a.iter().map(|&v| v as f64).sum()
+    let h: [f64; 4] = std::array::from_fn(|l| a[l] as f64 + a[l + 4] as f64);
+    (h[0] + h[2]) + (h[1] + h[3])
 }
 
-/// Fills `out` (`rows` × `cols`) with the grid's samples.
-pub fn sample(g: &Grid, rows: usize, cols: usize, out: &mut [f32]) {
-    assert!(cols.is_multiple_of(LANES) && out.len() >= rows * cols);
+/// Fills `rows` rows of `out` (rows of `s.ecols`) with the grid's samples, the first
+/// `s.win` + 2 columns of each at least.
+pub fn sample(s: &Shape, g: &Grid, rows: usize, out: &mut [f32]) {
+    assert!(out.len() >= rows * s.ecols && s.ecols >= s.sampled());
+    g.row(rows, s.sampled() - LANES, LANES); // the last value read is in the plane
     #[cfg(target_arch = "x86_64")]
     if has_avx2() {
         // SAFETY: AVX2 is present and the sizes are checked above.
-        return unsafe { sample_avx2(g, rows, cols, out) };
+        return unsafe { sample_avx2(s, g, rows, out) };
     }
-    sample_portable(g, rows, cols, out)
+    sample_portable(s, g, rows, out)
 }
 
-fn sample_portable(g: &Grid, rows: usize, cols: usize, out: &mut [f32]) {
-    for r in 0..rows {
-        let (t, b) = g.rows(r, cols);
-        for (c, o) in out[r * cols..][..cols].iter_mut().enumerate() {
-            *o = g.w[0] * t[c] + g.w[1] * t[c + 1] + g.w[2] * b[c] + g.w[3] * b[c + 1];
+fn sample_portable(s: &Shape, g: &Grid, rows: usize, out: &mut [f32]) {
+    let h = |r: usize, k: usize| -> [f32; LANES] {
+        let p = g.row(r, k, LANES);
+        std::array::from_fn(|l| g.wx[1].mul_add(p[l + 1], g.wx[0] * p[l]))
+    };
+    for k in (0..s.sampled()).step_by(LANES) {
+        let mut above = h(0, k);
+        for r in 0..rows {
+            let below = h(r + 1, k);
+            for (l, o) in out[r * s.ecols + k..][..LANES].iter_mut().enumerate() {
+                *o = g.wy[1].mul_add(below[l], g.wy[0] * above[l]);
+            }
+            above = below;
         }
     }
 }
 
 /// Scharr derivatives of the window whose samples, grown by one pixel on every side, are
-/// `ext` (rows of `ecols` ≥ `cols` + 2 values): window (r, c) is `ext` (r + 1, c + 1).
-/// Writes `gx`, `gy` (`win` × `cols`) scaled by `live` per column (1/32 in the window, which
-/// makes them grey levels per pixel, as the Scharr weights sum to 32; 0 past it) and returns
-/// the gradient matrix (Σgx², Σgx·gy, Σgy²).
-pub fn gradients(
-    ext: &[f32],
-    ecols: usize,
-    live: &[f32],
-    gx: &mut [f32],
-    gy: &mut [f32],
-) -> [f64; 3] {
-    let cols = live.len();
-    let win = gx.len() / cols;
-    assert!(cols.is_multiple_of(LANES) && ecols >= cols + 2 && ext.len() >= (win + 2) * ecols);
-    assert!(gy.len() == gx.len() && gx.len() == win * cols);
+/// `ext` (see [`sample`]): window (r, c) is `ext` (r + 1, c + 1). Writes `gx`, `gy` (`s.win`
+/// rows of `s.cols`) scaled by `live` per column (1/32 in the window, which makes them grey
+/// levels per pixel, as the Scharr weights sum to 32; 0 past it) and returns the gradient
+/// matrix and the window's image against its derivatives:
+/// (Σgx², Σgx·gy, Σgy², ΣI·gx, ΣI·gy), I the window's samples. `ext` must be finite.
+pub fn gradients(s: &Shape, ext: &[f32], live: &[f32], gx: &mut [f32], gy: &mut [f32]) -> [f64; 5] {
+    assert!(s.cols.is_multiple_of(LANES) && s.ecols >= s.cols + 2 && live.len() == s.cols);
+    assert!(ext.len() >= (s.win + 2) * s.ecols);
+    assert!(gy.len() == gx.len() && gx.len() == s.win * s.cols);
     #[cfg(target_arch = "x86_64")]
     if has_avx2() {
         // SAFETY: AVX2 is present and the sizes are checked above.
-        return unsafe { gradients_avx2(ext, ecols, live, gx, gy) };
+        return unsafe { gradients_avx2(s, ext, live, gx, gy) };
     }
-    gradients_portable(ext, ecols, live, gx, gy)
+    gradients_portable(s, ext, live, gx, gy)
 }
 
 fn gradients_portable(
+    s: &Shape,
     ext: &[f32],
-    ecols: usize,
     live: &[f32],
     gx: &mut [f32],
     gy: &mut [f32],
-) -> [f64; 3] {
-    let cols = live.len();
-    let win = gx.len() / cols;
-    let (mut a11, mut a12, mut a22) = ([0.0f32; LANES], [0.0f32; LANES], [0.0f32; LANES]);
-    for r in 0..win {
-        let row = |k: usize| &ext[(r + k) * ecols..][..ecols];
-        let (e0, e1, e2) = (row(0), row(1), row(2));
-        for c in 0..cols {
-            let (l, s) = (c % LANES, live[c]);
-            let x =
-                s * (3.0 * (e0[c + 2] - e0[c] + e2[c + 2] - e2[c]) + 10.0 * (e1[c + 2] - e1[c]));
-            let y = s
-                * (3.0 * (e2[c] + e2[c + 2] - e0[c] - e0[c + 2]) + 10.0 * (e2[c + 1] - e0[c + 1]));
-            gx[r * cols + c] = x;
-            gy[r * cols + c] = y;
-            a11[l] += x * x;
-            a12[l] += x * y;
-            a22[l] += y * y;
+) -> [f64; 5] {
+    let mut acc = [[0.0f32; LANES]; 5];
+    // Per column of ext row e: (row difference n − p, row smoothing 3·(p + n) + 10·m, m).
+    let along = |e: usize, k: usize| -> [[f32; LANES]; 3] {
+        let v = &ext[e * s.ecols + k..][..LANES + 2];
+        [
+            std::array::from_fn(|l| v[l + 2] - v[l]),
+            std::array::from_fn(|l| 10.0f32.mul_add(v[l + 1], 3.0 * (v[l] + v[l + 2]))),
+            std::array::from_fn(|l| v[l + 1]),
+        ]
+    };
+    for k in (0..s.cols).step_by(LANES) {
+        let (mut r0, mut r1) = (along(0, k), along(1, k));
+        for r in 0..s.win {
+            let r2 = along(r + 2, k);
+            for l in 0..LANES {
+                let m = live[k + l];
+                let x = m * 10.0f32.mul_add(r1[0][l], 3.0 * (r0[0][l] + r2[0][l]));
+                let y = m * (r2[1][l] - r0[1][l]);
+                let i = r1[2][l];
+                gx[r * s.cols + k + l] = x;
+                gy[r * s.cols + k + l] = y;
+                for (a, t) in acc.iter_mut().zip([(x, x), (x, y), (y, y), (i, x), (i, y)]) {
+                    a[l] = t.0.mul_add(t.1, a[l]);
+                }
+            }
+            (r0, r1) = (r1, r2);
         }
     }
-    [sum(a11), sum(a12), sum(a22)]
+    acc.map(sum)
 }
 
-/// Σ(J − I)·gx and Σ(J − I)·gy over the window, J the `next` grid's samples, I the window's
-/// samples inside `ext` (see [`gradients`]), `gx`, `gy` as [`gradients`] wrote them.
-pub fn mismatch(
-    next: &Grid,
-    ext: &[f32],
-    ecols: usize,
-    gx: &[f32],
-    gy: &[f32],
-    cols: usize,
-) -> [f64; 2] {
-    let win = gx.len() / cols;
-    assert!(cols.is_multiple_of(LANES) && ecols >= cols + 2 && ext.len() >= (win + 2) * ecols);
-    assert!(gy.len() == gx.len() && gx.len() == win * cols);
+/// ΣJ·gx and ΣJ·gy over the window, J the `next` grid's samples, `gx`, `gy` as [`gradients`]
+/// wrote them.
+pub fn correlate(s: &Shape, next: &Grid, gx: &[f32], gy: &[f32]) -> [f64; 2] {
+    assert!(s.cols.is_multiple_of(LANES));
+    assert!(gy.len() == gx.len() && gx.len() == s.win * s.cols);
+    next.row(s.win, s.cols - LANES, LANES); // the last value read is in the plane
     #[cfg(target_arch = "x86_64")]
     if has_avx2() {
         // SAFETY: AVX2 is present and the sizes are checked above.
-        return unsafe { mismatch_avx2(next, ext, ecols, gx, gy, cols) };
+        return unsafe { correlate_avx2(s, next, gx, gy) };
     }
-    mismatch_portable(next, ext, ecols, gx, gy, cols)
+    correlate_portable(s, next, gx, gy)
 }
 
-fn mismatch_portable(
-    next: &Grid,
-    ext: &[f32],
-    ecols: usize,
-    gx: &[f32],
-    gy: &[f32],
-    cols: usize,
-) -> [f64; 2] {
-    let win = gx.len() / cols;
-    let (mut b1, mut b2) = ([0.0f32; LANES], [0.0f32; LANES]);
-    let w = next.w;
-    for r in 0..win {
-        let (t, b) = next.rows(r, cols);
-        let i = &ext[(r + 1) * ecols + 1..][..cols];
-        for c in 0..cols {
-            let j = w[0] * t[c] + w[1] * t[c + 1] + w[2] * b[c] + w[3] * b[c + 1];
-            let d = j - i[c];
-            b1[c % LANES] += d * gx[r * cols + c];
-            b2[c % LANES] += d * gy[r * cols + c];
+fn correlate_portable(s: &Shape, g: &Grid, gx: &[f32], gy: &[f32]) -> [f64; 2] {
+    let h = |r: usize, k: usize| -> [f32; LANES] {
+        let p = g.row(r, k, LANES);
+        std::array::from_fn(|l| g.wx[1].mul_add(p[l + 1], g.wx[0] * p[l]))
+    };
+    // [row parity][derivative][lane]
+    let mut acc = [[[0.0f32; LANES]; 2]; 2];
+    for k in (0..s.cols).step_by(LANES) {
+        let mut above = h(0, k);
+        for r in 0..s.win {
+            let below = h(r + 1, k);
+            let a = &mut acc[r % 2];
+            for l in 0..LANES {
+                let j = g.wy[1].mul_add(below[l], g.wy[0] * above[l]);
+                a[0][l] = j.mul_add(gx[r * s.cols + k + l], a[0][l]);
+                a[1][l] = j.mul_add(gy[r * s.cols + k + l], a[1][l]);
+            }
+            above = below;
         }
     }
-    [sum(b1), sum(b2)]
+    [0, 1].map(|d| sum(std::array::from_fn(|l| acc[0][d][l] + acc[1][d][l])))
 }
 
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
     use super::*;
 
-    /// w0·t0 + w1·t1 + w2·b0 + w3·b1, left to right.
+    /// w[0]·P[p] + w[1]·P[p + 1], [`LANES`] columns from `p`.
     #[inline]
-    #[target_feature(enable = "avx2")]
-    pub unsafe fn bilinear(t: *const f32, b: *const f32, w: &[__m256; 4]) -> __m256 {
-        let s = _mm256_add_ps(
-            _mm256_mul_ps(w[0], _mm256_loadu_ps(t)),
-            _mm256_mul_ps(w[1], _mm256_loadu_ps(t.add(1))),
-        );
-        let s = _mm256_add_ps(s, _mm256_mul_ps(w[2], _mm256_loadu_ps(b)));
-        _mm256_add_ps(s, _mm256_mul_ps(w[3], _mm256_loadu_ps(b.add(1))))
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn along(p: *const f32, w: &[__m256; 2]) -> __m256 {
+        _mm256_fmadd_ps(
+            w[1],
+            _mm256_loadu_ps(p.add(1)),
+            _mm256_mul_ps(w[0], _mm256_loadu_ps(p)),
+        )
+    }
+
+    /// w[0]·a + w[1]·b.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn across(a: __m256, b: __m256, w: &[__m256; 2]) -> __m256 {
+        _mm256_fmadd_ps(w[1], b, _mm256_mul_ps(w[0], a))
     }
 
     #[inline]
-    #[target_feature(enable = "avx2")]
-    pub unsafe fn weights(w: [f32; 4]) -> [__m256; 4] {
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn weights(w: [f32; 2]) -> [__m256; 2] {
         w.map(|v| _mm256_set1_ps(v))
     }
 
     #[inline]
-    #[target_feature(enable = "avx2")]
+    #[target_feature(enable = "avx2,fma")]
     pub unsafe fn lanes(v: __m256) -> [f32; LANES] {
         let mut out = [0.0f32; LANES];
         _mm256_storeu_ps(out.as_mut_ptr(), v);
@@ -192,15 +249,17 @@ mod avx2 {
 /// # Safety
 /// AVX2 must be present and the sizes those [`sample`] checks.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn sample_avx2(g: &Grid, rows: usize, cols: usize, out: &mut [f32]) {
-    let w = avx2::weights(g.w);
-    for r in 0..rows {
-        let (t, b) = g.rows(r, cols);
-        let row = &mut out[r * cols..][..cols];
-        for k in (0..cols).step_by(LANES) {
-            let v = avx2::bilinear(t.as_ptr().add(k), b.as_ptr().add(k), &w);
-            _mm256_storeu_ps(row.as_mut_ptr().add(k), v);
+#[target_feature(enable = "avx2,fma")]
+unsafe fn sample_avx2(s: &Shape, g: &Grid, rows: usize, out: &mut [f32]) {
+    let (wx, wy) = (avx2::weights(g.wx), avx2::weights(g.wy));
+    let p = g.plane.as_ptr().add(g.start);
+    for k in (0..s.sampled()).step_by(LANES) {
+        let mut above = avx2::along(p.add(k), &wx);
+        for r in 0..rows {
+            let below = avx2::along(p.add((r + 1) * g.stride + k), &wx);
+            let v = avx2::across(above, below, &wy);
+            _mm256_storeu_ps(out.as_mut_ptr().add(r * s.ecols + k), v);
+            above = below;
         }
     }
 }
@@ -208,88 +267,82 @@ unsafe fn sample_avx2(g: &Grid, rows: usize, cols: usize, out: &mut [f32]) {
 /// # Safety
 /// AVX2 must be present and the sizes those [`gradients`] checks.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 unsafe fn gradients_avx2(
+    s: &Shape,
     ext: &[f32],
-    ecols: usize,
     live: &[f32],
     gx: &mut [f32],
     gy: &mut [f32],
-) -> [f64; 3] {
-    let cols = live.len();
-    let win = gx.len() / cols;
+) -> [f64; 5] {
     let (three, ten) = (_mm256_set1_ps(3.0), _mm256_set1_ps(10.0));
-    let (mut a11, mut a12, mut a22) = (
-        _mm256_setzero_ps(),
-        _mm256_setzero_ps(),
-        _mm256_setzero_ps(),
-    );
+    let mut acc = [_mm256_setzero_ps(); 5];
     let e = ext.as_ptr();
-    for r in 0..win {
-        for k in (0..cols).step_by(LANES) {
-            let at = |row: usize, dc: usize| _mm256_loadu_ps(e.add((r + row) * ecols + k + dc));
-            let (p0, m0, n0) = (at(0, 0), at(0, 1), at(0, 2));
-            let (p1, n1) = (at(1, 0), at(1, 2));
-            let (p2, m2, n2) = (at(2, 0), at(2, 1), at(2, 2));
-            let s = _mm256_loadu_ps(live.as_ptr().add(k));
-            let dx = _mm256_sub_ps(_mm256_add_ps(_mm256_sub_ps(n0, p0), n2), p2);
+    let along = |row: usize, k: usize| {
+        let v = e.add(row * s.ecols + k);
+        let (p, m, n) = (
+            _mm256_loadu_ps(v),
+            _mm256_loadu_ps(v.add(1)),
+            _mm256_loadu_ps(v.add(2)),
+        );
+        let smooth = _mm256_fmadd_ps(ten, m, _mm256_mul_ps(three, _mm256_add_ps(p, n)));
+        (_mm256_sub_ps(n, p), smooth, m)
+    };
+    for k in (0..s.cols).step_by(LANES) {
+        let live = _mm256_loadu_ps(live.as_ptr().add(k));
+        let (mut r0, mut r1) = (along(0, k), along(1, k));
+        for r in 0..s.win {
+            let r2 = along(r + 2, k);
             let x = _mm256_mul_ps(
-                s,
-                _mm256_add_ps(
-                    _mm256_mul_ps(three, dx),
-                    _mm256_mul_ps(ten, _mm256_sub_ps(n1, p1)),
-                ),
+                live,
+                _mm256_fmadd_ps(ten, r1.0, _mm256_mul_ps(three, _mm256_add_ps(r0.0, r2.0))),
             );
-            let dy = _mm256_sub_ps(_mm256_sub_ps(_mm256_add_ps(p2, n2), p0), n0);
-            let y = _mm256_mul_ps(
-                s,
-                _mm256_add_ps(
-                    _mm256_mul_ps(three, dy),
-                    _mm256_mul_ps(ten, _mm256_sub_ps(m2, m0)),
-                ),
-            );
-            _mm256_storeu_ps(gx.as_mut_ptr().add(r * cols + k), x);
-            _mm256_storeu_ps(gy.as_mut_ptr().add(r * cols + k), y);
-            a11 = _mm256_add_ps(a11, _mm256_mul_ps(x, x));
-            a12 = _mm256_add_ps(a12, _mm256_mul_ps(x, y));
-            a22 = _mm256_add_ps(a22, _mm256_mul_ps(y, y));
+            let y = _mm256_mul_ps(live, _mm256_sub_ps(r2.1, r0.1));
+            let i = r1.2;
+            _mm256_storeu_ps(gx.as_mut_ptr().add(r * s.cols + k), x);
+            _mm256_storeu_ps(gy.as_mut_ptr().add(r * s.cols + k), y);
+            for (a, (u, v)) in acc.iter_mut().zip([(x, x), (x, y), (y, y), (i, x), (i, y)]) {
+                *a = _mm256_fmadd_ps(u, v, *a);
+            }
+            (r0, r1) = (r1, r2);
         }
     }
-    [a11, a12, a22].map(|a| sum(avx2::lanes(a)))
+    acc.map(|a| sum(avx2::lanes(a)))
 }
 
 /// # Safety
-/// AVX2 must be present and the sizes those [`mismatch`] checks.
+/// AVX2 must be present and the sizes those [`correlate`] checks.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn mismatch_avx2(
-    next: &Grid,
-    ext: &[f32],
-    ecols: usize,
-    gx: &[f32],
-    gy: &[f32],
-    cols: usize,
-) -> [f64; 2] {
-    let win = gx.len() / cols;
-    let w = avx2::weights(next.w);
-    let (mut b1, mut b2) = (_mm256_setzero_ps(), _mm256_setzero_ps());
-    for r in 0..win {
-        let (t, b) = next.rows(r, cols);
-        let i = ext.as_ptr().add((r + 1) * ecols + 1);
-        for k in (0..cols).step_by(LANES) {
-            let j = avx2::bilinear(t.as_ptr().add(k), b.as_ptr().add(k), &w);
-            let d = _mm256_sub_ps(j, _mm256_loadu_ps(i.add(k)));
-            b1 = _mm256_add_ps(
-                b1,
-                _mm256_mul_ps(d, _mm256_loadu_ps(gx.as_ptr().add(r * cols + k))),
-            );
-            b2 = _mm256_add_ps(
-                b2,
-                _mm256_mul_ps(d, _mm256_loadu_ps(gy.as_ptr().add(r * cols + k))),
-            );
+#[target_feature(enable = "avx2,fma")]
+unsafe fn correlate_avx2(s: &Shape, g: &Grid, gx: &[f32], gy: &[f32]) -> [f64; 2] {
+    let (wx, wy) = (avx2::weights(g.wx), avx2::weights(g.wy));
+    let p = g.plane.as_ptr().add(g.start);
+    // [row parity][derivative]: two chains of additions per sum, not one.
+    let mut acc = [[_mm256_setzero_ps(); 2]; 2];
+    let step = |acc: &mut [__m256; 2], j: __m256, at: usize| {
+        acc[0] = _mm256_fmadd_ps(j, _mm256_loadu_ps(gx.as_ptr().add(at)), acc[0]);
+        acc[1] = _mm256_fmadd_ps(j, _mm256_loadu_ps(gy.as_ptr().add(at)), acc[1]);
+    };
+    for k in (0..s.cols).step_by(LANES) {
+        let mut above = avx2::along(p.add(k), &wx);
+        let mut r = 0;
+        while r < s.win {
+            let below = avx2::along(p.add((r + 1) * g.stride + k), &wx);
+            step(&mut acc[0], avx2::across(above, below, &wy), r * s.cols + k);
+            above = below;
+            if r + 1 < s.win {
+                let below = avx2::along(p.add((r + 2) * g.stride + k), &wx);
+                step(
+                    &mut acc[1],
+                    avx2::across(above, below, &wy),
+                    (r + 1) * s.cols + k,
+                );
+                above = below;
+            }
+            r += 2;
         }
     }
-    [sum(avx2::lanes(b1)), sum(avx2::lanes(b2))]
+    [0, 1].map(|d| sum(avx2::lanes(_mm256_add_ps(acc[0][d], acc[1][d]))))
 }
 
 #[cfg(all(test, target_arch = "x86_64"))]
@@ -314,38 +367,44 @@ mod tests {
         if !has_avx2() {
             return;
         }
-        let (win, cols, ecols, stride) = (21, 24, 32, 90);
-        let plane = values(stride * 40, 1);
-        let mut live = vec![1.0f32; cols];
-        live[win..].fill(0.0);
-        for (seed, w) in [(2, [0.1, 0.2, 0.3, 0.4]), (3, [0.9, 0.05, 0.03, 0.02])] {
-            let g = Grid {
-                plane: &plane,
-                start: 3 * stride + 5,
-                stride,
-                w,
-            };
-            let (mut a, mut b) = (vec![0.0; (win + 2) * ecols], vec![0.0; (win + 2) * ecols]);
-            sample(&g, win + 2, ecols, &mut a);
-            sample_portable(&g, win + 2, ecols, &mut b);
-            assert_eq!(a, b);
-            let ext = values((win + 2) * ecols, seed);
-            let (mut gx, mut gy) = (vec![0.0; win * cols], vec![0.0; win * cols]);
-            let (mut hx, mut hy) = (vec![0.0; win * cols], vec![0.0; win * cols]);
-            let m = gradients(&ext, ecols, &live, &mut gx, &mut gy);
-            assert_eq!(m, gradients_portable(&ext, ecols, &live, &mut hx, &mut hy));
-            assert_eq!((&gx, &gy), (&hx, &hy));
-            assert!(gx
-                .chunks(cols)
-                .all(|row| row[win..].iter().all(|&v| v == 0.0)));
-            let next = Grid {
-                start: 7 * stride + 11,
-                ..g
-            };
-            assert_eq!(
-                mismatch(&next, &ext, ecols, &gx, &gy, cols),
-                mismatch_portable(&next, &ext, ecols, &gx, &gy, cols)
-            );
+        for win in [5, 15, 21] {
+            let s = Shape::new(win);
+            let stride = 90;
+            let plane = values(stride * 40, 1);
+            let mut live = vec![1.0f32 / 32.0; s.cols];
+            live[win..].fill(0.0);
+            for (seed, wx, wy) in [(2, [0.3, 0.7], [0.6, 0.4]), (3, [0.95, 0.05], [0.02, 0.98])] {
+                let g = Grid {
+                    plane: &plane,
+                    start: 3 * stride + 5,
+                    stride,
+                    wx,
+                    wy,
+                };
+                let rows = win + 2;
+                // The same finite values in the columns neither samples.
+                let (mut a, mut b) = (values(rows * s.ecols, seed), values(rows * s.ecols, seed));
+                sample(&s, &g, rows, &mut a);
+                sample_portable(&s, &g, rows, &mut b);
+                assert_eq!(a, b);
+                let n = win * s.cols;
+                let (mut gx, mut gy, mut hx, mut hy) =
+                    (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+                let m = gradients(&s, &a, &live, &mut gx, &mut gy);
+                assert_eq!(m, gradients_portable(&s, &a, &live, &mut hx, &mut hy));
+                assert_eq!((&gx, &gy), (&hx, &hy));
+                assert!(gx
+                    .chunks(s.cols)
+                    .all(|row| row[win..].iter().all(|&v| v == 0.0)));
+                let next = Grid {
+                    start: 7 * stride + 11,
+                    ..g
+                };
+                assert_eq!(
+                    correlate(&s, &next, &gx, &gy),
+                    correlate_portable(&s, &next, &gx, &gy)
+                );
+            }
         }
     }
 }

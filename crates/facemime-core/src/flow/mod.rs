@@ -14,7 +14,7 @@ mod kernels;
 use crate::border::reflect101;
 use crate::error::Result;
 use crate::invalid;
-use kernels::{Grid, LANES};
+use kernels::{Grid, Shape};
 
 /// One level's image, padded by `pad` mirrored pixels on every side.
 #[derive(Default)]
@@ -97,7 +97,8 @@ impl Level {
             plane: &self.img,
             start,
             stride: self.stride(),
-            w: [(1.0 - a) * (1.0 - b), a * (1.0 - b), (1.0 - a) * b, a * b],
+            wx: [1.0 - a, a],
+            wy: [1.0 - b, b],
         }
     }
 }
@@ -160,9 +161,7 @@ impl Pyramid {
             return invalid!("crop {crop:?} is empty or outside the {width}×{height} image");
         }
         let window = self.window;
-        // Room for the widest read: the grown window's rows of cols + LANES samples from one
-        // pixel left of the window, plus the bilinear neighbour (see `Windows`).
-        let pad = window.div_ceil(LANES) * LANES + LANES;
+        let pad = Shape::new(window).pad();
         let (mut w, mut h) = (x1 - x0, y1 - y0);
         let mut sizes = vec![(w, h)];
         while sizes.len() <= max_level && w.div_ceil(2) > window && h.div_ceil(2) > window {
@@ -249,11 +248,11 @@ pub struct LkParams {
     pub min_eigen: f64,
 }
 
-/// Window buffers of one point on one level: the image samples of the window grown by one
-/// pixel on every side, (win + 2) rows of `cols` + [`LANES`], and the derivatives on the
-/// window, win rows of `cols`, the window side rounded up to [`LANES`] (zero past the side).
+/// Window buffers of one point on one level (layout: [`Shape`]): the image samples of the
+/// window grown by one pixel on every side, (win + 2) rows, and the derivatives on the window,
+/// win rows, zero past the side.
 struct Windows {
-    win: usize,
+    shape: Shape,
     live: Vec<f32>,
     ext: Vec<f32>,
     gx: Vec<f32>,
@@ -262,15 +261,15 @@ struct Windows {
 
 impl Windows {
     fn new(win: usize) -> Self {
-        let cols = win.div_ceil(LANES) * LANES;
-        let mut live = vec![1.0 / 32.0; cols];
+        let shape = Shape::new(win);
+        let mut live = vec![1.0 / 32.0; shape.cols];
         live[win..].fill(0.0);
         Self {
-            win,
+            shape,
             live,
-            ext: vec![0.0; (win + 2) * (cols + LANES)],
-            gx: vec![0.0; win * cols],
-            gy: vec![0.0; win * cols],
+            ext: vec![0.0; (win + 2) * shape.ecols],
+            gx: vec![0.0; win * shape.cols],
+            gy: vec![0.0; win * shape.cols],
         }
     }
 }
@@ -326,8 +325,8 @@ fn track_level(
     params: &LkParams,
     bufs: &mut Windows,
 ) -> Option<[f64; 2]> {
-    let win = bufs.win;
-    let (cols, ecols) = (bufs.live.len(), bufs.live.len() + LANES);
+    let s = bufs.shape;
+    let win = s.win;
     let half = (win - 1) as f64 / 2.0;
     let corner = |q: [f64; 2]| [(q[0] - half) as f32, (q[1] - half) as f32];
     let c0 = corner(prev.to_level(p, level));
@@ -335,15 +334,16 @@ fn track_level(
         return None;
     }
     let (lp, ln) = (&prev.levels[level], &next.levels[level]);
-    // The window's image grown by one pixel, its derivatives and gradient matrix.
+    // The window's image grown by one pixel, its derivatives, gradient matrix and image
+    // against its derivatives.
     kernels::sample(
+        &s,
         &lp.grid(c0[0] - 1.0, c0[1] - 1.0),
         win + 2,
-        ecols,
         &mut bufs.ext,
     );
-    let [a11, a12, a22] =
-        kernels::gradients(&bufs.ext, ecols, &bufs.live, &mut bufs.gx, &mut bufs.gy);
+    let [a11, a12, a22, i1, i2] =
+        kernels::gradients(&s, &bufs.ext, &bufs.live, &mut bufs.gx, &mut bufs.gy);
     let det = a11 * a22 - a12 * a12;
     let min_eigen =
         (a11 + a22 - ((a11 - a22).powi(2) + 4.0 * a12 * a12).sqrt()) / (2.0 * (win * win) as f64);
@@ -358,14 +358,9 @@ fn track_level(
         if !next.inside(level, c1) {
             return None;
         }
-        let [b1, b2] = kernels::mismatch(
-            &ln.grid(c1[0], c1[1]),
-            &bufs.ext,
-            ecols,
-            &bufs.gx,
-            &bufs.gy,
-            cols,
-        );
+        // The mismatch Σ(J − I)·∇I, J the next level's samples at the estimate.
+        let [j1, j2] = kernels::correlate(&s, &ln.grid(c1[0], c1[1]), &bufs.gx, &bufs.gy);
+        let (b1, b2) = (j1 - i1, j2 - i2);
         let step = [(a12 * b2 - a22 * b1) / det, (a12 * b1 - a11 * b2) / det];
         q = [q[0] + step[0], q[1] + step[1]];
         if step[0] * step[0] + step[1] * step[1] <= params.epsilon * params.epsilon {
