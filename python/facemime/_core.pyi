@@ -56,6 +56,7 @@ class FlowFrames:
         self,
         points: npt.NDArray[np.float64],
         extra: npt.NDArray[np.float64],
+        extra_levels: int,
         limit: float,
         min_points: int,
         rounds: int,

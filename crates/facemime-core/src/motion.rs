@@ -6,7 +6,7 @@
 //! z = x + iy; as a 2×3 matrix it is [[Re a, −Im a, Re b], [Im a, Re a, Im b]].
 
 use crate::error::Result;
-use crate::flow::{lucas_kanade, LkParams, Pyramid};
+use crate::flow::{lucas_kanade, lucas_kanade_from, LkParams, Pyramid};
 
 /// Tukey's biweight constant (95 % efficiency on Gaussian residuals).
 const TUKEY: f64 = 4.685;
@@ -166,27 +166,60 @@ pub struct RigidStep {
     pub extra: Vec<Option<[f64; 2]>>,
 }
 
-/// The head's motion from `prev`'s frame to `next`'s: the rigid `points` (pixels of the
-/// previous frame) followed by the Lucas-Kanade flow forwards and back; those that come back
-/// within `limit` px of where they started are fitted by [`robust_similarity`] (inliers within
-/// `limit` px, at most `rounds` rounds), which counts when at least `min_points` passed the
-/// check and fit it. The `extra` points are followed and checked alike (not fitted).
-#[allow(clippy::too_many_arguments)]
-pub fn follow_rigid(
+/// The 2×3 similarity `m` applied to `p`.
+fn apply(m: &[[f64; 3]; 2], p: [f64; 2]) -> [f64; 2] {
+    [
+        m[0][0] * p[0] + m[0][1] * p[1] + m[0][2],
+        m[1][0] * p[0] + m[1][1] * p[1] + m[1][2],
+    ]
+}
+
+/// The inverse of a 2×3 similarity (z ↦ a·z + b inverts to z ↦ (z − b)/a).
+fn invert(m: &[[f64; 3]; 2]) -> [[f64; 3]; 2] {
+    let (a, b) = (
+        Complex::of([m[0][0], m[1][0]]),
+        Complex::of([m[0][2], m[1][2]]),
+    );
+    let n = a.re * a.re + a.im * a.im;
+    let inv = Complex {
+        re: a.re / n,
+        im: -a.im / n,
+    };
+    let c = inv.mul(b).scale(-1.0);
+    [[inv.re, -inv.im, c.re], [inv.im, inv.re, c.im]]
+}
+
+/// Each of `start` (pixels of `prev`'s frame) followed into `next`'s frame and back: its
+/// position there, None where the flow failed or came back more than `limit` px from where it
+/// started. With a `guide` (a similarity from `prev`'s frame to `next`'s, levels): the flow
+/// starts where the similarity carries each point (its inverse on the way back) and runs
+/// through that many levels above the frame at most.
+fn forward_backward(
     prev: &Pyramid,
     next: &Pyramid,
-    points: &[[f64; 2]],
-    extra: &[[f64; 2]],
+    start: &[[f64; 2]],
+    guide: Option<(&[[f64; 3]; 2], usize)>,
     lk: &LkParams,
     limit: f64,
-    min_points: usize,
-    rounds: usize,
-) -> Result<RigidStep> {
-    let start: Vec<[f64; 2]> = points.iter().chain(extra).copied().collect();
-    let there = lucas_kanade(prev, next, &start, lk)?;
-    let ahead: Vec<[f64; 2]> = there.iter().map(|q| q.unwrap_or([f64::NAN; 2])).collect();
-    let back = lucas_kanade(next, prev, &ahead, lk)?;
-    let checked: Vec<Option<[f64; 2]>> = (0..start.len())
+) -> Result<Vec<Option<[f64; 2]>>> {
+    let (there, back) = match guide {
+        None => {
+            let there = lucas_kanade(prev, next, start, lk)?;
+            let ahead: Vec<[f64; 2]> = there.iter().map(|q| q.unwrap_or([f64::NAN; 2])).collect();
+            let back = lucas_kanade(next, prev, &ahead, lk)?;
+            (there, back)
+        }
+        Some((m, levels)) => {
+            let guess: Vec<[f64; 2]> = start.iter().map(|&p| apply(m, p)).collect();
+            let there = lucas_kanade_from(prev, next, start, &guess, levels, lk)?;
+            let ahead: Vec<[f64; 2]> = there.iter().map(|q| q.unwrap_or([f64::NAN; 2])).collect();
+            let inv = invert(m);
+            let guess: Vec<[f64; 2]> = ahead.iter().map(|&q| apply(&inv, q)).collect();
+            let back = lucas_kanade_from(next, prev, &ahead, &guess, levels, lk)?;
+            (there, back)
+        }
+    };
+    Ok((0..start.len())
         .map(|i| match (there[i], back[i]) {
             (Some(q), Some(b)) => {
                 let d = [b[0] - start[i][0], b[1] - start[i][1]];
@@ -194,17 +227,41 @@ pub fn follow_rigid(
             }
             _ => None,
         })
+        .collect())
+}
+
+/// The head's motion from `prev`'s frame to `next`'s: the rigid `points` (pixels of the
+/// previous frame) followed by the Lucas-Kanade flow forwards and back; those that come back
+/// within `limit` px of where they started are fitted by [`robust_similarity`] (inliers within
+/// `limit` px, at most `rounds` rounds), which counts when at least `min_points` passed the
+/// check and fit it. The `extra` points are followed and checked alike (not fitted). With a
+/// similarity, their flow starts where it carries them and runs through `extra_levels` levels
+/// above the frame at most (each level costs as much as the frame's own); those that fail the
+/// check then, or all of them without a similarity, are followed like the rigid points.
+#[allow(clippy::too_many_arguments)]
+pub fn follow_rigid(
+    prev: &Pyramid,
+    next: &Pyramid,
+    points: &[[f64; 2]],
+    extra: &[[f64; 2]],
+    extra_levels: usize,
+    lk: &LkParams,
+    limit: f64,
+    min_points: usize,
+    rounds: usize,
+) -> Result<RigidStep> {
+    let checked = forward_backward(prev, next, points, None, lk, limit)?;
+    let good: Vec<usize> = (0..points.len())
+        .filter(|&i| checked[i].is_some())
         .collect();
-    let n = points.len();
-    let good: Vec<usize> = (0..n).filter(|&i| checked[i].is_some()).collect();
     let mut step = RigidStep {
         similarity: None,
         kept: Vec::new(),
         moved: Vec::new(),
-        extra: checked[n..].to_vec(),
+        extra: Vec::new(),
     };
     if good.len() >= min_points {
-        let src: Vec<[f64; 2]> = good.iter().map(|&i| start[i]).collect();
+        let src: Vec<[f64; 2]> = good.iter().map(|&i| points[i]).collect();
         let dst: Vec<[f64; 2]> = good.iter().map(|&i| checked[i].expect("checked")).collect();
         let (m, inliers) = robust_similarity(&src, &dst, limit, rounds);
         if inliers.iter().filter(|&&k| k).count() >= min_points {
@@ -213,6 +270,18 @@ pub fn follow_rigid(
                 step.kept.push(good[j]);
                 step.moved.push(dst[j]);
             }
+        }
+    }
+    let guide = step.similarity.as_ref().map(|m| (m, extra_levels));
+    step.extra = forward_backward(prev, next, extra, guide, lk, limit)?;
+    if guide.is_some() {
+        let missed: Vec<usize> = (0..extra.len())
+            .filter(|&i| step.extra[i].is_none())
+            .collect();
+        let again: Vec<[f64; 2]> = missed.iter().map(|&i| extra[i]).collect();
+        let found = forward_backward(prev, next, &again, None, lk, limit)?;
+        for (&i, f) in missed.iter().zip(found) {
+            step.extra[i] = f;
         }
     }
     Ok(step)
@@ -237,13 +306,6 @@ pub fn inside_quads(points: &[[f64; 2]], quads: &[[[f64; 2]; 4]]) -> Vec<bool> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn apply(m: &[[f64; 3]; 2], p: [f64; 2]) -> [f64; 2] {
-        [
-            m[0][0] * p[0] + m[0][1] * p[1] + m[0][2],
-            m[1][0] * p[0] + m[1][1] * p[1] + m[1][2],
-        ]
-    }
 
     #[test]
     fn recovers_an_exact_similarity_and_rejects_gross_outliers() {
@@ -288,7 +350,7 @@ mod tests {
             .map(|k| [30.0 + 6.0 * (k % 3) as f64, 30.0 + 6.0 * (k / 3) as f64])
             .collect();
         let extra = [[48.0, 50.0], [f64::NAN, 3.0], [-500.0, 40.0]];
-        let step = follow_rigid(&pa, &pb, &points, &extra, &PARAMS, 1.0, 6, 10).unwrap();
+        let step = follow_rigid(&pa, &pb, &points, &extra, 1, &PARAMS, 1.0, 6, 10).unwrap();
         let m = step.similarity.expect("a similarity");
         for p in &points {
             let q = apply(&m, *p);
@@ -299,8 +361,59 @@ mod tests {
         assert!((e[0] - 49.5).abs() < 0.05 && (e[1] - 49.5).abs() < 0.05);
         assert_eq!(step.extra[1..], [None, None]);
         // Fewer points than the minimum: no similarity, nothing kept.
-        let few = follow_rigid(&pa, &pb, &points[..5], &[], &PARAMS, 1.0, 6, 10).unwrap();
+        let few = follow_rigid(&pa, &pb, &points[..5], &[], 1, &PARAMS, 1.0, 6, 10).unwrap();
         assert_eq!((few.similarity, few.kept.len()), (None, 0));
+    }
+
+    #[test]
+    fn extra_points_start_where_the_head_moved_them_and_are_looked_for_wider_if_that_fails() {
+        use crate::flow::tests::{pyramid, texture, PARAMS};
+        let (w, h) = (384, 256);
+        // The head moves by (30, -20); inside a 140 px square on the left, the image moves by
+        // (-30, -20) instead, beyond the frame level's reach from where the head puts it.
+        let a = texture(w, h, 0.0, 0.0);
+        let mut b = texture(w, h, 30.0, -20.0);
+        let part = texture(w, h, -30.0, -20.0);
+        for y in 50..190 {
+            for x in 0..140 {
+                b[y * w + x] = part[y * w + x];
+            }
+        }
+        let (pa, pb) = (pyramid(&a, w, h), pyramid(&b, w, h));
+        let points: Vec<[f64; 2]> = (0..12)
+            .map(|k| [220.0 + 12.0 * (k % 4) as f64, 120.0 + 15.0 * (k / 4) as f64])
+            .collect();
+        let extra = [[240.0, 150.0], [70.0, 130.0]];
+        let step = follow_rigid(&pa, &pb, &points, &extra, 0, &PARAMS, 1.0, 6, 10).unwrap();
+        let m = step.similarity.expect("a similarity");
+        assert!(
+            (m[0][2] - 30.0).abs() < 0.1 && (m[1][2] + 20.0).abs() < 0.1,
+            "{m:?}"
+        );
+        let off = |q: Option<[f64; 2]>, want: [f64; 2]| {
+            q.map_or(f64::INFINITY, |q| {
+                (q[0] - want[0]).abs().max((q[1] - want[1]).abs())
+            })
+        };
+        // On the frame's level only, from where the head moved it.
+        assert!(
+            off(step.extra[0], [270.0, 130.0]) < 0.05,
+            "{:?}",
+            step.extra[0]
+        );
+        // Found again through every level.
+        assert!(
+            off(step.extra[1], [40.0, 110.0]) < 0.1,
+            "{:?}",
+            step.extra[1]
+        );
+        // On the frame's level alone, the first is not found from where it was, nor the
+        // second from where the head moved it.
+        let alone = crate::flow::lucas_kanade_from(&pa, &pb, &extra, &extra, 0, &PARAMS).unwrap();
+        assert!(off(alone[0], [270.0, 130.0]) > 1.0, "{:?}", alone[0]);
+        let moved = [apply(&m, extra[1])];
+        let guided = crate::flow::lucas_kanade_from(&pa, &pb, &extra[1..], &moved, 0, &PARAMS);
+        assert!(off(guided.unwrap()[0], [40.0, 110.0]) > 1.0);
     }
 
     #[test]

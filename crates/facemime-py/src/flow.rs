@@ -114,17 +114,19 @@ impl FlowFrames {
     }
 
     /// points: (N, 2) rigid points and extra: (M, 2) other points, pixels in the previous
-    /// frame; limit: forward-backward and fit tolerance (px); min_points: fewest points for a
+    /// frame; extra_levels: pyramid levels above the frame at most for the extra points, whose
+    /// flow starts where the head's similarity carries them when there is one; limit: forward-backward and fit tolerance (px); min_points: fewest points for a
     /// similarity; rounds: its fit's rounds at most. Returns (the 2×3 similarity or None, the
     /// (K,) indices of the rigid points kept, their (K, 2) positions in the current frame, the
     /// extra points' (M, 2) positions, NaN where the flow failed or its check).
-    #[pyo3(signature = (points, extra, limit, min_points, rounds, iterations, epsilon, min_eigen))]
+    #[pyo3(signature = (points, extra, extra_levels, limit, min_points, rounds, iterations, epsilon, min_eigen))]
     #[allow(clippy::too_many_arguments)]
     fn follow<'py>(
         &self,
         py: Python<'py>,
         points: PyReadonlyArray2<f64>,
         extra: PyReadonlyArray2<f64>,
+        extra_levels: usize,
         limit: f64,
         min_points: usize,
         rounds: usize,
@@ -141,7 +143,19 @@ impl FlowFrames {
         };
         let (prev, cur) = (&self.prev, &self.cur);
         let step = py
-            .detach(|| motion::follow_rigid(prev, cur, &pts, &more, &lk, limit, min_points, rounds))
+            .detach(|| {
+                motion::follow_rigid(
+                    prev,
+                    cur,
+                    &pts,
+                    &more,
+                    extra_levels,
+                    &lk,
+                    limit,
+                    min_points,
+                    rounds,
+                )
+            })
             .map_err(CoreErr)?;
         Ok((
             step.similarity.map(|m| array(py, &m)),

@@ -284,6 +284,23 @@ pub fn lucas_kanade(
     points: &[[f64; 2]],
     params: &LkParams,
 ) -> Result<Vec<Option<[f64; 2]>>> {
+    lucas_kanade_from(prev, next, points, points, usize::MAX, params)
+}
+
+/// [`lucas_kanade`] from a first estimate per point, `guesses` (frame pixels in `next`'s frame,
+/// as many as `points`), through levels `top`..=0 at most: a good guess needs fewer levels,
+/// each of which costs as much as the frame's own.
+pub fn lucas_kanade_from(
+    prev: &Pyramid,
+    next: &Pyramid,
+    points: &[[f64; 2]],
+    guesses: &[[f64; 2]],
+    top: usize,
+    params: &LkParams,
+) -> Result<Vec<Option<[f64; 2]>>> {
+    if guesses.len() != points.len() {
+        return invalid!("{} guesses for {} points", guesses.len(), points.len());
+    }
     if prev.window != next.window {
         return invalid!(
             "the pyramids have different windows ({} and {})",
@@ -295,12 +312,12 @@ pub fn lucas_kanade(
         return invalid!("the flow needs two built pyramids");
     }
     let mut bufs = Windows::new(prev.window);
-    let top = prev.max_level().min(next.max_level());
-    let follow = |&p: &[f64; 2]| {
-        if !(p[0].is_finite() && p[1].is_finite()) {
+    let top = prev.max_level().min(next.max_level()).min(top);
+    let follow = |(&p, &g): (&[f64; 2], &[f64; 2])| {
+        if !(p[0].is_finite() && p[1].is_finite() && g[0].is_finite() && g[1].is_finite()) {
             return None;
         }
-        let mut guess = p;
+        let mut guess = g;
         let mut ok = true;
         for level in (0..=top).rev() {
             match track_level(prev, next, level, p, guess, params, &mut bufs) {
@@ -311,7 +328,7 @@ pub fn lucas_kanade(
         }
         ok.then_some(guess)
     };
-    Ok(points.iter().map(follow).collect())
+    Ok(points.iter().zip(guesses).map(follow).collect())
 }
 
 /// One level of the flow of frame point `p` from its current estimate `guess` (frame pixels).
