@@ -155,18 +155,19 @@ fn gaussian(sigma: f64) -> Vec<f32> {
     taps.iter().map(|t| (t / sum) as f32).collect()
 }
 
-/// `out[i] = Σ_t taps[t] · rows[t][i]`, summed in tap order, [`BLOCK`] outputs at a time so
-/// that the sums stay in registers; a ragged end is one more block overlapping the last one
-/// (every output is the same sum whichever block computes it).
+/// `out[i] = Σ_t taps[t] · base[starts[t] + i]`, summed in tap order, [`BLOCK`] outputs at a
+/// time so that the sums stay in registers; a ragged end is one more block overlapping the last
+/// one (every output is the same sum whichever block computes it).
 #[inline(always)]
-fn weighted(out: &mut [f32], taps: &[f32], rows: &[&[f32]]) {
+fn weighted(out: &mut [f32], taps: &[f32], base: &[f32], starts: &[usize]) {
     let n = out.len();
+    let row = |t: usize| &base[starts[t]..][..n];
     let mut x = 0;
     while x < n && n >= BLOCK {
         x = x.min(n - BLOCK);
         let mut acc = [0.0f32; BLOCK];
-        for (&k, row) in taps.iter().zip(rows) {
-            for (a, s) in acc.iter_mut().zip(&row[x..x + BLOCK]) {
+        for (t, &k) in taps.iter().enumerate() {
+            for (a, s) in acc.iter_mut().zip(&row(t)[x..x + BLOCK]) {
                 *a += k * s;
             }
         }
@@ -176,8 +177,8 @@ fn weighted(out: &mut [f32], taps: &[f32], rows: &[&[f32]]) {
     for (i, o) in out.iter_mut().enumerate().skip(x) {
         *o = taps
             .iter()
-            .zip(rows)
-            .fold(0.0, |a, (&k, row)| a + k * row[i]);
+            .enumerate()
+            .fold(0.0, |a, (t, &k)| a + k * row(t)[i]);
     }
 }
 
@@ -185,8 +186,7 @@ fn weighted(out: &mut [f32], taps: &[f32], rows: &[&[f32]]) {
 const BLOCK: usize = 64;
 
 /// Smooths the (h, w) plane `img` in place with the separable `taps`, in the spans `smoothed`
-/// (reading the spans `across`, which must hold all that they reach); `pad` and `rows` are
-/// scratch.
+/// (reading the spans `across`, which must hold all that they reach).
 #[inline(always)]
 fn blur(
     img: &mut [f32],
@@ -194,30 +194,30 @@ fn blur(
     taps: &[f32],
     smoothed: &[Span],
     across: &[Span],
-    pad: &mut Vec<f32>,
-    rows: &mut Vec<f32>,
+    scratch: &mut BlurScratch,
 ) {
+    let BlurScratch { pad, rows, starts } = scratch;
     let (r, h) = (taps.len() / 2, smoothed.len());
     rows.resize(w * h, 0.0);
     for (y, &[c0, c1]) in across.iter().enumerate().filter(|(_, s)| s[0] < s[1]) {
         let line = &img[y * w..][..w];
         let n = c1 - c0;
+        // pad[i] is column c0 + i − r: those inside the region copied, the others mirrored.
         pad.resize(n + 2 * r, 0.0);
-        if c0 >= r && c1 + r <= w {
-            pad.copy_from_slice(&line[c0 - r..c1 + r]);
-        } else {
-            for (i, v) in pad.iter_mut().enumerate() {
-                *v = line[reflect101((c0 + i) as isize - r as isize, w)];
-            }
+        let (first, last) = (r.saturating_sub(c0), (n + 2 * r).min(w + r - c0));
+        pad[first..last].copy_from_slice(&line[c0 + first - r..c0 + last - r]);
+        for i in (0..first).chain(last..n + 2 * r) {
+            pad[i] = line[reflect101((c0 + i) as isize - r as isize, w)];
         }
-        let shifted: Vec<&[f32]> = (0..taps.len()).map(|t| &pad[t..][..n]).collect();
-        weighted(&mut rows[y * w + c0..][..n], taps, &shifted);
+        starts.clear();
+        starts.extend(0..taps.len());
+        weighted(&mut rows[y * w + c0..][..n], taps, pad, starts);
     }
     for (y, &[c0, c1]) in smoothed.iter().enumerate().filter(|(_, s)| s[0] < s[1]) {
-        let around: Vec<&[f32]> = (0..taps.len())
-            .map(|t| &rows[reflect101((y + t) as isize - r as isize, h) * w + c0..][..c1 - c0])
-            .collect();
-        weighted(&mut img[y * w + c0..][..c1 - c0], taps, &around);
+        starts.clear();
+        starts
+            .extend((0..taps.len()).map(|t| reflect101((y + t) as isize - r as isize, h) * w + c0));
+        weighted(&mut img[y * w + c0..][..c1 - c0], taps, rows, starts);
     }
 }
 
@@ -258,8 +258,15 @@ struct Scratch {
     luma: Vec<f32>,
     chroma: Vec<f32>,
     prev_luma: Vec<f32>,
+    blur: BlurScratch,
+}
+
+/// [`blur`]'s buffers: a mirrored row, the rows blurred along, the rows a sum reads.
+#[derive(Default)]
+struct BlurScratch {
     pad: Vec<f32>,
     rows: Vec<f32>,
+    starts: Vec<usize>,
 }
 
 thread_local! {
@@ -288,16 +295,15 @@ fn build(
         luma,
         chroma,
         prev_luma,
-        pad,
-        rows,
+        blur: buffers,
     } = &mut scratch;
     planes(frame, region, &converted, luma, Some(chroma));
     for plane in [&mut *luma, &mut *chroma] {
-        blur(plane, w, &taps, &smoothed, &across, pad, rows);
+        blur(plane, w, &taps, &smoothed, &across, buffers);
     }
     if let Some(p) = prev {
         planes(p, region, &converted, prev_luma, None);
-        blur(prev_luma, w, &taps, &smoothed, &across, pad, rows);
+        blur(prev_luma, w, &taps, &smoothed, &across, buffers);
     }
     let (luma, chroma) = (&*luma, &*chroma);
     let before = if prev.is_some() { &*prev_luma } else { luma };
