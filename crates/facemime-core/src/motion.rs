@@ -6,7 +6,7 @@
 //! z = x + iy; as a 2×3 matrix it is [[Re a, −Im a, Re b], [Im a, Re a, Im b]].
 
 use crate::error::Result;
-use crate::flow::{lucas_kanade, lucas_kanade_from, LkParams, Pyramid};
+use crate::flow::{lucas_kanade_from, LkParams, Pyramid};
 
 /// Tukey's biweight constant (95 % efficiency on Gaussian residuals).
 const TUKEY: f64 = 4.685;
@@ -189,36 +189,28 @@ fn invert(m: &[[f64; 3]; 2]) -> [[f64; 3]; 2] {
     [[inv.re, -inv.im, c.re], [inv.im, inv.re, c.im]]
 }
 
+/// The 2×3 identity.
+const IDENTITY: [[f64; 3]; 2] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+
 /// Each of `start` (pixels of `prev`'s frame) followed into `next`'s frame and back: its
 /// position there, None where the flow failed or came back more than `limit` px from where it
-/// started. With a `guide` (a similarity from `prev`'s frame to `next`'s, levels): the flow
-/// starts where the similarity carries each point (its inverse on the way back) and runs
-/// through that many levels above the frame at most.
+/// started. The flow starts where the similarity `m` (from `prev`'s frame to `next`'s) carries
+/// each point, its inverse on the way back, and runs through `levels` levels above the frame
+/// at most.
 fn forward_backward(
     prev: &Pyramid,
     next: &Pyramid,
     start: &[[f64; 2]],
-    guide: Option<(&[[f64; 3]; 2], usize)>,
+    (m, levels): (&[[f64; 3]; 2], usize),
     lk: &LkParams,
     limit: f64,
 ) -> Result<Vec<Option<[f64; 2]>>> {
-    let (there, back) = match guide {
-        None => {
-            let there = lucas_kanade(prev, next, start, lk)?;
-            let ahead: Vec<[f64; 2]> = there.iter().map(|q| q.unwrap_or([f64::NAN; 2])).collect();
-            let back = lucas_kanade(next, prev, &ahead, lk)?;
-            (there, back)
-        }
-        Some((m, levels)) => {
-            let guess: Vec<[f64; 2]> = start.iter().map(|&p| apply(m, p)).collect();
-            let there = lucas_kanade_from(prev, next, start, &guess, levels, lk)?;
-            let ahead: Vec<[f64; 2]> = there.iter().map(|q| q.unwrap_or([f64::NAN; 2])).collect();
-            let inv = invert(m);
-            let guess: Vec<[f64; 2]> = ahead.iter().map(|&q| apply(&inv, q)).collect();
-            let back = lucas_kanade_from(next, prev, &ahead, &guess, levels, lk)?;
-            (there, back)
-        }
-    };
+    let guess: Vec<[f64; 2]> = start.iter().map(|&p| apply(m, p)).collect();
+    let there = lucas_kanade_from(prev, next, start, &guess, levels, lk)?;
+    let ahead: Vec<[f64; 2]> = there.iter().map(|q| q.unwrap_or([f64::NAN; 2])).collect();
+    let inv = invert(m);
+    let guess: Vec<[f64; 2]> = ahead.iter().map(|&q| apply(&inv, q)).collect();
+    let back = lucas_kanade_from(next, prev, &ahead, &guess, levels, lk)?;
     Ok((0..start.len())
         .map(|i| match (there[i], back[i]) {
             (Some(q), Some(b)) => {
@@ -250,7 +242,9 @@ pub fn follow_rigid(
     min_points: usize,
     rounds: usize,
 ) -> Result<RigidStep> {
-    let checked = forward_backward(prev, next, points, None, lk, limit)?;
+    // From where they were, through every level.
+    let unguided = (&IDENTITY, usize::MAX);
+    let checked = forward_backward(prev, next, points, unguided, lk, limit)?;
     let good: Vec<usize> = (0..points.len())
         .filter(|&i| checked[i].is_some())
         .collect();
@@ -272,18 +266,19 @@ pub fn follow_rigid(
             }
         }
     }
-    let guide = step.similarity.as_ref().map(|m| (m, extra_levels));
-    step.extra = forward_backward(prev, next, extra, guide, lk, limit)?;
-    if guide.is_some() {
-        let missed: Vec<usize> = (0..extra.len())
-            .filter(|&i| step.extra[i].is_none())
-            .collect();
-        let again: Vec<[f64; 2]> = missed.iter().map(|&i| extra[i]).collect();
-        let found = forward_backward(prev, next, &again, None, lk, limit)?;
-        for (&i, f) in missed.iter().zip(found) {
-            step.extra[i] = f;
+    step.extra = match &step.similarity {
+        None => forward_backward(prev, next, extra, unguided, lk, limit)?,
+        Some(m) => {
+            let mut found = forward_backward(prev, next, extra, (m, extra_levels), lk, limit)?;
+            let missed: Vec<usize> = (0..extra.len()).filter(|&i| found[i].is_none()).collect();
+            let again: Vec<[f64; 2]> = missed.iter().map(|&i| extra[i]).collect();
+            let wider = forward_backward(prev, next, &again, unguided, lk, limit)?;
+            for (&i, f) in missed.iter().zip(wider) {
+                found[i] = f;
+            }
+            found
         }
-    }
+    };
     Ok(step)
 }
 
