@@ -115,8 +115,9 @@ impl FlowFrames {
 
     /// points: (N, 2) rigid points and extra: (M, 2) other points, pixels in the previous
     /// frame; extra_levels: pyramid levels above the frame at most for the extra points, whose
-    /// flow starts where the head's similarity carries them when there is one; limit: forward-backward and fit tolerance (px); min_points: fewest points for a
-    /// similarity; rounds: its fit's rounds at most. Returns (the 2×3 similarity or None, the
+    /// flow starts where the head's similarity carries them when there is one; limit:
+    /// forward-backward and fit tolerance (px); min_points: fewest points for a similarity;
+    /// rounds: its fit's rounds at most. Returns (the 2×3 similarity or None, the
     /// (K,) indices of the rigid points kept, their (K, 2) positions in the current frame, the
     /// extra points' (M, 2) positions, NaN where the flow failed or its check).
     #[pyo3(signature = (points, extra, extra_levels, limit, min_points, rounds, iterations, epsilon, min_eigen))]
