@@ -52,5 +52,5 @@ class FrameFlow:
         that then fail the check, like the rigid points). Returns (the 2×3 similarity,
         or None; the (K,) indices of the rigid points that fit it and their (K, 2) positions now;
         the extra points' (M, 2) positions now, NaN where the flow or its check failed)."""
-        return self._frames.follow(as_points(points), as_points(extra), int(extra_levels), float(limit), int(min_points), int(rounds),
-                                   ITERATIONS, EPSILON, MIN_EIGEN)
+        return self._frames.follow(as_points(points), as_points(extra), int(extra_levels), float(limit),
+                                   int(min_points), int(rounds), ITERATIONS, EPSILON, MIN_EIGEN)

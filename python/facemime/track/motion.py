@@ -203,7 +203,8 @@ class HeadMotion:
         moved = None if extra is None else np.full((len(extra_pts), 2), np.nan)
         self._flow.push(gray, self._crop_box(gray.shape, extra_pts))
         if len(self.points) >= MIN_POINTS:
-            fit, kept, dst, followed = self._flow.follow(self.points, extra_pts, GUIDED_LEVELS, FB_LIMIT, MIN_POINTS, FIT_ROUNDS)
+            fit, kept, dst, followed = self._flow.follow(self.points, extra_pts, GUIDED_LEVELS, FB_LIMIT, MIN_POINTS,
+                                                         FIT_ROUNDS)
             if moved is not None:
                 moved = followed
             if fit is not None:
