@@ -8,9 +8,12 @@ The tracker is the default one: head-motion compensation plus all eight curves (
 segment, at most 15 iterations.
 
 Each measurement is run ``--repeats`` times, the runs of the three alternating, and the fastest
-run of each counts (on a shared machine the slower runs measure the neighbours).
+run of each counts (on a shared machine the slower runs measure the neighbours). With
+``--stages``, one more run of the tracker times its native stages (optical flow, pyramid, image
+field, snake solver, gray conversion, corner detection) by wrapping their calls, and prints where
+a frame's time goes.
 
-    python benchmarks/track.py [--data ../shared/data] [--frames 200] [--repeats 3]
+    python benchmarks/track.py [--data ../shared/data] [--frames 200] [--repeats 3] [--stages]
 
 The last line of output is one JSON object with at least ``fps_tracker`` and ``fps_snakes``.
 """
@@ -25,12 +28,16 @@ import argparse
 import json
 import platform
 import time
+from collections import defaultdict
+from collections.abc import Callable
 from pathlib import Path
+from unittest import mock
 
 import av
 import cv2
 import numpy as np
 
+import facemime.track.tracker as tracker_module
 from facemime.track import Tracker
 from facemime.track.contours import CONTOUR_NAMES, from_face_mesh
 
@@ -54,6 +61,52 @@ class TimingSolver:
 
     def evaluate(self, *args):
         return self.solver.evaluate(*args)
+
+
+class StageClock:
+    """Seconds spent in each labelled stage, added up by the calls it wraps."""
+
+    def __init__(self) -> None:
+        self.seconds: dict[str, float] = defaultdict(float)
+
+    def wrap(self, label: str, fn: Callable) -> Callable:
+        def timed(*args, **kwargs):
+            t0 = time.perf_counter()
+            try:
+                return fn(*args, **kwargs)
+            finally:
+                self.seconds[label] += time.perf_counter() - t0
+        return timed
+
+
+class TimedMethods:
+    """Forwards to ``target``, timing the methods named in ``labels`` under their labels (for the
+    core's classes, whose instances take no new attributes)."""
+
+    def __init__(self, target, clock: StageClock, labels: dict[str, str]):
+        self._target, self._clock, self._labels = target, clock, labels
+
+    def __getattr__(self, name: str):
+        attr = getattr(self._target, name)
+        return self._clock.wrap(self._labels[name], attr) if name in self._labels else attr
+
+
+def stage_seconds(frames: list[np.ndarray], init: dict[str, np.ndarray], clock: StageClock) -> float:
+    """Seconds the default tracker took on frames 1.., its native stages timed into ``clock``."""
+    with mock.patch.object(cv2, "cvtColor", clock.wrap("gray conversion", cv2.cvtColor)), \
+            mock.patch.object(cv2, "goodFeaturesToTrack", clock.wrap("corner detection", cv2.goodFeaturesToTrack)), \
+            mock.patch.object(tracker_module, "build_field", clock.wrap("image field", tracker_module.build_field)):
+        tracker = Tracker(frames[0], init)
+        clock.seconds.clear()  # the first frame's set-up is not a frame's work
+        tracker._solver = TimedMethods(tracker._solver, clock, {"solve": "snake solver",  # noqa: SLF001
+                                                                "evaluate": "snake solver"})
+        flow = tracker._motion._flow  # noqa: SLF001 - benchmark instrumentation
+        flow._frames = TimedMethods(flow._frames, clock, {"push": "pyramid", "follow": "optical flow",  # noqa: SLF001
+                                                          "track": "optical flow"})
+        t0 = time.perf_counter()
+        for frame in frames[1:]:
+            tracker.update(frame)
+        return time.perf_counter() - t0
 
 
 def decode(path: Path, limit: int) -> tuple[list[np.ndarray], float]:
@@ -99,11 +152,13 @@ def main() -> None:
     ap.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data")
     ap.add_argument("--frames", type=int, default=200, help="frames per video at most")
     ap.add_argument("--repeats", type=int, default=3, help="runs of each measurement; the fastest counts")
+    ap.add_argument("--stages", action="store_true", help="also time the tracker's native stages")
     args = ap.parse_args()
     if args.repeats < 1:
         ap.error("--repeats must be at least 1")
     cv2.setNumThreads(1)
     totals = {"frames": 0, "decode": 0.0, "tracker": 0.0, "snakes": 0.0, "lk": 0.0, "iterations": 0}
+    stages, staged = defaultdict(float), 0.0  # with --stages: seconds per stage, and in all
     for video in VIDEOS:
         path = args.data / "video" / f"{video}.mp4"
         frames, _ = decode(path, args.frames)
@@ -118,6 +173,11 @@ def main() -> None:
             best["tracker"], best["snakes"] = min(best["tracker"], track_s), min(best["snakes"], snake_s)
             best["lk"] = min(best["lk"], lk_seconds(frames, pts))
         totals["iterations"] += iterations  # the same every run: the tracker is deterministic
+        if args.stages:
+            clock = StageClock()
+            staged += stage_seconds(frames, init, clock)
+            for label, seconds in clock.seconds.items():
+                stages[label] += seconds
         n = len(frames) - 1
         print(f"{video}: {n} frames  decode {len(frames) / best['decode']:7.0f} fps  tracker {n / best['tracker']:6.0f} fps  "
               f"snakes alone {n / best['snakes']:7.0f} fps  LK+FB {n / best['lk']:6.0f} fps")
@@ -141,6 +201,12 @@ def main() -> None:
     print(f"all: tracker {result['fps_tracker']:.0f} fps ({result['tracker_vs_decode']:.2f}x decoding, "
           f"{result['tracker_vs_lk']:.2f}x LK), snakes alone {result['fps_snakes']:.0f} fps, "
           f"{result['mean_iterations']:.1f} iterations per frame")
+    if args.stages:
+        ms = {label: 1e3 * seconds / n for label, seconds in sorted(stages.items(), key=lambda kv: -kv[1])}
+        ms["the rest (Python, smaller native calls)"] = 1e3 * staged / n - sum(ms.values())
+        result["stages_ms"] = ms
+        print(f"where a frame's {1e3 * staged / n:.2f} ms go (one run, calls timed): "
+              + ", ".join(f"{label} {v:.2f}" for label, v in ms.items()))
     print(json.dumps(result))
 
 
