@@ -45,24 +45,6 @@ VIDEOS = ("lp_d0", "lp_d3", "lp_d12")
 ROOT = Path(__file__).resolve().parents[1]
 
 
-class TimingSolver:
-    """Forwards to the real solver and adds up the seconds and iterations of its solve calls
-    (keeping no arguments: holding every frame's image field would slow the tracker down)."""
-
-    def __init__(self, solver):
-        self.solver, self.seconds, self.iterations = solver, 0.0, 0
-
-    def solve(self, *args):
-        t0 = time.perf_counter()
-        out = self.solver.solve(*args)
-        self.seconds += time.perf_counter() - t0
-        self.iterations += out[1]
-        return out
-
-    def evaluate(self, *args):
-        return self.solver.evaluate(*args)
-
-
 class StageClock:
     """Seconds spent in each labelled stage, added up by the calls it wraps."""
 
@@ -81,7 +63,8 @@ class StageClock:
 
 class TimedMethods:
     """Forwards to ``target``, timing the methods named in ``labels`` under their labels (for the
-    core's classes, whose instances take no new attributes)."""
+    core's classes, whose instances take no new attributes; it keeps no arguments: holding every
+    frame's image field would slow the tracker down)."""
 
     def __init__(self, target, clock: StageClock, labels: dict[str, str]):
         self._target, self._clock, self._labels = target, clock, labels
@@ -101,8 +84,7 @@ def stage_seconds(frames: list[np.ndarray], init: dict[str, np.ndarray], clock: 
         tracker._solver = TimedMethods(tracker._solver, clock, {"solve": "snake solver",  # noqa: SLF001
                                                                 "evaluate": "snake solver"})
         flow = tracker._motion._flow  # noqa: SLF001 - benchmark instrumentation
-        flow._frames = TimedMethods(flow._frames, clock, {"push": "pyramid", "follow": "optical flow",  # noqa: SLF001
-                                                          "track": "optical flow"})
+        flow._frames = TimedMethods(flow._frames, clock, {"push": "pyramid", "follow": "optical flow"})  # noqa: SLF001
         t0 = time.perf_counter()
         for frame in frames[1:]:
             tracker.update(frame)
@@ -137,14 +119,13 @@ def lk_seconds(frames: list[np.ndarray], pts: np.ndarray) -> float:
 
 def track_seconds(frames: list[np.ndarray], init: dict[str, np.ndarray]) -> tuple[float, float, int]:
     """Seconds the default tracker took on frames 1.. (initialised on frame 0), seconds of it
-    in the snake solver, and the solver's iterations."""
-    tracker = Tracker(frames[0], init)
-    timer = TimingSolver(tracker._solver)  # noqa: SLF001 - benchmark instrumentation
-    tracker._solver = timer  # noqa: SLF001
-    t0 = time.perf_counter()
+    in the snake solver's solve calls, and the solver's iterations."""
+    tracker, clock = Tracker(frames[0], init), StageClock()
+    tracker._solver = TimedMethods(tracker._solver, clock, {"solve": "snakes"})  # noqa: SLF001
+    iterations, t0 = 0, time.perf_counter()
     for frame in frames[1:]:
-        tracker.update(frame)
-    return time.perf_counter() - t0, timer.seconds, timer.iterations
+        iterations += tracker.update(frame).iterations
+    return time.perf_counter() - t0, clock.seconds["snakes"], iterations
 
 
 def main() -> None:
