@@ -9,9 +9,9 @@ segment, at most 15 iterations.
 
 Each measurement is run ``--repeats`` times, the runs of the three alternating, and the fastest
 run of each counts (on a shared machine the slower runs measure the neighbours). With
-``--stages``, one more run of the tracker times its native stages (optical flow, pyramid, image
-field, snake solver, gray conversion, corner detection) by wrapping their calls, and prints where
-a frame's time goes.
+``--stages``, one more run of the tracker times its native stages (head motion: pyramid and
+optical flow; image field, snake solver, gray conversion, corner detection) by wrapping their
+calls, and prints where a frame's time goes.
 
     python benchmarks/track.py [--data ../shared/data] [--frames 200] [--repeats 3] [--stages]
 
@@ -83,8 +83,8 @@ def stage_seconds(frames: list[np.ndarray], init: dict[str, np.ndarray], clock: 
         clock.seconds.clear()  # the first frame's set-up is not a frame's work
         tracker._solver = TimedMethods(tracker._solver, clock, {"solve": "snake solver",  # noqa: SLF001
                                                                 "evaluate": "snake solver"})
-        flow = tracker._motion._flow  # noqa: SLF001 - benchmark instrumentation
-        flow._frames = TimedMethods(flow._frames, clock, {"push": "pyramid", "follow": "optical flow"})  # noqa: SLF001
+        head = tracker._motion  # noqa: SLF001 - benchmark instrumentation
+        head._head = TimedMethods(head._head, clock, {"follow": "head motion (pyramid, optical flow)"})  # noqa: SLF001
         t0 = time.perf_counter()
         for frame in frames[1:]:
             tracker.update(frame)

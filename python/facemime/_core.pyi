@@ -52,10 +52,18 @@ class FlowFrames:
         epsilon: float,
         min_eigen: float,
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...
-    def follow(
+
+class HeadFollower:
+    """The head's rigid points followed from frame to frame (see facemime.track.motion)."""
+
+    def __init__(
         self,
-        points: npt.NDArray[np.float64],
-        extra: npt.NDArray[np.float64],
+        gray: npt.NDArray[np.uint8],
+        brows: npt.NDArray[np.float64],
+        zones: npt.NDArray[np.float64],
+        points: npt.NDArray[np.float32],
+        window: int,
+        max_level: int,
         extra_levels: int,
         limit: float,
         min_points: int,
@@ -63,9 +71,16 @@ class FlowFrames:
         iterations: int,
         epsilon: float,
         min_eigen: float,
-    ) -> tuple[
-        npt.NDArray[np.float64] | None, npt.NDArray[np.uint64], npt.NDArray[np.float64], npt.NDArray[np.float64]
-    ]: ...
+    ) -> None: ...
+    def follow(
+        self, gray: npt.NDArray[np.uint8], brows: npt.NDArray[np.float64], extra: npt.NDArray[np.float64]
+    ) -> tuple[npt.NDArray[np.float64] | None, npt.NDArray[np.float64]]: ...
+    def advance(self, step: npt.NDArray[np.float64]) -> bool: ...
+    def detected(self, points: npt.NDArray[np.float32]) -> None: ...
+    def drop_points(self) -> None: ...
+    zones: npt.NDArray[np.float64]
+    points: tuple[npt.NDArray[np.float32], npt.NDArray[np.int64]]
+    followed: tuple[npt.NDArray[np.float32], npt.NDArray[np.int64]]
 
 def lip_score_map(
     frame: npt.NDArray[np.uint8],
@@ -93,7 +108,6 @@ class LipPlacer:
         scale: float,
     ) -> None: ...
 
-def inside_quads(points: npt.NDArray[np.float64], quads: npt.NDArray[np.float64]) -> npt.NDArray[np.bool_]: ...
 def robust_similarity(
     src: npt.NDArray[np.float64],
     dst: npt.NDArray[np.float64],

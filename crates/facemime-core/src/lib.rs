@@ -10,6 +10,7 @@ pub mod adjust;
 mod border;
 pub mod error;
 pub mod flow;
+pub mod head;
 pub mod lip_placement;
 pub mod lip_search;
 pub mod motion;

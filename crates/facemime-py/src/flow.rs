@@ -2,7 +2,6 @@
 //! (each built once, their memory reused) and the Lucas-Kanade flow between them.
 
 use facemime_core::flow::{self, LkParams, Pyramid};
-use facemime_core::motion;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -12,15 +11,6 @@ use crate::points::{array, rows};
 
 /// The moved points and the mask of those followed.
 type Flow<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>);
-
-/// The head's step: its similarity or None, the kept rigid points' indices and positions, and
-/// the extra points' positions.
-type Step<'py> = (
-    Option<Bound<'py, PyArray2<f64>>>,
-    Bound<'py, PyArray1<usize>>,
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray2<f64>>,
-);
 
 /// (N, 2) float64 array of points, NaN rows for None.
 fn point_rows<'py>(py: Python<'py>, pts: &[Option<[f64; 2]>]) -> Bound<'py, PyArray2<f64>> {
@@ -111,59 +101,6 @@ impl FlowFrames {
             .map_err(CoreErr)?;
         let ok: Vec<bool> = moved.iter().map(Option::is_some).collect();
         Ok((point_rows(py, &moved), ok.into_pyarray(py)))
-    }
-
-    /// points: (N, 2) rigid points and extra: (M, 2) other points, pixels in the previous
-    /// frame; extra_levels: pyramid levels above the frame at most for the extra points, whose
-    /// flow starts where the head's similarity carries them when there is one; limit:
-    /// forward-backward and fit tolerance (px); min_points: fewest points for a similarity;
-    /// rounds: its fit's rounds at most. Returns (the 2×3 similarity or None, the
-    /// (K,) indices of the rigid points kept, their (K, 2) positions in the current frame, the
-    /// extra points' (M, 2) positions, NaN where the flow failed or its check).
-    #[pyo3(signature = (points, extra, extra_levels, limit, min_points, rounds, iterations, epsilon, min_eigen))]
-    #[allow(clippy::too_many_arguments)]
-    fn follow<'py>(
-        &self,
-        py: Python<'py>,
-        points: PyReadonlyArray2<f64>,
-        extra: PyReadonlyArray2<f64>,
-        extra_levels: usize,
-        limit: f64,
-        min_points: usize,
-        rounds: usize,
-        iterations: usize,
-        epsilon: f64,
-        min_eigen: f64,
-    ) -> PyResult<Step<'py>> {
-        self.ready()?;
-        let (pts, more) = (rows::<2>("points", &points)?, rows::<2>("extra", &extra)?);
-        let lk = LkParams {
-            iterations,
-            epsilon,
-            min_eigen,
-        };
-        let (prev, cur) = (&self.prev, &self.cur);
-        let step = py
-            .detach(|| {
-                motion::follow_rigid(
-                    prev,
-                    cur,
-                    &pts,
-                    &more,
-                    extra_levels,
-                    &lk,
-                    limit,
-                    min_points,
-                    rounds,
-                )
-            })
-            .map_err(CoreErr)?;
-        Ok((
-            step.similarity.map(|m| array(py, &m)),
-            step.kept.into_pyarray(py),
-            array(py, &step.moved),
-            point_rows(py, &step.extra),
-        ))
     }
 }
 

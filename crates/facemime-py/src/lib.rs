@@ -6,6 +6,7 @@ use pyo3::prelude::*;
 mod adjust;
 mod error;
 mod flow;
+mod head;
 mod lip_search;
 mod motion;
 mod points;
@@ -18,6 +19,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     adjust::register(m)?;
     flow::register(m)?;
+    head::register(m)?;
     lip_search::register(m)?;
     motion::register(m)?;
     pose::register(m)?;

@@ -40,17 +40,3 @@ class FrameFlow:
         """Positions in the current frame of (N, 2) points of the previous one (the reverse
         with ``backward``): ((N, 2) float64, NaN where lost; (N,) bool, followed)."""
         return self._frames.track(as_points(points), backward, ITERATIONS, EPSILON, MIN_EIGEN)
-
-    def follow(self, points: np.ndarray, extra: np.ndarray, extra_levels: int, limit: float, min_points: int,
-               rounds: int) -> tuple[np.ndarray | None, np.ndarray, np.ndarray, np.ndarray]:
-        """The head's step from the previous frame to the current one (``facemime_core::motion::
-        follow_rigid``): the rigid ``points`` (N, 2) followed forwards and back, those that came
-        back within ``limit`` px fitted by a robust similarity (:func:`facemime.track.motion.
-        robust_similarity`, ``rounds`` rounds at most) when at least ``min_points`` did and fit
-        it; the ``extra`` points (M, 2) followed and checked alike, from where that similarity
-        carries them through ``extra_levels`` pyramid levels at most when there is one (those
-        that then fail the check, like the rigid points). Returns (the 2×3 similarity,
-        or None; the (K,) indices of the rigid points that fit it and their (K, 2) positions now;
-        the extra points' (M, 2) positions now, NaN where the flow or its check failed)."""
-        return self._frames.follow(as_points(points), as_points(extra), int(extra_levels), float(limit),
-                                   int(min_points), int(rounds), ITERATIONS, EPSILON, MIN_EIGEN)

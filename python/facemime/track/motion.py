@@ -17,7 +17,7 @@ import cv2
 import numpy as np
 
 from facemime import _core
-from facemime.track.flow import LEVELS, WINDOW, FrameFlow, as_points
+from facemime.track.flow import EPSILON, ITERATIONS, LEVELS, MIN_EIGEN, WINDOW, as_points
 
 #: Rigid zones in face coordinates (s, t) of the first frame: a point is ``c + s·W·u + t·v``
 #: where ``c`` is the centre of the brows, ``v`` runs from it to the centre of the mouth, ``u`` is
@@ -95,7 +95,9 @@ IDENTITY = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 class HeadMotion:
     """Follows the head from frame to frame. Feed gray (H, W) uint8 frames to :meth:`update`
     with the contours tracked in the previous frame: they place the rigid zones, so the points
-    stay on the face even when the accumulated motion drifts.
+    stay on the face even when the accumulated motion drifts. The flow, the fit and the zones
+    run in the core (``facemime._core.HeadFollower``); finding corners and the coarse fallback
+    are OpenCV's, here.
 
     ``total`` is the accumulated transform from the first frame to the current one. ``points``
     (M, 2) float32 are the rigid points followed into the current frame and ``ids`` (M,) int64
@@ -109,63 +111,57 @@ class HeadMotion:
         self._max_points = max_points
         self.total = IDENTITY.copy()
         self._prev = gray
-        self._contours0 = {n: np.asarray(c, float) for n, c in contours.items()}
-        self._zones0 = zone_polygons(contours)
-        self._zones = self._zones0
-        self._next_id = 0
-        self.points, self.ids = self._detect(gray)
-        self.followed = (self.points, self.ids)
-        self._wanted = max(MIN_POINTS, len(self.points) // 2)
-        self._flow = FrameFlow()
-        self._flow.push(gray, self._crop_box(gray.shape, np.zeros((0, 2))))
+        self._brows = [n for n in contours if n.startswith("brow")]
+        zones = zone_polygons(contours)
+        self._head = _core.HeadFollower(
+            np.ascontiguousarray(gray, np.uint8), self._brow_points(contours), np.stack(zones),
+            self._detect(gray, zones), WINDOW, LEVELS, GUIDED_LEVELS, FB_LIMIT, MIN_POINTS, FIT_ROUNDS, ITERATIONS,
+            EPSILON, MIN_EIGEN)
 
-    def _zones_box(self, shape: tuple[int, ...], margin: int) -> tuple[int, int, int, int]:
-        """(x0, y0, x1, y1), exclusive ends: the zones' box, from the floor of their smallest
-        to the ceiling of their largest coordinates, grown by ``margin`` px, inside the frame."""
-        corners = np.concatenate(self._zones)
+    @property
+    def points(self) -> np.ndarray:
+        return self._head.points[0]
+
+    @property
+    def ids(self) -> np.ndarray:
+        return self._head.points[1]
+
+    @property
+    def followed(self) -> tuple[np.ndarray, np.ndarray]:
+        return self._head.followed
+
+    def _brow_points(self, contours: Mapping[str, np.ndarray]) -> np.ndarray:
+        return as_points(np.concatenate([contours[n] for n in self._brows]))
+
+    @staticmethod
+    def _zones_box(zones: np.ndarray | list[np.ndarray], shape: tuple[int, ...], margin: int) -> tuple[int, int, int, int]:
+        """(x0, y0, x1, y1), exclusive ends: the ``zones``' box, from the floor of their
+        smallest to the ceiling of their largest coordinates, grown by ``margin`` px, inside
+        the frame."""
+        corners = np.reshape(zones, (-1, 2))
         x0, y0 = np.maximum(np.floor(corners.min(axis=0)).astype(int) - margin, 0)
         x1, y1 = np.minimum(np.ceil(corners.max(axis=0)).astype(int) + margin, [shape[1], shape[0]])
         return int(x0), int(y0), int(x1), int(y1)
 
-    def _detect(self, gray: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Corners in the zones and their new ids. The corner measure reads a few pixels around
+    def _detect(self, gray: np.ndarray, zones: np.ndarray | list[np.ndarray]) -> np.ndarray:
+        """(M, 2) float32 corners in the ``zones``. The corner measure reads a few pixels around
         each pixel, so it runs on the zones' box grown by :data:`DETECT_MARGIN` px only: the
         same corners as on the whole frame, for a fraction of the work."""
-        x0, y0, x1, y1 = self._zones_box(gray.shape, DETECT_MARGIN)
+        x0, y0, x1, y1 = self._zones_box(zones, gray.shape, DETECT_MARGIN)
         pts = None
         if x1 - x0 > 2 * DETECT_MARGIN and y1 - y0 > 2 * DETECT_MARGIN:
             mask = np.zeros((y1 - y0, x1 - x0), np.uint8)
-            for poly in self._zones:
+            for poly in zones:
                 cv2.fillConvexPoly(mask, np.round(poly - [x0, y0]).astype(np.int32), 255)
             pts = cv2.goodFeaturesToTrack(gray[y0:y1, x0:x1], self._max_points, 0.01, self._min_distance, mask=mask,
                                           blockSize=5)
-        pts = np.zeros((0, 2), np.float32) if pts is None else (pts.reshape(-1, 2) + [x0, y0]).astype(np.float32)
-        ids = np.arange(self._next_id, self._next_id + len(pts), dtype=np.int64)
-        self._next_id += len(pts)
-        return pts, ids
-
-    def _keep(self, mask: np.ndarray) -> None:
-        self.points, self.ids = self.points[mask], self.ids[mask]
-
-    def _inside(self, pts: np.ndarray) -> np.ndarray:
-        """Which of ``pts`` (N, 2) lie in a zone (convex quadrilaterals, either winding)."""
-        return _core.inside_quads(as_points(pts), np.stack(self._zones))
-
-    def _crop_box(self, shape: tuple[int, ...], extra: np.ndarray) -> tuple[int, int, int, int]:
-        """The part of the frame the flow uses: the zones, points and ``extra`` with room for
-        the coarsest level's window. Its corner is on a multiple of 2^LEVELS px, so that the
-        pyramid levels of consecutive frames sample the same grid."""
-        pts = np.concatenate(self._zones + [self.points.astype(float), extra.astype(float)])
-        pad, grid = 2 ** LEVELS * WINDOW // 2 + 8, 2 ** LEVELS
-        x0, y0 = (np.floor(pts.min(axis=0)).astype(int) - pad) // grid * grid
-        x1, y1 = np.ceil(pts.max(axis=0)).astype(int) + pad
-        return max(x0, 0), max(y0, 0), min(x1, shape[1]), min(y1, shape[0])
+        return np.zeros((0, 2), np.float32) if pts is None else (pts.reshape(-1, 2) + [x0, y0]).astype(np.float32)
 
     def _coarse_shift(self, gray: np.ndarray) -> tuple[np.ndarray, bool]:
         """Fallback for motion too fast or blurred for the flow: the translation that best
         matches the previous frame's face zones (normalised cross-correlation at 1/4 scale,
-        searched up to half the zone size away)."""
-        x0, y0, x1, y1 = self._zones_box(gray.shape, 0)
+        searched up to half the zone size away); the rigid points are then dropped."""
+        x0, y0, x1, y1 = self._zones_box(self._head.zones, gray.shape, 0)
         if x1 - x0 < 16 or y1 - y0 < 16:
             return IDENTITY.copy(), False
         rx, ry = (x1 - x0) // 2, (y1 - y0) // 2
@@ -182,7 +178,7 @@ class HeadMotion:
         shift = np.array([sx0 + 4.0 * bx - x0, sy0 + 4.0 * by - y0])
         step = IDENTITY.copy()
         step[:, 2] = shift
-        self._keep(np.zeros(len(self.points), bool))
+        self._head.drop_points()
         return step, True
 
     def update(self, gray: np.ndarray, contours: Mapping[str, np.ndarray],
@@ -196,29 +192,12 @@ class HeadMotion:
         and the coarse fallback failed), whether it was measured, and the extra points' new
         positions (NaN where the flow failed its forward-backward check).
         """
-        place = brow_similarity(self._contours0, contours)
-        self._zones = [apply(place, z) for z in self._zones0]
-        step, ok = IDENTITY.copy(), False
-        extra_pts = np.zeros((0, 2)) if extra is None else np.asarray(extra, float).reshape(-1, 2)
-        moved = None if extra is None else np.full((len(extra_pts), 2), np.nan)
-        self._flow.push(gray, self._crop_box(gray.shape, extra_pts))
-        if len(self.points) >= MIN_POINTS:
-            fit, kept, dst, followed = self._flow.follow(self.points, extra_pts, GUIDED_LEVELS, FB_LIMIT, MIN_POINTS,
-                                                         FIT_ROUNDS)
-            if moved is not None:
-                moved = followed
-            if fit is not None:
-                step, ok = fit, True
-                self._keep(kept)
-                self.points = dst.astype(np.float32)
-        if not ok:
-            step, ok = self._coarse_shift(gray)
+        gray = np.ascontiguousarray(gray, np.uint8)
+        extra_pts = as_points(np.zeros((0, 2)) if extra is None else extra)
+        fit, moved = self._head.follow(gray, self._brow_points(contours), extra_pts)
+        step, ok = (fit, True) if fit is not None else self._coarse_shift(gray)
         self.total = compose(step, self.total)
-        self._zones = [apply(step, z) for z in self._zones]
-        if len(self.points):
-            self._keep(self._inside(self.points))
-        self.followed = (self.points, self.ids)
-        if len(self.points) < self._wanted:
-            self.points, self.ids = self._detect(gray)
+        if self._head.advance(step):
+            self._head.detected(self._detect(gray, self._head.zones))
         self._prev = gray
-        return step, ok, moved
+        return step, ok, None if extra is None else moved

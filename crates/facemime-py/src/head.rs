@@ -1,0 +1,189 @@
+//! Bindings of `facemime_core::head`: `HeadFollower`, the head's rigid points followed from
+//! frame to frame.
+
+use facemime_core::flow::LkParams;
+use facemime_core::head::{self, FollowSettings, Quad};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2, PyReadonlyArray3};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use crate::error::CoreErr;
+use crate::points::{array, rows};
+
+/// The head's similarity step or None, and the extra points' positions.
+type Step<'py> = (Option<Bound<'py, PyArray2<f64>>>, Bound<'py, PyArray2<f64>>);
+
+/// A (H, W) C-contiguous uint8 image: its pixels, width and height.
+fn gray_view<'a>(gray: &'a PyReadonlyArray2<'_, u8>) -> PyResult<(&'a [u8], usize, usize)> {
+    let shape = gray.as_array().shape().to_vec();
+    let data = gray
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("gray must be a C-contiguous uint8 array"))?;
+    Ok((data, shape[1], shape[0]))
+}
+
+/// The rows of a (M, 2) float32 point array.
+fn points_f32(points: &PyReadonlyArray2<f32>) -> PyResult<Vec<[f32; 2]>> {
+    let v = points.as_array();
+    if v.shape()[1] != 2 {
+        return Err(PyValueError::new_err(format!(
+            "points must have shape (M, 2), got {:?}",
+            v.shape()
+        )));
+    }
+    Ok(v.rows().into_iter().map(|r| [r[0], r[1]]).collect())
+}
+
+/// (M, 2) float32 points and their (M,) int64 identities.
+fn identified<'py>(
+    py: Python<'py>,
+    (pts, ids): (&[[f32; 2]], &[i64]),
+) -> (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<i64>>) {
+    let flat: Vec<f32> = pts.iter().flatten().copied().collect();
+    let pts = ndarray::Array2::from_shape_vec((pts.len(), 2), flat).expect("M x 2");
+    (pts.into_pyarray(py), ids.to_vec().into_pyarray(py))
+}
+
+/// See `facemime.track.motion.HeadMotion` for the documented API.
+#[pyclass(module = "facemime._core")]
+pub struct HeadFollower {
+    head: head::HeadFollower,
+}
+
+#[pymethods]
+impl HeadFollower {
+    /// gray: the first frame, (H, W) uint8; brows: (N, 2) its brow points; zones: (Z, 4, 2)
+    /// its rigid zones; points: (M, 2) float32 corners found in them; window, max_level,
+    /// extra_levels, limit, min_points, rounds, iterations, epsilon, min_eigen: see
+    /// `facemime_core::head::FollowSettings` and `facemime_core::flow::LkParams`.
+    #[new]
+    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (gray, brows, zones, points, window, max_level, extra_levels, limit, min_points, rounds, iterations, epsilon, min_eigen))]
+    fn new(
+        gray: PyReadonlyArray2<u8>,
+        brows: PyReadonlyArray2<f64>,
+        zones: PyReadonlyArray3<f64>,
+        points: PyReadonlyArray2<f32>,
+        window: usize,
+        max_level: usize,
+        extra_levels: usize,
+        limit: f64,
+        min_points: usize,
+        rounds: usize,
+        iterations: usize,
+        epsilon: f64,
+        min_eigen: f64,
+    ) -> PyResult<Self> {
+        let (data, width, height) = gray_view(&gray)?;
+        let z = zones.as_array();
+        if z.shape()[1..] != [4, 2] {
+            return Err(PyValueError::new_err(format!(
+                "zones must have shape (Z, 4, 2), got {:?}",
+                z.shape()
+            )));
+        }
+        let zones: Vec<Quad> = z
+            .outer_iter()
+            .map(|c| std::array::from_fn(|k| [c[[k, 0]], c[[k, 1]]]))
+            .collect();
+        let settings = FollowSettings {
+            window,
+            max_level,
+            extra_levels,
+            limit,
+            min_points,
+            rounds,
+            lk: LkParams {
+                iterations,
+                epsilon,
+                min_eigen,
+            },
+        };
+        let brows = rows::<2>("brows", &brows)?;
+        let points = points_f32(&points)?;
+        let head = head::HeadFollower::new(data, width, height, brows, zones, points, settings)
+            .map_err(CoreErr)?;
+        Ok(Self { head })
+    }
+
+    /// gray: the next frame, (H, W) uint8; brows: (N, 2) the previous frame's brow points;
+    /// extra: (E, 2) other points of the previous frame. Returns (the head's 2×3 similarity
+    /// step or None, the extra points' (E, 2) positions, NaN where the flow failed).
+    fn follow<'py>(
+        &mut self,
+        py: Python<'py>,
+        gray: PyReadonlyArray2<u8>,
+        brows: PyReadonlyArray2<f64>,
+        extra: PyReadonlyArray2<f64>,
+    ) -> PyResult<Step<'py>> {
+        let (data, width, height) = gray_view(&gray)?;
+        let (brows, extra) = (rows::<2>("brows", &brows)?, rows::<2>("extra", &extra)?);
+        let head = &mut self.head;
+        let got = py
+            .detach(|| head.follow(data, width, height, &brows, &extra))
+            .map_err(CoreErr)?;
+        let moved: Vec<[f64; 2]> = got
+            .extra
+            .iter()
+            .map(|m| m.unwrap_or([f64::NAN; 2]))
+            .collect();
+        Ok((got.similarity.map(|m| array(py, &m)), array(py, &moved)))
+    }
+
+    /// step: the head's 2×3 similarity from the previous frame. Returns whether new points
+    /// are wanted.
+    fn advance(&mut self, step: PyReadonlyArray2<f64>) -> PyResult<bool> {
+        let m = rows::<3>("step", &step)?;
+        if m.len() != 2 {
+            return Err(PyValueError::new_err(format!(
+                "step must have shape (2, 3), got ({}, 3)",
+                m.len()
+            )));
+        }
+        Ok(self.head.advance(&[m[0], m[1]]))
+    }
+
+    /// points: (M, 2) float32, new corners replacing the rigid points (new identities).
+    fn detected(&mut self, points: PyReadonlyArray2<f32>) -> PyResult<()> {
+        self.head.detected(points_f32(&points)?);
+        Ok(())
+    }
+
+    /// Drops every rigid point.
+    fn drop_points(&mut self) {
+        self.head.drop_points();
+    }
+
+    /// (Z, 4, 2) float64: the rigid zones now.
+    #[getter]
+    fn zones<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f64>> {
+        let z = self.head.zones();
+        let flat: Vec<f64> = z.iter().flatten().flatten().copied().collect();
+        ndarray::Array3::from_shape_vec((z.len(), 4, 2), flat)
+            .expect("Z x 4 x 2")
+            .into_pyarray(py)
+    }
+
+    /// ((M, 2) float32, (M,) int64): the rigid points now and their identities.
+    #[getter]
+    fn points<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<i64>>) {
+        identified(py, self.head.points())
+    }
+
+    /// ((M, 2) float32, (M,) int64): the points followed from the previous frame.
+    #[getter]
+    fn followed<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<i64>>) {
+        identified(py, self.head.followed())
+    }
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<HeadFollower>()?;
+    Ok(())
+}
