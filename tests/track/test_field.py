@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from facemime.io.video import VideoReader
-from facemime.track.field import build_field, region
+from facemime.track.field import build_field, regions
 
 LUMA = np.array([[0.299, 0.587, 0.114]], np.float32)
 
@@ -43,10 +43,14 @@ def test_without_a_previous_frame_the_last_channel_repeats_the_luma(frames):
     np.testing.assert_array_equal(got[..., 5], got[..., 4])
 
 
-def test_the_region_covers_the_points_with_their_margin_inside_the_image():
-    points = np.array([[10.2, 50.0], [90.7, 60.5]])
-    assert region(points, 5.0, 100, 80) == (5, 45, 97, 67)
-    assert region(np.array([[99.0, 79.0]]), 0.0, 100, 80) == (96, 76, 100, 80)
+def test_the_regions_cover_their_knots_with_their_margin_inside_the_image():
+    knots = np.array([[10.2, 50.0], [90.7, 60.5], [99.0, 79.0]])
+    bands = [(np.array([0, 1], np.uintp), 5.0), (np.array([2], np.uintp), 0.0)]
+    box, boxes = regions(knots, bands, 100, 80)
+    assert boxes == [(5, 45, 97, 67), (96, 76, 100, 80)]
+    assert box == (5, 45, 100, 80)
+    with pytest.raises(ValueError, match="past the 3 knots"):
+        regions(knots, [(np.array([3], np.uintp), 1.0)], 100, 80)
 
 
 def test_a_reused_buffer_gets_the_same_field_whatever_it_held(frames):

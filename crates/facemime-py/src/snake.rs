@@ -2,8 +2,8 @@
 
 use facemime_core::raster::ImageRef;
 use facemime_core::snake::{
-    self, CurveParams, Field, FrameInput, Operator, PairKind, PairSpec, Problem, Settings,
-    FIELD_CHANNELS,
+    self, Band, CurveParams, Field, FrameInput, FrameTimes, Knots, MorePasses, Operator, PairKind,
+    PairSpec, Problem, Settings, FIELD_CHANNELS,
 };
 use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
@@ -11,6 +11,7 @@ use numpy::{
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use std::sync::Mutex;
 
 use crate::error::CoreErr;
 use crate::points::{array, rows};
@@ -24,7 +25,54 @@ fn err(msg: String) -> PyErr {
 #[pyclass(module = "facemime._core", frozen)]
 pub struct SnakeSolver {
     problem: Problem,
+    /// The image field's buffer for `track`, and the time its stages took in all.
+    frames: Mutex<(Vec<f32>, FrameTimes)>,
 }
+
+/// Knot bands as (indices, margin) pairs from numpy, each with at least one knot and every
+/// index below `n` knots.
+fn bands_of<'a>(
+    given: &'a [(PyReadonlyArray1<'_, usize>, f64)],
+    n: usize,
+) -> PyResult<Vec<Band<'a>>> {
+    given
+        .iter()
+        .map(|(k, margin)| {
+            let knots = k
+                .as_slice()
+                .map_err(|_| err("band knots must be a contiguous array".into()))?;
+            if knots.is_empty() {
+                return Err(err("a band needs at least one knot".into()));
+            }
+            within("bands", knots, n)?;
+            Ok(Band {
+                knots,
+                margin: *margin,
+            })
+        })
+        .collect()
+}
+
+/// An error unless every index is below `n` knots.
+fn within(name: &str, idx: &[usize], n: usize) -> PyResult<()> {
+    match idx.iter().find(|&&k| k >= n) {
+        Some(k) => Err(err(format!("{name}: knot index {k} is past the {n} knots"))),
+        None => Ok(()),
+    }
+}
+
+/// An error unless the frame is at least 4×4 pixels.
+fn frame_size(width: usize, height: usize) -> PyResult<()> {
+    if width < 4 || height < 4 {
+        return Err(err(format!(
+            "the frame must be at least 4x4, got {width}x{height}"
+        )));
+    }
+    Ok(())
+}
+
+/// A frame's knots (K, 2), the solver's iterations and each curve's response (C,).
+type Tracked<'py> = (Bound<'py, PyArray2<f64>>, usize, Bound<'py, PyArray1<f64>>);
 
 #[pymethods]
 impl SnakeSolver {
@@ -123,6 +171,7 @@ impl SnakeSolver {
         };
         Ok(SnakeSolver {
             problem: Problem::new(curves, specs, n_knots, settings).map_err(CoreErr)?,
+            frames: Mutex::new((Vec::new(), FrameTimes::default())),
         })
     }
 
@@ -170,6 +219,96 @@ impl SnakeSolver {
             sol.energy,
             sol.response.into_pyarray(py),
         ))
+    }
+
+    /// One frame from `start`: the image field of `frame` (and `prev`, or None) smoothed by
+    /// `smoothing` px in the `bands`, (knot indices (uintp), margin px) pairs, around `start`,
+    /// built into a buffer the solver keeps; a solver pass; then passes of the features of the
+    /// curves flagged in `mouth_curves` moving only `mouth_knots`, while one of them moved at
+    /// least `fast` px in the last, `passes` in all at most. bounds: (width, height) of the
+    /// frame. Returns (knots (K, 2), iterations, response (C,)), as `solve`.
+    #[pyo3(signature = (frame, prev, start, rest, down, pair_targets, bounds, smoothing, bands, mouth_knots, mouth_curves, passes, fast))]
+    #[allow(clippy::too_many_arguments)]
+    fn track<'py>(
+        &self,
+        py: Python<'py>,
+        frame: PyReadonlyArray3<u8>,
+        prev: Option<PyReadonlyArray3<u8>>,
+        start: PyReadonlyArray2<f64>,
+        rest: PyReadonlyArray2<f64>,
+        down: (f64, f64),
+        pair_targets: PyReadonlyArray1<f64>,
+        bounds: (usize, usize),
+        smoothing: f64,
+        bands: Vec<(PyReadonlyArray1<usize>, f64)>,
+        mouth_knots: PyReadonlyArray1<usize>,
+        mouth_curves: PyReadonlyArray1<bool>,
+        passes: usize,
+        fast: f64,
+    ) -> PyResult<Tracked<'py>> {
+        let img = rgb_view("frame", &frame)?;
+        frame_size(bounds.0, bounds.1)?;
+        let before = prev.as_ref().map(|p| rgb_view("prev", p)).transpose()?;
+        let (start, rest) = (rows::<2>("start", &start)?, rows::<2>("rest", &rest)?);
+        let n = self.problem.n_knots();
+        if start.len() != n || rest.len() != n {
+            return Err(err(format!(
+                "start and rest must have {n} knots, got {} and {}",
+                start.len(),
+                rest.len()
+            )));
+        }
+        let bands = bands_of(&bands, n)?;
+        let mouth = mouth_knots
+            .as_slice()
+            .map_err(|_| err("mouth_knots must be a contiguous array".into()))?;
+        within("mouth_knots", mouth, n)?;
+        let curves = mouth_curves.as_array().to_vec();
+        let more = MorePasses {
+            knots: mouth,
+            curves: &curves,
+            passes,
+            fast,
+        };
+        let knots = Knots {
+            start: &start,
+            rest: &rest,
+            down: [down.0, down.1],
+            pair_targets: pair_targets
+                .as_slice()
+                .map_err(|_| err("pair_targets must be a contiguous array".into()))?,
+            bounds: [bounds.0, bounds.1],
+        };
+        let mut frames = self.frames.lock().expect("not poisoned");
+        let (buffer, total) = &mut *frames;
+        let (sol, times) = py
+            .detach(|| {
+                snake::solve_frame(
+                    &self.problem,
+                    &img,
+                    before.as_ref(),
+                    smoothing,
+                    &bands,
+                    &more,
+                    &knots,
+                    buffer,
+                )
+            })
+            .map_err(CoreErr)?;
+        total.field += times.field;
+        total.solver += times.solver;
+        Ok((
+            array(py, &sol.knots),
+            sol.iterations,
+            sol.response.into_pyarray(py),
+        ))
+    }
+
+    /// (image field, solver) seconds that `track` took in all, for benchmarks.
+    #[getter]
+    fn times(&self) -> (f64, f64) {
+        let t = self.frames.lock().expect("not poisoned").1;
+        (t.field.as_secs_f64(), t.solver.as_secs_f64())
     }
 
     /// Energy and each curve's mean H at `start`, without moving; returns (energy, response (C,)).
@@ -339,8 +478,26 @@ fn affine_rest<'py>(
     Ok(array(py, &snake::affine_rest(&a, &b, &slices, amount)))
 }
 
+/// knots: (K, 2) pixels; bands: (knot indices (uintp), margin px) pairs; width, height: the
+/// frame's. Returns (the box holding every band's region, each band's region): the integer
+/// boxes (x0, y0, x1, y1), exclusive ends, around the band's knots grown by its margin, inside
+/// the frame, at least 4×4.
+#[pyfunction]
+fn field_regions(
+    knots: PyReadonlyArray2<f64>,
+    bands: Vec<(PyReadonlyArray1<usize>, f64)>,
+    width: usize,
+    height: usize,
+) -> PyResult<([usize; 4], Vec<[usize; 4]>)> {
+    let knots = rows::<2>("knots", &knots)?;
+    let bands = bands_of(&bands, knots.len())?;
+    frame_size(width, height)?;
+    Ok(snake::band_regions(&knots, &bands, width, height))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<SnakeSolver>()?;
+    m.add_function(wrap_pyfunction!(field_regions, m)?)?;
     m.add_function(wrap_pyfunction!(affine_rest, m)?)?;
     m.add_function(wrap_pyfunction!(frame_field, m)?)?;
     m.add("FIELD_CHANNELS", FIELD_CHANNELS)?;

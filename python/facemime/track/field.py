@@ -14,14 +14,14 @@ import numpy as np
 from facemime import _core
 
 
-def region(points: np.ndarray, margin: float, width: int, height: int) -> tuple[int, int, int, int]:
-    """(x0, y0, x1, y1) integer box around ``points`` (N, 2) grown by ``margin`` px, inside the
-    image, at least 4×4."""
-    lo = np.floor(points.min(axis=0) - margin).astype(int)
-    hi = np.ceil(points.max(axis=0) + margin).astype(int) + 1
-    x0, y0 = max(int(lo[0]), 0), max(int(lo[1]), 0)
-    x1, y1 = min(int(hi[0]), width), min(int(hi[1]), height)
-    return min(x0, width - 4), min(y0, height - 4), max(x1, min(x0, width - 4) + 4), max(y1, min(y0, height - 4) + 4)
+def regions(knots: np.ndarray, bands: list[tuple[np.ndarray, float]], width: int,
+            height: int) -> tuple[tuple[int, int, int, int], list[tuple[int, int, int, int]]]:
+    """The field's regions for ``knots`` (K, 2) px in a ``width`` × ``height`` frame: each of
+    ``bands``, (knot indices as np.uintp, margin px), gives the integer box (x0, y0, x1, y1),
+    exclusive ends, around its knots grown by its margin, inside the frame, at least 4×4;
+    returns (the box holding them all, those boxes)."""
+    box, boxes = _core.field_regions(np.ascontiguousarray(knots, np.float64), bands, width, height)
+    return tuple(box), [tuple(b) for b in boxes]
 
 
 def build_field(frame: np.ndarray, prev: np.ndarray | None, box: tuple[int, int, int, int], sigma: float,

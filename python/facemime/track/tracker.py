@@ -50,7 +50,7 @@ from facemime.metrics import resample
 from facemime.track import motion
 from facemime.track.brows import BrowSearch
 from facemime.track.contours import CONTOUR_NAMES, FEATURES, POLARITY
-from facemime.track.field import build_field, region
+from facemime.track.field import build_field, regions
 from facemime.track.lips import LipSearch
 from facemime.track.mouth import mouth_shift, relocate
 from facemime.track.scale import FrameScale, ScaledMotion
@@ -297,7 +297,8 @@ class Tracker:
         self._affine_groups = [[int(i) for i in self._features[f]] for f in ("mouth_outer", "mouth_inner")]
         # The field's bands: the mouth's knots with its solver passes, the brows' with one.
         brows = np.unique(np.concatenate([self._features["brow_left"], self._features["brow_right"]]))
-        self._bands = ((self._mouth_knots, p.mouth_passes), (brows, 1))
+        self._frame_bands = self._band_args(((self._mouth_knots, p.mouth_passes), (brows, 1)))
+        self._mouth_uintp = self._mouth_knots.astype(np.uintp)
         self._mouth_rows = [i for i, n in enumerate(CONTOUR_NAMES) if n.startswith("mouth")]
         self._feature_rows = {f: np.array([CONTOUR_NAMES.index(n) for n in names]) for f, names in FEATURES.items()}
         self._upper_rows, self._lower_rows = np.array(list(self._feature_rows.values())).T
@@ -370,27 +371,36 @@ class Tracker:
         along = (corners[1] - corners[0]) / max(np.linalg.norm(corners[1] - corners[0]), 1e-9)
         return np.array([-along[1], along[0]])
 
+    def _band_args(self, bands: tuple[tuple[np.ndarray, int], ...]) -> list[tuple[np.ndarray, float]]:
+        """(knot indices as np.uintp, margin px) of each of ``bands``, (knot indices, solver
+        passes): the margin that so many passes from the knots, each reaching δ0/(1−σ) px, and
+        the smoothing can read."""
+        p = self.params
+        reach = p.delta0 / (1.0 - p.sigma)
+        return [(np.asarray(idx, np.uintp), passes * reach + 4.0 * p.smoothing + 2.0) for idx, passes in bands]
+
+    def _previous(self) -> np.ndarray | None:
+        """The previous frame when the temporal brightness term reads it, else None."""
+        p = self.params
+        return self._prev if max(p.mouth.gamma, p.mouth_inner.gamma, p.brows.gamma) > 0 else None
+
     def _field(self, frame: np.ndarray, knots: np.ndarray,
                bands: tuple[tuple[np.ndarray, int], ...] | None = None) -> tuple[np.ndarray, tuple[float, float]]:
         """The image field the solver reads around ``knots``: (field, origin of its box). Each of
         ``bands``, (knot indices, solver passes), is the box around those knots that so many
         passes from them can read (default: the mouth's passes and one for the brows). The field
         is valid until the next call (one buffer, reused)."""
-        p = self.params
-        reach = p.delta0 / (1.0 - p.sigma)
         # The snakes read the image only near the knots: around the brows and around the mouth,
         # not the eyes and nose between them.
-        boxes = [region(knots[idx], passes * reach + 4.0 * p.smoothing + 2.0, self.width, self.height)
-                 for idx, passes in bands or self._bands]
-        box = (min(b[0] for b in boxes), min(b[1] for b in boxes), max(b[2] for b in boxes), max(b[3] for b in boxes))
-        prev = self._prev if max(p.mouth.gamma, p.mouth_inner.gamma, p.brows.gamma) > 0 else None
+        band_args = self._band_args(bands) if bands is not None else self._frame_bands
+        box, boxes = regions(knots, band_args, self.width, self.height)
         # One buffer reused frame after frame: a fresh megabyte-sized array each frame cost
         # more in page faults than filling it.
         size = (box[3] - box[1]) * (box[2] - box[0]) * _core.FIELD_CHANNELS
         if self._field_buffer.size < size:
             self._field_buffer = np.empty(size + size // 4, np.float32)
         out = self._field_buffer[:size].reshape(box[3] - box[1], box[2] - box[0], _core.FIELD_CHANNELS)
-        return build_field(frame, prev, box, p.smoothing, boxes, out), (float(box[0]), float(box[1]))
+        return build_field(frame, self._previous(), box, self.params.smoothing, boxes, out), (float(box[0]), float(box[1]))
 
     def _responses(self, frame: np.ndarray, start: np.ndarray, rest: np.ndarray, down: np.ndarray, targets: np.ndarray) -> np.ndarray:
         fld, origin = self._field(frame, start)
@@ -447,17 +457,11 @@ class Tracker:
         carried = motion.apply(total, self._knots0)
         rest = self._mouth_rest(carried, start)
         targets = self._targets0 * scale
-        image = self._field(frame, start)  # wide enough for all of the mouth's passes
-        knots, iters, resp = self._solve(image, start, rest, down, targets)
-        before = start
-        for _ in range(p.mouth_passes - 1):
-            if np.abs(knots[self._mouth_knots] - before[self._mouth_knots]).max() < FAST * reach:
-                break
-            before = knots.copy()
-            again, more, again_resp = self._solve(image, before, rest, down, targets, self._mouth_curves)
-            knots[self._mouth_knots] = again[self._mouth_knots]
-            resp[self._mouth_rows] = again_resp[self._mouth_rows]
-            iters += more
+        # The field around the start, a solver pass, then more for the mouth while a mouth knot
+        # moved FAST of a pass's reach in the last.
+        knots, iters, resp = self._solver.track(frame, self._previous(), start, rest, tuple(down), targets,
+                                                (self.width, self.height), p.smoothing, self._frame_bands,
+                                                self._mouth_uintp, self._mouth_curves, p.mouth_passes, FAST * reach)
         self._centre_inner(knots, rest, down)
         confidence, lost = {}, []
         ratio = self._ratio(resp)

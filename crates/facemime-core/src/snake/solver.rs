@@ -46,6 +46,7 @@ pub struct Problem {
 }
 
 /// One frame's input. Slices are indexed like the shared knot array.
+#[derive(Clone, Copy)]
 pub struct FrameInput<'a> {
     /// Image field of this frame (see [`Field`]).
     pub field: Field<'a>,

@@ -1,0 +1,186 @@
+//! One frame of the tracker's snakes: the image field built only where the knots' passes can
+//! read it, then the solver's passes over it, the fastest-moving features getting more.
+//!
+//! Pixels: x right, y down, origin at the centre of the top-left pixel; boxes are
+//! `[x0, y0, x1, y1)`, exclusive ends.
+
+use std::time::{Duration, Instant};
+
+use super::field::{Field, FIELD_CHANNELS};
+use super::frame_field::frame_field;
+use super::solver::{FrameInput, Problem, Solution};
+use crate::error::Result;
+use crate::raster::ImageRef;
+
+/// Knots whose field is read `margin` pixels around them at most.
+pub struct Band<'a> {
+    pub knots: &'a [usize],
+    pub margin: f64,
+}
+
+/// The solver passes after the first for some features: another pass follows while one of
+/// `knots` moved at least `fast` pixels in the last, `passes` passes in all at most; a pass
+/// solves the features of the curves flagged in `curves` and moves only `knots`.
+pub struct MorePasses<'a> {
+    pub knots: &'a [usize],
+    pub curves: &'a [bool],
+    pub passes: usize,
+    pub fast: f64,
+}
+
+/// Wall time of a frame's two stages.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FrameTimes {
+    pub field: Duration,
+    pub solver: Duration,
+}
+
+/// The integer box around `points` grown by `margin` pixels, inside the `width`×`height`
+/// image (from the floor of the smallest to one past the ceiling of the largest coordinate),
+/// at least 4×4. `points` must not be empty.
+pub fn region(points: &[[f64; 2]], margin: f64, width: usize, height: usize) -> [usize; 4] {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in points {
+        for a in 0..2 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    let (w, h) = (width as i64, height as i64);
+    let x0 = ((lo[0] - margin).floor() as i64).max(0).min(w - 4);
+    let y0 = ((lo[1] - margin).floor() as i64).max(0).min(h - 4);
+    let x1 = ((hi[0] + margin).ceil() as i64 + 1).min(w).max(x0 + 4);
+    let y1 = ((hi[1] + margin).ceil() as i64 + 1).min(h).max(y0 + 4);
+    [x0, y0, x1, y1].map(|v| v as usize)
+}
+
+/// Each band's [`region`] around its knots, and the box holding them all.
+pub fn band_regions(
+    knots: &[[f64; 2]],
+    bands: &[Band<'_>],
+    width: usize,
+    height: usize,
+) -> ([usize; 4], Vec<[usize; 4]>) {
+    let boxes: Vec<[usize; 4]> = bands
+        .iter()
+        .map(|b| {
+            let pts: Vec<[f64; 2]> = b.knots.iter().map(|&i| knots[i]).collect();
+            region(&pts, b.margin, width, height)
+        })
+        .collect();
+    let mut all = [usize::MAX, usize::MAX, 0, 0];
+    for b in &boxes {
+        all = [
+            all[0].min(b[0]),
+            all[1].min(b[1]),
+            all[2].max(b[2]),
+            all[3].max(b[3]),
+        ];
+    }
+    (all, boxes)
+}
+
+/// The knots' start, rest shape, the face's down direction, the pairs' target gaps and the
+/// image size, as in [`FrameInput`].
+pub struct Knots<'a> {
+    pub start: &'a [[f64; 2]],
+    pub rest: &'a [[f64; 2]],
+    pub down: [f64; 2],
+    pub pair_targets: &'a [f64],
+    pub bounds: [usize; 2],
+}
+
+/// One frame's knots from `knots`' start: the field of `frame` (and `prev`, see
+/// [`frame_field`]) smoothed by `smoothing` pixels in the `bands` around the start, written
+/// into `buffer` (grown as needed and reused), a pass of the solver over every curve, then
+/// `more`'s passes. Returns the solution (iterations added up; each curve's response from the
+/// last pass that solved it) and the time of each stage.
+#[allow(clippy::too_many_arguments)]
+pub fn solve_frame(
+    problem: &Problem,
+    frame: &ImageRef,
+    prev: Option<&ImageRef>,
+    smoothing: f64,
+    bands: &[Band<'_>],
+    more: &MorePasses<'_>,
+    knots: &Knots<'_>,
+    buffer: &mut Vec<f32>,
+) -> Result<(Solution, FrameTimes)> {
+    let t0 = Instant::now();
+    let [width, height] = knots.bounds;
+    let (b, boxes) = band_regions(knots.start, bands, width, height);
+    let (w, h) = (b[2] - b[0], b[3] - b[1]);
+    let size = w * h * FIELD_CHANNELS;
+    if buffer.len() < size {
+        buffer.resize(size, 0.0);
+    }
+    let data = &mut buffer[..size];
+    frame_field(frame, prev, b, smoothing, Some(&boxes), data)?;
+    let input = FrameInput {
+        field: Field::new(data, w, h, [b[0] as f64, b[1] as f64])?,
+        start: knots.start,
+        rest: knots.rest,
+        down: knots.down,
+        pair_targets: knots.pair_targets,
+        bounds: [width as f64, height as f64],
+    };
+    let t1 = Instant::now();
+    let mut sol = problem.solve(&input)?;
+    let mut before = input.start.to_vec();
+    for _ in 1..more.passes {
+        let moved = more.knots.iter().fold(0.0f64, |m, &i| {
+            let (a, z) = (sol.knots[i], before[i]);
+            m.max((a[0] - z[0]).abs()).max((a[1] - z[1]).abs())
+        });
+        if moved < more.fast {
+            break;
+        }
+        before.copy_from_slice(&sol.knots);
+        let again = problem.solve_some(
+            &FrameInput {
+                start: &before,
+                ..input
+            },
+            more.curves,
+            None,
+        )?;
+        for &i in more.knots {
+            sol.knots[i] = again.knots[i];
+        }
+        for (c, _) in more.curves.iter().enumerate().filter(|(_, &on)| on) {
+            sol.response[c] = again.response[c];
+        }
+        sol.iterations += again.iterations;
+    }
+    let times = FrameTimes {
+        field: t1 - t0,
+        solver: t1.elapsed(),
+    };
+    Ok((sol, times))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn regions_cover_the_points_with_their_margin_inside_the_image() {
+        let points = [[10.5, 50.0], [90.2, 61.7]];
+        assert_eq!(region(&points, 5.0, 100, 80), [5, 45, 97, 68]);
+        assert_eq!(region(&[[99.0, 79.0]], 0.0, 100, 80), [96, 76, 100, 80]);
+        let knots = [[10.0, 10.0], [20.0, 12.0], [60.0, 40.0]];
+        let bands = [
+            Band {
+                knots: &[0, 1],
+                margin: 2.0,
+            },
+            Band {
+                knots: &[2],
+                margin: 1.0,
+            },
+        ];
+        let (all, boxes) = band_regions(&knots, &bands, 100, 80);
+        assert_eq!(boxes, [[8, 8, 23, 15], [59, 39, 63, 43]], "at least 4×4");
+        assert_eq!(all, [8, 8, 63, 43]);
+    }
+}
