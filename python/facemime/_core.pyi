@@ -133,6 +133,17 @@ def affine_rest(
 
 FIELD_CHANNELS: int
 
+def centre_group(
+    knots: npt.NDArray[np.float64],
+    rest: npt.NDArray[np.float64],
+    inner: npt.NDArray[np.uintp],
+    outer: npt.NDArray[np.uintp],
+    along: tuple[float, float],
+    amount: float,
+) -> None: ...
+def field_regions(
+    knots: npt.NDArray[np.float64], bands: list[tuple[npt.NDArray[np.uintp], float]], width: int, height: int
+) -> tuple[tuple[int, int, int, int], list[tuple[int, int, int, int]]]: ...
 def frame_field(
     frame: npt.NDArray[np.uint8],
     prev: npt.NDArray[np.uint8] | None,
@@ -146,6 +157,7 @@ class SnakeSolver:
     """Curves over one shared knot array, solved jointly by sign descent (see facemime.track)."""
 
     n_knots: int
+    times: tuple[float, float]
 
     def __init__(
         self,
@@ -172,6 +184,22 @@ class SnakeSolver:
         curves: npt.NDArray[np.bool_] | None = None,
         held: npt.NDArray[np.bool_] | None = None,
     ) -> tuple[npt.NDArray[np.float64], int, float, npt.NDArray[np.float64]]: ...
+    def track(
+        self,
+        frame: npt.NDArray[np.uint8],
+        prev: npt.NDArray[np.uint8] | None,
+        start: npt.NDArray[np.float64],
+        rest: npt.NDArray[np.float64],
+        down: tuple[float, float],
+        pair_targets: npt.NDArray[np.float64],
+        bounds: tuple[int, int],
+        smoothing: float,
+        bands: list[tuple[npt.NDArray[np.uintp], float]],
+        mouth_knots: npt.NDArray[np.uintp],
+        mouth_curves: npt.NDArray[np.bool_],
+        passes: int,
+        fast: float,
+    ) -> tuple[npt.NDArray[np.float64], int, npt.NDArray[np.float64]]: ...
     def evaluate(
         self,
         field: npt.NDArray[np.float32],

@@ -7,7 +7,7 @@ use facemime_core::snake::{
 };
 use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
-    PyReadonlyArray3, PyUntypedArrayMethods,
+    PyReadonlyArray3, PyReadwriteArray2, PyUntypedArrayMethods,
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -495,8 +495,48 @@ fn field_regions(
     Ok(snake::band_regions(&knots, &bands, width, height))
 }
 
+/// knots: (K, 2) pixels, changed in place; rest: (K, 2) their rest shape; inner, outer:
+/// knot indices (uintp) of two groups; along: a unit vector; amount: 0..1. Slides the inner
+/// knots along `along` by `amount` of their drift along it from where they sat relative to the
+/// outer ones in the rest shape.
+#[pyfunction]
+fn centre_group(
+    mut knots: PyReadwriteArray2<f64>,
+    rest: PyReadonlyArray2<f64>,
+    inner: PyReadonlyArray1<usize>,
+    outer: PyReadonlyArray1<usize>,
+    along: (f64, f64),
+    amount: f64,
+) -> PyResult<()> {
+    let (mut pts, rest) = (rows::<2>("knots", &knots)?, rows::<2>("rest", &rest)?);
+    if pts.len() != rest.len() {
+        return Err(err(format!(
+            "knots has {} rows but rest has {}",
+            pts.len(),
+            rest.len()
+        )));
+    }
+    let indices = |a: &PyReadonlyArray1<usize>, name: &str| -> PyResult<Vec<usize>> {
+        let v = a.as_array().to_vec();
+        within(name, &v, pts.len())?;
+        if v.is_empty() {
+            return Err(err(format!("{name} needs at least one knot")));
+        }
+        Ok(v)
+    };
+    let (inner, outer) = (indices(&inner, "inner")?, indices(&outer, "outer")?);
+    snake::centre_group(&mut pts, &rest, &inner, &outer, [along.0, along.1], amount);
+    let mut out = knots.as_array_mut();
+    for &i in &inner {
+        out[[i, 0]] = pts[i][0];
+        out[[i, 1]] = pts[i][1];
+    }
+    Ok(())
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<SnakeSolver>()?;
+    m.add_function(wrap_pyfunction!(centre_group, m)?)?;
     m.add_function(wrap_pyfunction!(field_regions, m)?)?;
     m.add_function(wrap_pyfunction!(affine_rest, m)?)?;
     m.add_function(wrap_pyfunction!(frame_field, m)?)?;

@@ -299,6 +299,14 @@ class Tracker:
         brows = np.unique(np.concatenate([self._features["brow_left"], self._features["brow_right"]]))
         self._frame_bands = self._band_args(((self._mouth_knots, p.mouth_passes), (brows, 1)))
         self._mouth_uintp = self._mouth_knots.astype(np.uintp)
+        self._inner_uintp, self._outer_uintp = (self._features[f].astype(np.uintp) for f in ("mouth_inner", "mouth_outer"))
+        # Each feature's upper curve's end knots and how far its chord may shrink.
+        self._chord_ends = np.array([[self._index[up][0], self._index[up][-1]] for up, _ in FEATURES.values()]).T
+        self._least_chord = np.array([NARROWEST if up == "mouth_inner_upper" else 0.5 for up, _ in FEATURES.values()])
+        # All contours' knots in CONTOUR_NAMES order, and each contour's span of them.
+        self._order = np.concatenate([self._index[n] for n in CONTOUR_NAMES])
+        ends = np.cumsum([0] + [len(self._index[n]) for n in CONTOUR_NAMES]).tolist()
+        self._spans = list(zip(CONTOUR_NAMES, ends[:-1], ends[1:]))
         self._mouth_rows = [i for i, n in enumerate(CONTOUR_NAMES) if n.startswith("mouth")]
         self._feature_rows = {f: np.array([CONTOUR_NAMES.index(n) for n in names]) for f, names in FEATURES.items()}
         self._upper_rows, self._lower_rows = np.array(list(self._feature_rows.values())).T
@@ -466,11 +474,12 @@ class Tracker:
         confidence, lost = {}, []
         ratio = self._ratio(resp)
         confidences = self._confidences(ratio)
-        for feature, names in FEATURES.items():
+        shapes_ok = self._shapes_ok(knots, carried)
+        for feature in FEATURES:
             rows, idx = self._feature_rows[feature], self._features[feature]
             conf = confidences[feature]
             fallback = carried
-            shape_ok = self._shape_ok(knots, carried, names)
+            shape_ok = shapes_ok[feature]
             search = self._brow_search.get(feature)
             if search is not None and (ratio[rows].min() < p.brow_search or not shape_ok):
                 found = search.find(gray, scale, start[idx])
@@ -484,7 +493,7 @@ class Tracker:
                         conf_again = self._confidences(self._ratio(again_resp))[feature]
                         if conf_again > conf or not shape_ok:
                             knots[idx], conf = again[idx], conf_again
-                            shape_ok = self._shape_ok(knots, carried, names)
+                            shape_ok = self._shape_ok(knots, carried, feature)
             confidence[feature] = conf
             if conf < p.lost_response or not shape_ok:
                 lost.append(feature)
@@ -560,7 +569,7 @@ class Tracker:
                     found, best = settled[inner], conf
             if found is not None:
                 placed[inner] = found
-        if best >= p.lost_response and self._shape_ok(placed, carried, FEATURES["mouth_inner"]):
+        if best >= p.lost_response and self._shape_ok(placed, carried, "mouth_inner"):
             knots[inner] = placed[inner]
             return best, iters
         return None, iters
@@ -589,7 +598,7 @@ class Tracker:
         self._centre_inner(settled, rest, down)
         features = ("mouth_outer", "mouth_inner")
         confidence = {f: c for f, c in self._confidences(self._ratio(resp)).items() if f in features}
-        if all(confidence[f] >= self.params.lost_response and self._shape_ok(settled, carried, FEATURES[f])
+        if all(confidence[f] >= self.params.lost_response and self._shape_ok(settled, carried, f)
                for f in features):
             knots[mouth] = settled[mouth]
             self._mouth_lost_for = 0
@@ -597,16 +606,10 @@ class Tracker:
         return None, iters
 
     def _centre_inner(self, knots: np.ndarray, rest: np.ndarray, down: np.ndarray) -> None:
-        """Slide the inner mouth along the mouth line so that it sits where it sat in the outer
-        mouth in the rest shape (a closed mouth's dark line gives the inner curves nothing to
-        hold them sideways; in place)."""
-        along = np.array([down[1], -down[0]])
-        inner, outer = self._features["mouth_inner"], self._features["mouth_outer"]
-        both = np.concatenate((knots, rest), axis=1)
-        # Each feature's mean knot and mean rest knot (= ndarray.mean, less overhead).
-        mi, mo = both[inner].sum(axis=0) / len(inner), both[outer].sum(axis=0) / len(outer)
-        drift = (mi[:2] - mo[:2]) - (mi[2:] - mo[2:])
-        knots[inner] -= CENTRING * (drift @ along) * along
+        """Slide the inner mouth along the mouth line by :data:`CENTRING` of its drift from
+        where it sat in the outer mouth in the rest shape (a closed mouth's dark line gives the
+        inner curves nothing to hold them sideways; ``facemime._core.centre_group``, in place)."""
+        _core.centre_group(knots, rest, self._inner_uintp, self._outer_uintp, (down[1], -down[0]), CENTRING)
 
     def _uncross(self, knots: np.ndarray, down: np.ndarray) -> None:
         """Where the inner lower lip lies above the inner upper lip (along ``down``), put both
@@ -624,16 +627,18 @@ class Tracker:
         (``facemime._core.affine_rest``)."""
         return _core.affine_rest(carried, start, self._affine_groups, self.params.mouth_affine)
 
-    def _shape_ok(self, knots: np.ndarray, rest: np.ndarray, names: tuple[str, str]) -> bool:
-        """The upper curve's chord stays within a factor 2 of its rest chord (the inner mouth's
-        may shrink to :data:`NARROWEST` of it: a mouth rounding into an "O" opens only in the
-        middle of the line where the lips met)."""
-        curve = self._index[names[0]]
-        first, last = curve[0], curve[-1]
-        chord = _length(knots[last] - knots[first])
-        rest_chord = _length(rest[last] - rest[first])
-        least = NARROWEST if names[0] == "mouth_inner_upper" else 0.5
-        return bool(least * rest_chord <= chord <= 2.0 * rest_chord)
+    def _shapes_ok(self, knots: np.ndarray, rest: np.ndarray) -> dict[str, bool]:
+        """Per feature, whether its upper curve's chord stays within a factor 2 of its chord in
+        ``rest`` (the inner mouth's may shrink to :data:`NARROWEST` of it: a mouth rounding into
+        an "O" opens only in the middle of the line where the lips met)."""
+        first, last = self._chord_ends
+        d, r = knots[last] - knots[first], rest[last] - rest[first]
+        chord, rest_chord = np.sqrt((d * d).sum(axis=1)), np.sqrt((r * r).sum(axis=1))
+        return dict(zip(FEATURES, ((self._least_chord * rest_chord <= chord) & (chord <= 2.0 * rest_chord)).tolist()))
+
+    def _shape_ok(self, knots: np.ndarray, rest: np.ndarray, feature: str) -> bool:
+        """:meth:`_shapes_ok` of one feature."""
+        return self._shapes_ok(knots, rest)[feature]
 
     @property
     def motion(self) -> motion.HeadMotion | ScaledMotion | None:
@@ -661,5 +666,6 @@ class Tracker:
         return out
 
     def _named(self, knots: np.ndarray) -> dict[str, np.ndarray]:
-        """name -> (N, 2) copies of the contours' knots."""
-        return {n: knots[self._index[n]] for n in CONTOUR_NAMES}
+        """name -> (N, 2) the contours' knots (slices of one new array)."""
+        flat = knots[self._order]
+        return {n: flat[a:b] for n, a, b in self._spans}

@@ -17,7 +17,9 @@ mod solver;
 
 pub use energy::{CurveParams, Operator, PairKind, PairSpec};
 pub use field::{Field, FIELD_CHANNELS};
-pub use frame::{band_regions, region, solve_frame, Band, FrameTimes, Knots, MorePasses};
+pub use frame::{
+    band_regions, centre_group, region, solve_frame, Band, FrameTimes, Knots, MorePasses,
+};
 pub use frame_field::{field_shape, frame_field, MAX_SIGMA};
 pub use rest::affine_rest;
 pub use solver::{FrameInput, Problem, Settings, Solution};
