@@ -279,11 +279,13 @@ impl SnakeSolver {
                 .map_err(|_| err("pair_targets must be a contiguous array".into()))?,
             bounds: [bounds.0, bounds.1],
         };
-        let mut frames = self.frames.lock().expect("not poisoned");
-        let (buffer, total) = &mut *frames;
-        let (sol, times) = py
+        // The buffer is locked with the GIL released: a second thread tracking on this solver
+        // waits for it there, not while holding the GIL that the first needs back.
+        let sol = py
             .detach(|| {
-                snake::solve_frame(
+                let mut frames = self.frames.lock().expect("not poisoned");
+                let (buffer, total) = &mut *frames;
+                let (sol, times) = snake::solve_frame(
                     &self.problem,
                     &img,
                     before.as_ref(),
@@ -292,11 +294,12 @@ impl SnakeSolver {
                     &more,
                     &knots,
                     buffer,
-                )
+                )?;
+                total.field += times.field;
+                total.solver += times.solver;
+                Ok::<_, facemime_core::CoreError>(sol)
             })
             .map_err(CoreErr)?;
-        total.field += times.field;
-        total.solver += times.solver;
         Ok((
             array(py, &sol.knots),
             sol.iterations,
