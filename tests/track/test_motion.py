@@ -1,10 +1,27 @@
-"""Head-motion compensation: the robust similarity fit and reproducible tracks."""
+"""Head-motion compensation: the robust similarity fit, the head followed on real videos and
+reproducible tracks."""
 
+import itertools
+
+import cv2
 import numpy as np
+import pytest
 
+from facemime.io.video import VideoReader
 from facemime.track import Tracker
-from facemime.track.motion import apply, robust_similarity
+from facemime.track.contours import from_face_mesh
+from facemime.track.motion import HeadMotion, apply, robust_similarity
 from facemime.track.synthetic import band_face
+
+NOSE_BRIDGE = [6, 197, 195, 5]  # Face Mesh landmarks on the nose, between the eyes and the tip
+
+
+def gray_frames(shared, video: str, count: int) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
+    """The first ``count`` frames of a shared video in gray, its landmarks and IODs."""
+    with VideoReader(shared / "video" / f"{video}.mp4") as reader:
+        frames = [cv2.cvtColor(f, cv2.COLOR_RGB2GRAY) for f in itertools.islice(reader, count)]
+    z = np.load(shared / "video" / f"{video}.landmarks.npz")
+    return frames, z["landmarks"], z["iod"]
 
 
 def test_robust_similarity_recovers_the_motion_despite_gross_outliers():
@@ -31,3 +48,47 @@ def test_the_same_frames_give_the_same_track_twice_in_one_process():
     for a, b in zip(*runs):
         for name in a:
             np.testing.assert_array_equal(a[name], b[name])
+
+
+def test_the_head_motion_carries_the_nose_with_the_face(shared):
+    frames, lm, iod = gray_frames(shared, "lp_d0", 60)
+    head = HeadMotion(frames[0], from_face_mesh(lm[0]))
+    for t in range(1, len(frames)):
+        _, ok, _ = head.update(frames[t], from_face_mesh(lm[t - 1]))
+        assert ok
+        moved = apply(head.total, lm[0][NOSE_BRIDGE, :2])
+        assert np.abs(moved - lm[t][NOSE_BRIDGE, :2]).max() < 0.03 * iod[t], t
+
+
+def test_points_keep_their_identity_while_followed_and_new_ones_get_new_ones(shared):
+    # lp_d12 turns its head: points fail the similarity fit and new ones are found often.
+    frames, lm, _ = gray_frames(shared, "lp_d12", 40)
+    head = HeadMotion(frames[0], from_face_mesh(lm[0]))
+    found_again = 0
+    for t in range(1, len(frames)):
+        before = set(head.ids.tolist())
+        _, _, moved = head.update(frames[t], from_face_mesh(lm[t - 1]), extra=lm[t - 1][NOSE_BRIDGE, :2])
+        followed = head.followed[1].tolist()
+        assert set(followed) <= before
+        assert moved.shape == (len(NOSE_BRIDGE), 2)
+        if head.ids.tolist() != followed:
+            found_again += 1
+            assert head.ids.min() > max(before)
+        assert head.points.dtype == np.float32 and len(head.points) == len(head.ids)
+    assert found_again > 0
+
+
+@pytest.mark.parametrize("blur", [6.0, 10.0])
+def test_a_jump_too_blurred_for_the_flow_is_measured_by_the_coarse_search(shared, blur):
+    frames, lm, _ = gray_frames(shared, "lp_d0", 1)
+    head = HeadMotion(frames[0], from_face_mesh(lm[0]))
+    first = head.ids.copy()
+    jumped = cv2.GaussianBlur(np.roll(frames[0], 12, axis=1), (0, 0), blur)
+    step, ok, moved = head.update(jumped, from_face_mesh(lm[0]))
+    assert ok and moved is None
+    # The search runs at a quarter of the size: within 4 px of the 12 px jump.
+    assert abs(step[0, 2] - 12.0) <= 4.0 and abs(step[1, 2]) <= 4.0
+    np.testing.assert_array_equal(step[:, :2], np.eye(2))
+    # The flow followed no point; new ones were found, with new identities.
+    assert len(head.followed[0]) == 0
+    assert len(head.ids) > 0 and head.ids.min() > first.max()
