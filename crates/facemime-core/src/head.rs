@@ -12,7 +12,7 @@
 use crate::error::Result;
 use crate::flow::{LkParams, Pyramid};
 use crate::invalid;
-use crate::motion::{follow_rigid, inside_quads, robust_similarity};
+use crate::motion::{apply, follow_rigid, inside_quads, robust_similarity};
 
 /// A convex quadrilateral, corners in order (pixels).
 pub type Quad = [[f64; 2]; 4];
@@ -66,13 +66,6 @@ pub struct HeadFollower {
     followed: (Vec<[f32; 2]>, Vec<i64>),
     next_id: i64,
     wanted: usize,
-}
-
-fn apply(m: &[[f64; 3]; 2], p: [f64; 2]) -> [f64; 2] {
-    [
-        m[0][0] * p[0] + m[0][1] * p[1] + m[0][2],
-        m[1][0] * p[0] + m[1][1] * p[1] + m[1][2],
-    ]
 }
 
 fn widen(p: &[f32; 2]) -> [f64; 2] {

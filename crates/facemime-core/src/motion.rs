@@ -167,7 +167,7 @@ pub struct RigidStep {
 }
 
 /// The 2×3 similarity `m` applied to `p`.
-fn apply(m: &[[f64; 3]; 2], p: [f64; 2]) -> [f64; 2] {
+pub(crate) fn apply(m: &[[f64; 3]; 2], p: [f64; 2]) -> [f64; 2] {
     [
         m[0][0] * p[0] + m[0][1] * p[1] + m[0][2],
         m[1][0] * p[0] + m[1][1] * p[1] + m[1][2],

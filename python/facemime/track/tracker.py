@@ -307,12 +307,11 @@ class Tracker:
         self._order = np.concatenate([self._index[n] for n in CONTOUR_NAMES])
         ends = np.cumsum([0] + [len(self._index[n]) for n in CONTOUR_NAMES]).tolist()
         self._spans = list(zip(CONTOUR_NAMES, ends[:-1], ends[1:]))
-        self._mouth_rows = [i for i, n in enumerate(CONTOUR_NAMES) if n.startswith("mouth")]
         self._feature_rows = {f: np.array([CONTOUR_NAMES.index(n) for n in names]) for f, names in FEATURES.items()}
         self._upper_rows, self._lower_rows = np.array(list(self._feature_rows.values())).T
         # Curve masks of the features solved on their own: the mouth's second pass, a brow found again.
         self._feature_curves = {f: np.isin(np.arange(len(CONTOUR_NAMES)), rows) for f, rows in self._feature_rows.items()}
-        self._mouth_curves = np.isin(np.arange(len(CONTOUR_NAMES)), self._mouth_rows)
+        self._mouth_curves = np.array([n.startswith("mouth") for n in CONTOUR_NAMES])
         self._solver, self._targets0 = self._build_solver()
         self._field_buffer = np.empty(0, np.float32)
         gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
