@@ -133,6 +133,24 @@ def affine_rest(
 
 FIELD_CHANNELS: int
 
+def chords_within(
+    knots: npt.NDArray[np.float64],
+    rest: npt.NDArray[np.float64],
+    ends: npt.NDArray[np.uintp],
+    least: npt.NDArray[np.float64],
+) -> list[bool]: ...
+def reported_knots(
+    knots: npt.NDArray[np.float64],
+    offset: npt.NDArray[np.float64],
+    linear: npt.NDArray[np.float64],
+    down: tuple[float, float],
+    upper: npt.NDArray[np.uintp],
+    lower: npt.NDArray[np.uintp],
+) -> npt.NDArray[np.float64]: ...
+def start_knots(
+    step: npt.NDArray[np.float64], knots: npt.NDArray[np.float64], flow: npt.NDArray[np.float64]
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...
+def transformed(m: npt.NDArray[np.float64], points: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
 def centre_group(
     knots: npt.NDArray[np.float64],
     rest: npt.NDArray[np.float64],

@@ -537,8 +537,125 @@ fn centre_group(
     Ok(())
 }
 
+/// The 2×3 matrix `m` as rows; an error naming `name` for another shape.
+fn matrix<const C: usize>(name: &str, m: &PyReadonlyArray2<f64>) -> PyResult<[[f64; C]; 2]> {
+    match rows::<C>(name, m)?.as_slice() {
+        &[a, b] => Ok([a, b]),
+        r => Err(err(format!(
+            "{name} must have shape (2, {C}), got ({}, {C})",
+            r.len()
+        ))),
+    }
+}
+
+/// m: 2×3 transform; points: (K, 2) pixels. Returns the (K, 2) transformed points.
+#[pyfunction]
+fn transformed<'py>(
+    py: Python<'py>,
+    m: PyReadonlyArray2<f64>,
+    points: PyReadonlyArray2<f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let m = matrix::<3>("m", &m)?;
+    Ok(array(
+        py,
+        &snake::transformed(&m, &rows::<2>("points", &points)?),
+    ))
+}
+
+/// The starting knots (K, 2) and the mask of those the flow followed (K,).
+type Started<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>);
+
+/// step: the head's 2×3 similarity; knots: (K, 2) pixels of the previous frame; flow: (K, 2)
+/// their positions by the optical flow, NaN where it failed. Returns ((K, 2) starting knots:
+/// the flow's where it followed them, else where the step carries them; (K,) followed mask).
+#[pyfunction]
+fn start_knots<'py>(
+    py: Python<'py>,
+    step: PyReadonlyArray2<f64>,
+    knots: PyReadonlyArray2<f64>,
+    flow: PyReadonlyArray2<f64>,
+) -> PyResult<Started<'py>> {
+    let step = matrix::<3>("step", &step)?;
+    let (knots, flow) = (rows::<2>("knots", &knots)?, rows::<2>("flow", &flow)?);
+    if knots.len() != flow.len() {
+        return Err(err(format!(
+            "knots has {} rows but flow has {}",
+            knots.len(),
+            flow.len()
+        )));
+    }
+    let (start, followed) = snake::start_knots(&step, &knots, &flow);
+    Ok((array(py, &start), followed.into_pyarray(py)))
+}
+
+/// knots, rest: (K, 2) pixels; ends: (F, 2) knot index pairs (uintp); least: (F,) factors.
+/// Returns, per pair, whether its chord in `knots` is within `least` to 2 times its chord in
+/// `rest`.
+#[pyfunction]
+fn chords_within(
+    knots: PyReadonlyArray2<f64>,
+    rest: PyReadonlyArray2<f64>,
+    ends: PyReadonlyArray2<usize>,
+    least: PyReadonlyArray1<f64>,
+) -> PyResult<Vec<bool>> {
+    let (knots, rest) = (rows::<2>("knots", &knots)?, rows::<2>("rest", &rest)?);
+    let e = ends.as_array();
+    if e.ncols() != 2 || least.len() != e.nrows() {
+        return Err(err(format!(
+            "ends must be (F, 2) and least (F,), got {:?} and ({},)",
+            e.shape(),
+            least.len()
+        )));
+    }
+    let ends: Vec<[usize; 2]> = e.rows().into_iter().map(|r| [r[0], r[1]]).collect();
+    within("ends", ends.as_flattened(), knots.len().min(rest.len()))?;
+    Ok(snake::chords_within(
+        &knots,
+        &rest,
+        &ends,
+        &least.as_array().to_vec(),
+    ))
+}
+
+/// knots, offset: (K, 2) pixels; linear: the head's 2×2 linear part; down: unit vector;
+/// upper, lower: knot indices (uintp) of two curves, pair by pair. Returns the (K, 2) knots
+/// less their offsets turned by `linear`, each crossed pair (lower above upper along `down`)
+/// put at its midpoint.
+#[pyfunction]
+fn reported_knots<'py>(
+    py: Python<'py>,
+    knots: PyReadonlyArray2<f64>,
+    offset: PyReadonlyArray2<f64>,
+    linear: PyReadonlyArray2<f64>,
+    down: (f64, f64),
+    upper: PyReadonlyArray1<usize>,
+    lower: PyReadonlyArray1<usize>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (knots, offset) = (rows::<2>("knots", &knots)?, rows::<2>("offset", &offset)?);
+    if knots.len() != offset.len() {
+        return Err(err(format!(
+            "knots has {} rows but offset has {}",
+            knots.len(),
+            offset.len()
+        )));
+    }
+    let linear = matrix::<2>("linear", &linear)?;
+    let (upper, lower) = (upper.as_array().to_vec(), lower.as_array().to_vec());
+    if upper.len() != lower.len() {
+        return Err(err("upper and lower must pair their knots".into()));
+    }
+    within("upper", &upper, knots.len())?;
+    within("lower", &lower, knots.len())?;
+    let out = snake::reported_knots(&knots, &offset, linear, [down.0, down.1], &upper, &lower);
+    Ok(array(py, &out))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<SnakeSolver>()?;
+    m.add_function(wrap_pyfunction!(transformed, m)?)?;
+    m.add_function(wrap_pyfunction!(start_knots, m)?)?;
+    m.add_function(wrap_pyfunction!(chords_within, m)?)?;
+    m.add_function(wrap_pyfunction!(reported_knots, m)?)?;
     m.add_function(wrap_pyfunction!(centre_group, m)?)?;
     m.add_function(wrap_pyfunction!(field_regions, m)?)?;
     m.add_function(wrap_pyfunction!(affine_rest, m)?)?;

@@ -301,7 +301,9 @@ class Tracker:
         self._mouth_uintp = self._mouth_knots.astype(np.uintp)
         self._inner_uintp, self._outer_uintp = (self._features[f].astype(np.uintp) for f in ("mouth_inner", "mouth_outer"))
         # Each feature's upper curve's end knots and how far its chord may shrink.
-        self._chord_ends = np.array([[self._index[up][0], self._index[up][-1]] for up, _ in FEATURES.values()]).T
+        self._chord_ends = np.array([[self._index[up][0], self._index[up][-1]] for up, _ in FEATURES.values()], np.uintp)
+        # The inner lips' knots pair by pair, corners left out: (upper, lower).
+        self._inner_pairs = tuple(self._index[n][1:-1].astype(np.uintp) for n in FEATURES["mouth_inner"])
         self._least_chord = np.array([NARROWEST if up == "mouth_inner_upper" else 0.5 for up, _ in FEATURES.values()])
         # All contours' knots in CONTOUR_NAMES order, and each contour's span of them.
         self._order = np.concatenate([self._index[n] for n in CONTOUR_NAMES])
@@ -452,16 +454,17 @@ class Tracker:
         down /= _length(down)
         bounds_hi = np.array([self.width - 1.0, self.height - 1.0])
         reach = p.delta0 / (1.0 - p.sigma)
-        start = motion.apply(step, self._knots)
-        if flow is not None:
-            followed = np.isfinite(flow[:, 0])
-            start[followed] = flow[followed]
+        if flow is None:
+            start = _core.transformed(step, self._knots)
+        else:
+            # Where the flow followed a knot, else where the head's step carries it.
+            start, followed = _core.start_knots(step, self._knots, flow)
             if np.count_nonzero(followed[self._mouth_knots]) < p.mouth_patch * len(self._mouth_knots):
                 self._mouth_sideways(gray, start, followed, step, down, reach)
             if self._lips is not None:
                 self._lips.move(frame, start, ~followed, scale)
         start = np.minimum(np.maximum(start, 0.0), bounds_hi)  # = np.clip, less overhead
-        carried = motion.apply(total, self._knots0)
+        carried = _core.transformed(total, self._knots0)
         rest = self._mouth_rest(carried, start)
         targets = self._targets0 * scale
         # The field around the start, a solver pass, then more for the mouth while a mouth knot
@@ -610,16 +613,6 @@ class Tracker:
         inner curves nothing to hold them sideways; ``facemime._core.centre_group``, in place)."""
         _core.centre_group(knots, rest, self._inner_uintp, self._outer_uintp, (down[1], -down[0]), CENTRING)
 
-    def _uncross(self, knots: np.ndarray, down: np.ndarray) -> None:
-        """Where the inner lower lip lies above the inner upper lip (along ``down``), put both
-        points at their midpoint, so that the reported inner curves never cross (in place)."""
-        upper, lower = self._index["mouth_inner_upper"][1:-1], self._index["mouth_inner_lower"][1:-1]
-        gap = (knots[lower] - knots[upper]) @ down
-        crossed = gap < 0
-        shift = 0.5 * gap[crossed, None] * down
-        knots[upper[crossed]] += shift
-        knots[lower[crossed]] -= shift
-
     def _mouth_rest(self, carried: np.ndarray, start: np.ndarray) -> np.ndarray:
         """The rest knots: ``carried`` (the first frame's, moved by the head) with each mouth
         feature moved ``mouth_affine`` of the way to its affine least-squares fit to ``start``
@@ -630,10 +623,7 @@ class Tracker:
         """Per feature, whether its upper curve's chord stays within a factor 2 of its chord in
         ``rest`` (the inner mouth's may shrink to :data:`NARROWEST` of it: a mouth rounding into
         an "O" opens only in the middle of the line where the lips met)."""
-        first, last = self._chord_ends
-        d, r = knots[last] - knots[first], rest[last] - rest[first]
-        chord, rest_chord = np.sqrt((d * d).sum(axis=1)), np.sqrt((r * r).sum(axis=1))
-        return dict(zip(FEATURES, ((self._least_chord * rest_chord <= chord) & (chord <= 2.0 * rest_chord)).tolist()))
+        return dict(zip(FEATURES, _core.chords_within(knots, rest, self._chord_ends, self._least_chord)))
 
     def _shape_ok(self, knots: np.ndarray, rest: np.ndarray, feature: str) -> bool:
         """:meth:`_shapes_ok` of one feature."""
@@ -659,10 +649,10 @@ class Tracker:
         return self._named(self._scale.to_frame(self._reported_knots()))
 
     def _reported_knots(self) -> np.ndarray:
-        """The knots as reported: calibration offset taken out, inner curves uncrossed."""
-        out = self._knots - self._offset @ self._linear.T
-        self._uncross(out, self._down)
-        return out
+        """The knots as reported: calibration offset (turned and scaled with the head) taken
+        out, inner curves uncrossed (where the inner lower lip lies above the inner upper lip
+        along ``down``, both points go to their midpoint)."""
+        return _core.reported_knots(self._knots, self._offset, self._linear, tuple(self._down), *self._inner_pairs)
 
     def _named(self, knots: np.ndarray) -> dict[str, np.ndarray]:
         """name -> (N, 2) the contours' knots (slices of one new array)."""

@@ -193,6 +193,94 @@ pub fn centre_group(
     }
 }
 
+/// `x·m0 + y·m1` rounded as numpy's small matrix products round it here (one fused
+/// multiply-add after the first product), so that the tracker's knots stay what they were
+/// when these steps ran in numpy.
+fn dot_after(x: f64, m0: f64, y: f64, m1: f64) -> f64 {
+    y.mul_add(m1, x * m0)
+}
+
+/// The 2×3 transform `m` applied to each of `points` (pixels).
+pub fn transformed(m: &[[f64; 3]; 2], points: &[[f64; 2]]) -> Vec<[f64; 2]> {
+    points
+        .iter()
+        .map(|p| std::array::from_fn(|j| dot_after(p[0], m[j][0], p[1], m[j][1]) + m[j][2]))
+        .collect()
+}
+
+/// The knots' starting positions in a frame: where the head's `step` (a 2×3 similarity)
+/// carries `knots`, or where the optical flow put them (`flow`, NaN where it failed). Returns
+/// them and which came from the flow.
+pub fn start_knots(
+    step: &[[f64; 3]; 2],
+    knots: &[[f64; 2]],
+    flow: &[[f64; 2]],
+) -> (Vec<[f64; 2]>, Vec<bool>) {
+    let mut start = transformed(step, knots);
+    let followed: Vec<bool> = flow.iter().map(|f| f[0].is_finite()).collect();
+    for ((s, f), _) in start
+        .iter_mut()
+        .zip(flow)
+        .zip(&followed)
+        .filter(|(_, &ok)| ok)
+    {
+        *s = *f;
+    }
+    (start, followed)
+}
+
+/// Per (first, last) knot pair of `ends`: whether the chord between them in `knots` is at
+/// least `least` times and at most twice its length in `rest`.
+pub fn chords_within(
+    knots: &[[f64; 2]],
+    rest: &[[f64; 2]],
+    ends: &[[usize; 2]],
+    least: &[f64],
+) -> Vec<bool> {
+    let chord = |pts: &[[f64; 2]], [a, b]: [usize; 2]| {
+        let d = [pts[b][0] - pts[a][0], pts[b][1] - pts[a][1]];
+        (d[0] * d[0] + d[1] * d[1]).sqrt()
+    };
+    ends.iter()
+        .zip(least)
+        .map(|(&e, &lo)| {
+            let (c, r) = (chord(knots, e), chord(rest, e));
+            lo * r <= c && c <= 2.0 * r
+        })
+        .collect()
+}
+
+/// The knots as reported: each moved back by its `offset` (pixels) turned and scaled by
+/// `linear` (the head's 2×2 part), then, where a `lower` knot lies above its `upper` one along
+/// `down` (a unit vector), both put at their midpoint, so that those curves never cross.
+pub fn reported_knots(
+    knots: &[[f64; 2]],
+    offset: &[[f64; 2]],
+    linear: [[f64; 2]; 2],
+    down: [f64; 2],
+    upper: &[usize],
+    lower: &[usize],
+) -> Vec<[f64; 2]> {
+    let mut out: Vec<[f64; 2]> = knots
+        .iter()
+        .zip(offset)
+        .map(|(k, o)| {
+            std::array::from_fn(|j| k[j] - dot_after(o[0], linear[j][0], o[1], linear[j][1]))
+        })
+        .collect();
+    for (&u, &l) in upper.iter().zip(lower) {
+        let d = [out[l][0] - out[u][0], out[l][1] - out[u][1]];
+        // Rounded as numpy's matrix-vector product rounds it (the fused product first).
+        let gap = d[0].mul_add(down[0], d[1] * down[1]);
+        if gap < 0.0 {
+            let shift = [0.5 * gap * down[0], 0.5 * gap * down[1]];
+            out[u] = [out[u][0] + shift[0], out[u][1] + shift[1]];
+            out[l] = [out[l][0] - shift[0], out[l][1] - shift[1]];
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -225,5 +313,38 @@ mod tests {
         let mut knots = [[0.0, 0.0], [10.0, 0.0], [6.0, 2.0], [8.0, 2.0]];
         centre_group(&mut knots, &rest, &[2, 3], &[0, 1], [1.0, 0.0], 0.5);
         assert_eq!(knots, [[0.0, 0.0], [10.0, 0.0], [5.0, 2.0], [7.0, 2.0]]);
+    }
+
+    #[test]
+    fn knots_start_where_the_flow_put_them_or_else_where_the_head_moved_them() {
+        let step = [[0.0, -1.0, 10.0], [1.0, 0.0, 0.0]]; // a quarter turn, then 10 px right
+        let knots = [[1.0, 2.0], [3.0, 4.0]];
+        let (start, followed) = start_knots(&step, &knots, &[[f64::NAN; 2], [7.5, 8.5]]);
+        assert_eq!(start, [[8.0, 1.0], [7.5, 8.5]]);
+        assert_eq!(followed, [false, true]);
+    }
+
+    #[test]
+    fn chords_may_shrink_to_their_least_and_grow_to_twice() {
+        let rest = [[0.0, 0.0], [10.0, 0.0]];
+        let ends = [[0, 1]; 3];
+        let at = |x: f64| [[0.0, 0.0], [x, 0.0]];
+        assert_eq!(
+            chords_within(&at(5.0), &rest, &ends, &[0.5, 0.6, 0.25]),
+            [true, false, true]
+        );
+        assert_eq!(chords_within(&at(20.0), &rest, &ends[..1], &[0.5]), [true]);
+        assert_eq!(chords_within(&at(20.5), &rest, &ends[..1], &[0.5]), [false]);
+    }
+
+    #[test]
+    fn reported_knots_take_out_the_turned_offset_and_never_cross() {
+        let knots = [[0.0, 10.0], [0.0, 8.0], [5.0, 10.0], [5.0, 12.0]];
+        let offset = [[1.0, 0.0]; 4];
+        // Turned a quarter: each offset (1, 0) becomes (0, 1).
+        let linear = [[0.0, -1.0], [1.0, 0.0]];
+        let out = reported_knots(&knots, &offset, linear, [0.0, 1.0], &[0, 2], &[1, 3]);
+        // The first pair crossed (lower 2 px above upper): both go to their midpoint.
+        assert_eq!(out, [[0.0, 8.0], [0.0, 8.0], [5.0, 9.0], [5.0, 11.0]]);
     }
 }
