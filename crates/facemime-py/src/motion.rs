@@ -2,10 +2,9 @@
 
 use facemime_core::motion;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::points::{array, rows};
+use crate::points::{array, rows, same_length};
 
 /// The 2×3 similarity and the inlier mask.
 type Fit<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>);
@@ -21,13 +20,7 @@ fn robust_similarity<'py>(
     rounds: usize,
 ) -> PyResult<Fit<'py>> {
     let (s, d) = (rows::<2>("src", &src)?, rows::<2>("dst", &dst)?);
-    if s.len() != d.len() {
-        return Err(PyValueError::new_err(format!(
-            "src has {} points but dst has {}",
-            s.len(),
-            d.len()
-        )));
-    }
+    same_length(&[("src", s.len()), ("dst", d.len())])?;
     let (m, inliers) = py.detach(|| motion::robust_similarity(&s, &d, limit, rounds));
     Ok((array(py, &m), inliers.into_pyarray(py)))
 }

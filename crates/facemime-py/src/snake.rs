@@ -14,7 +14,7 @@ use pyo3::prelude::*;
 use std::sync::Mutex;
 
 use crate::error::CoreErr;
-use crate::points::{array, rows};
+use crate::points::{array, rows, same_length};
 
 fn err(msg: String) -> PyErr {
     PyValueError::new_err(msg)
@@ -467,13 +467,7 @@ fn affine_rest<'py>(
     amount: f64,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let (a, b) = (rows::<2>("carried", &carried)?, rows::<2>("start", &start)?);
-    if a.len() != b.len() {
-        return Err(err(format!(
-            "carried has {} knots but start has {}",
-            a.len(),
-            b.len()
-        )));
-    }
+    same_length(&[("carried", a.len()), ("start", b.len())])?;
     if let Some(&k) = groups.iter().flatten().find(|&&k| k >= a.len()) {
         return Err(err(format!("knot index {k} is past the {} knots", a.len())));
     }
@@ -512,13 +506,7 @@ fn centre_group(
     amount: f64,
 ) -> PyResult<()> {
     let (mut pts, rest) = (rows::<2>("knots", &knots)?, rows::<2>("rest", &rest)?);
-    if pts.len() != rest.len() {
-        return Err(err(format!(
-            "knots has {} rows but rest has {}",
-            pts.len(),
-            rest.len()
-        )));
-    }
+    same_length(&[("knots", pts.len()), ("rest", rest.len())])?;
     let indices = |a: &PyReadonlyArray1<usize>, name: &str| -> PyResult<Vec<usize>> {
         let v = a.as_array().to_vec();
         within(name, &v, pts.len())?;
@@ -577,13 +565,7 @@ fn start_knots<'py>(
 ) -> PyResult<Started<'py>> {
     let step = matrix::<3>("step", &step)?;
     let (knots, flow) = (rows::<2>("knots", &knots)?, rows::<2>("flow", &flow)?);
-    if knots.len() != flow.len() {
-        return Err(err(format!(
-            "knots has {} rows but flow has {}",
-            knots.len(),
-            flow.len()
-        )));
-    }
+    same_length(&[("knots", knots.len()), ("flow", flow.len())])?;
     let (start, followed) = snake::start_knots(&step, &knots, &flow);
     Ok((array(py, &start), followed.into_pyarray(py)))
 }
@@ -632,13 +614,7 @@ fn reported_knots<'py>(
     lower: PyReadonlyArray1<usize>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let (knots, offset) = (rows::<2>("knots", &knots)?, rows::<2>("offset", &offset)?);
-    if knots.len() != offset.len() {
-        return Err(err(format!(
-            "knots has {} rows but offset has {}",
-            knots.len(),
-            offset.len()
-        )));
-    }
+    same_length(&[("knots", knots.len()), ("offset", offset.len())])?;
     let linear = matrix::<2>("linear", &linear)?;
     let (upper, lower) = (upper.as_array().to_vec(), lower.as_array().to_vec());
     if upper.len() != lower.len() {
