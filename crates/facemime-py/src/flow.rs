@@ -2,15 +2,12 @@
 //! (each built once, their memory reused) and the Lucas-Kanade flow between them.
 
 use facemime_core::flow::{self, LkParams, Pyramid};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
-use crate::points::{array, rows};
-
-/// The moved points and the mask of those followed.
-type Flow<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>);
+use crate::points::{array, rows, MaskedPoints};
 
 /// (N, 2) float64 array of points, NaN rows for None.
 fn point_rows<'py>(py: Python<'py>, pts: &[Option<[f64; 2]>]) -> Bound<'py, PyArray2<f64>> {
@@ -83,7 +80,7 @@ impl FlowFrames {
         iterations: usize,
         epsilon: f64,
         min_eigen: f64,
-    ) -> PyResult<Flow<'py>> {
+    ) -> PyResult<MaskedPoints<'py>> {
         self.ready()?;
         let pts = rows::<2>("points", &points)?;
         let params = LkParams {

@@ -1,13 +1,10 @@
 //! Bindings of `facemime_core::motion`: the robust similarity fit of the head motion.
 
 use facemime_core::motion;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyReadonlyArray2};
 use pyo3::prelude::*;
 
-use crate::points::{array, rows, same_length};
-
-/// The 2×3 similarity and the inlier mask.
-type Fit<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>);
+use crate::points::{array, rows, same_length, MaskedPoints};
 
 /// src, dst: (N, 2) points (pixels); limit: inlier residual (pixels); rounds: IRLS rounds at most.
 /// Returns (the 2×3 similarity mapping src onto dst, the (N,) inlier mask).
@@ -18,7 +15,7 @@ fn robust_similarity<'py>(
     dst: PyReadonlyArray2<f64>,
     limit: f64,
     rounds: usize,
-) -> PyResult<Fit<'py>> {
+) -> PyResult<MaskedPoints<'py>> {
     let (s, d) = (rows::<2>("src", &src)?, rows::<2>("dst", &dst)?);
     same_length(&[("src", s.len()), ("dst", d.len())])?;
     let (m, inliers) = py.detach(|| motion::robust_similarity(&s, &d, limit, rounds));

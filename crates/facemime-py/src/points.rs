@@ -1,6 +1,6 @@
 //! Point arrays from numpy: (K, 2) pixel or (K, 3) model coordinates as fixed-size rows.
 
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -41,3 +41,7 @@ pub fn array<'py, const D: usize>(py: Python<'py>, rows: &[[f64; D]]) -> Bound<'
         .expect("K x D")
         .into_pyarray(py)
 }
+
+/// (K, 2) float64 points and a (K,) mask over them (the inliers of a fit, the points a flow
+/// followed).
+pub type MaskedPoints<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>);

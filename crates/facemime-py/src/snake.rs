@@ -14,7 +14,7 @@ use pyo3::prelude::*;
 use std::sync::Mutex;
 
 use crate::error::CoreErr;
-use crate::points::{array, rows, same_length};
+use crate::points::{array, rows, same_length, MaskedPoints};
 
 fn err(msg: String) -> PyErr {
     PyValueError::new_err(msg)
@@ -550,9 +550,6 @@ fn transformed<'py>(
     ))
 }
 
-/// The starting knots (K, 2) and the mask of those the flow followed (K,).
-type Started<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>);
-
 /// step: the head's 2×3 similarity; knots: (K, 2) pixels of the previous frame; flow: (K, 2)
 /// their positions by the optical flow, NaN where it failed. Returns ((K, 2) starting knots:
 /// the flow's where it followed them, else where the step carries them; (K,) followed mask).
@@ -562,7 +559,7 @@ fn start_knots<'py>(
     step: PyReadonlyArray2<f64>,
     knots: PyReadonlyArray2<f64>,
     flow: PyReadonlyArray2<f64>,
-) -> PyResult<Started<'py>> {
+) -> PyResult<MaskedPoints<'py>> {
     let step = matrix::<3>("step", &step)?;
     let (knots, flow) = (rows::<2>("knots", &knots)?, rows::<2>("flow", &flow)?);
     same_length(&[("knots", knots.len()), ("flow", flow.len())])?;
