@@ -219,3 +219,27 @@ def test_tracks_a_real_talking_face(shared, name, count):
             errors[g].append(group_nme(result.contours, reference_contours(z["landmarks"][i]), names, float(z["iod"][i])))
     for g, e in errors.items():
         assert np.mean(e) < 0.03 and max(e) < 0.06, g
+
+
+@pytest.mark.parametrize("fast", [0.0, 1e9])
+def test_the_frame_call_solves_as_building_the_field_and_solving_pass_by_pass(fast):
+    # SnakeSolver.track (field, a pass, the mouth's further passes while it moves `fast` px)
+    # against the separate calls it replaces: fast 0 always takes the mouth's second pass,
+    # 1e9 never does.
+    frame0, truth0 = band_face(noise=2.0)
+    tracker = Tracker(frame0, truth0)
+    frame = band_face(noise=2.0, seed=5, shift=(1.5, 1.0), opening=1.5)[0]
+    t, p = tracker, tracker.params
+    start, rest, down, targets = t._knots + [1.0, -0.5], t._knots0, t._down0, t._targets0  # noqa: SLF001
+    knots, iters, resp = t._solver.track(frame, None, start, rest, tuple(down), targets, (t.width, t.height),  # noqa: SLF001
+                                         p.smoothing, t._frame_bands, t._mouth_uintp, t._mouth_curves,  # noqa: SLF001
+                                         p.mouth_passes, fast)
+    field = t._field(frame, start)  # noqa: SLF001
+    want, want_iters, want_resp = t._solve(field, start, rest, down, targets)  # noqa: SLF001
+    if fast == 0.0:
+        mouth, curves = t._mouth_knots, t._mouth_curves  # noqa: SLF001
+        again, more, again_resp = t._solve(field, want.copy(), rest, down, targets, curves)  # noqa: SLF001
+        want[mouth], want_resp[curves], want_iters = again[mouth], again_resp[curves], want_iters + more
+    np.testing.assert_array_equal(knots, want)
+    np.testing.assert_array_equal(resp, want_resp)
+    assert iters == want_iters
