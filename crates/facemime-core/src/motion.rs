@@ -174,6 +174,28 @@ pub(crate) fn apply(m: &[[f64; 3]; 2], p: [f64; 2]) -> [f64; 2] {
     ]
 }
 
+/// The 2×3 transform `a ∘ b` (`b` first). Each entry of the linear product is rounded as
+/// numpy's matrix product rounds it (the second product fused with the sum of the first), so
+/// that the tracker's accumulated head motion stays what it was when numpy composed it.
+pub fn compose(a: &[[f64; 3]; 2], b: &[[f64; 3]; 2]) -> [[f64; 3]; 2] {
+    std::array::from_fn(|i| {
+        let mut row: [f64; 3] =
+            std::array::from_fn(|j| a[i][1].mul_add(b[1][j], a[i][0] * b[0][j]));
+        row[2] += a[i][2];
+        row
+    })
+}
+
+/// The head's uniform scale (the square root of the determinant's magnitude of `m`'s linear
+/// part) and the unit vector `v` becomes under that linear part (rounded as numpy rounds
+/// the product and the length).
+pub fn scale_and_turn(m: &[[f64; 3]; 2], v: [f64; 2]) -> (f64, [f64; 2]) {
+    let scale = (m[0][0] * m[1][1] - m[0][1] * m[1][0]).abs().sqrt();
+    let t: [f64; 2] = std::array::from_fn(|j| v[0].mul_add(m[j][0], v[1] * m[j][1]));
+    let length = t[1].mul_add(t[1], t[0] * t[0]).sqrt();
+    (scale, [t[0] / length, t[1] / length])
+}
+
 /// The inverse of a 2×3 similarity (z ↦ a·z + b inverts to z ↦ (z − b)/a).
 fn invert(m: &[[f64; 3]; 2]) -> [[f64; 3]; 2] {
     let (a, b) = (
@@ -320,6 +342,20 @@ mod tests {
         }
         assert_eq!(inliers.iter().filter(|&&i| !i).count(), 4);
         assert!(!inliers[3] && !inliers[11] && !inliers[17] && !inliers[25]);
+    }
+
+    #[test]
+    fn composition_applies_the_second_transform_first() {
+        let (a, b) = (
+            [[0.0, -1.0, 5.0], [1.0, 0.0, 0.0]],
+            [[2.0, 0.0, 1.0], [0.0, 2.0, 3.0]],
+        );
+        let ab = compose(&a, &b);
+        for p in [[0.0, 0.0], [1.5, -2.0]] {
+            assert_eq!(apply(&ab, p), apply(&a, apply(&b, p)));
+        }
+        let (scale, down) = scale_and_turn(&ab, [0.0, 1.0]);
+        assert_eq!((scale, down), (2.0, [-1.0, 0.0]));
     }
 
     #[test]

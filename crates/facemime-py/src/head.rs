@@ -8,7 +8,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
-use crate::points::{array, rows};
+use crate::points::{array, matrix, rows};
 
 /// The head's similarity step or None, and the extra points' positions.
 type Step<'py> = (Option<Bound<'py, PyArray2<f64>>>, Bound<'py, PyArray2<f64>>);
@@ -133,14 +133,7 @@ impl HeadFollower {
     /// step: the head's 2×3 similarity from the previous frame. Returns whether new points
     /// are wanted.
     fn advance(&mut self, step: PyReadonlyArray2<f64>) -> PyResult<bool> {
-        let m = rows::<3>("step", &step)?;
-        if m.len() != 2 {
-            return Err(PyValueError::new_err(format!(
-                "step must have shape (2, 3), got ({}, 3)",
-                m.len()
-            )));
-        }
-        Ok(self.head.advance(&[m[0], m[1]]))
+        Ok(self.head.advance(&matrix::<3>("step", &step)?))
     }
 
     /// points: (M, 2) float32, new corners replacing the rigid points (new identities).

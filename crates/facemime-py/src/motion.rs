@@ -1,10 +1,10 @@
 //! Bindings of `facemime_core::motion`: the robust similarity fit of the head motion.
 
 use facemime_core::motion;
-use numpy::{IntoPyArray, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 
-use crate::points::{array, rows, same_length, MaskedPoints};
+use crate::points::{array, matrix, rows, same_length, MaskedPoints};
 
 /// src, dst: (N, 2) points (pixels); limit: inlier residual (pixels); rounds: IRLS rounds at most.
 /// Returns (the 2×3 similarity mapping src onto dst, the (N,) inlier mask).
@@ -22,7 +22,28 @@ fn robust_similarity<'py>(
     Ok((array(py, &m), inliers.into_pyarray(py)))
 }
 
+/// a, b: 2×3 transforms. Returns the 2×3 transform a ∘ b (b first).
+#[pyfunction]
+fn compose<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray2<f64>,
+    b: PyReadonlyArray2<f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (a, b) = (matrix::<3>("a", &a)?, matrix::<3>("b", &b)?);
+    Ok(array(py, &motion::compose(&a, &b)))
+}
+
+/// m: a 2×3 similarity; v: a unit vector. Returns (the similarity's scale, v turned by it as a
+/// unit vector).
+#[pyfunction]
+fn scale_and_turn(m: PyReadonlyArray2<f64>, v: (f64, f64)) -> PyResult<(f64, (f64, f64))> {
+    let (scale, t) = motion::scale_and_turn(&matrix::<3>("m", &m)?, [v.0, v.1]);
+    Ok((scale, (t[0], t[1])))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(compose, m)?)?;
+    m.add_function(wrap_pyfunction!(scale_and_turn, m)?)?;
     m.add_function(wrap_pyfunction!(robust_similarity, m)?)?;
     Ok(())
 }

@@ -19,6 +19,18 @@ pub fn rows<const D: usize>(name: &str, a: &PyReadonlyArray2<f64>) -> PyResult<V
         .collect())
 }
 
+/// A (2, C) float64 array (a 2×3 transform, a 2×2 linear map) as its two rows; a clear error
+/// naming `name` for another shape.
+pub fn matrix<const C: usize>(name: &str, m: &PyReadonlyArray2<f64>) -> PyResult<[[f64; C]; 2]> {
+    match rows::<C>(name, m)?.as_slice() {
+        &[a, b] => Ok([a, b]),
+        r => Err(PyValueError::new_err(format!(
+            "{name} must have shape (2, {C}), got ({}, {C})",
+            r.len()
+        ))),
+    }
+}
+
 /// An error unless the arrays, given as (name, length) pairs, all have the same length.
 pub fn same_length(arrays: &[(&str, usize)]) -> PyResult<()> {
     if arrays.iter().all(|&(_, n)| n == arrays[0].1) {

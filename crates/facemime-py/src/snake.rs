@@ -14,7 +14,7 @@ use pyo3::prelude::*;
 use std::sync::Mutex;
 
 use crate::error::CoreErr;
-use crate::points::{array, rows, same_length, MaskedPoints};
+use crate::points::{array, matrix, rows, same_length, MaskedPoints};
 
 fn err(msg: String) -> PyErr {
     PyValueError::new_err(msg)
@@ -523,17 +523,6 @@ fn centre_group(
         out[[i, 1]] = pts[i][1];
     }
     Ok(())
-}
-
-/// The 2×3 matrix `m` as rows; an error naming `name` for another shape.
-fn matrix<const C: usize>(name: &str, m: &PyReadonlyArray2<f64>) -> PyResult<[[f64; C]; 2]> {
-    match rows::<C>(name, m)?.as_slice() {
-        &[a, b] => Ok([a, b]),
-        r => Err(err(format!(
-            "{name} must have shape (2, {C}), got ({}, {C})",
-            r.len()
-        ))),
-    }
 }
 
 /// m: 2×3 transform; points: (K, 2) pixels. Returns the (K, 2) transformed points.

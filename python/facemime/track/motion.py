@@ -78,10 +78,8 @@ def brow_similarity(src: Mapping[str, np.ndarray], dst: Mapping[str, np.ndarray]
 
 
 def compose(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """The 2×3 transform ``a ∘ b`` (apply ``b`` first)."""
-    m = a[:, :2] @ b
-    m[:, 2] += a[:, 2]
-    return m
+    """The 2×3 transform ``a ∘ b`` (apply ``b`` first; ``facemime._core.compose``)."""
+    return _core.compose(a, b)
 
 
 def apply(m: np.ndarray, pts: np.ndarray) -> np.ndarray:

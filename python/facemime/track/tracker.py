@@ -37,7 +37,6 @@ Coordinates are (x, y) pixels, origin at the centre of the top-left pixel, y dow
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
@@ -246,11 +245,6 @@ def _check_contours(contours: Mapping[str, object], width: int, height: int) -> 
     return out
 
 
-def _length(d: np.ndarray) -> float:
-    """Euclidean length of a vector (= np.linalg.norm, less overhead)."""
-    return math.sqrt(d @ d)
-
-
 def _rgb(name: str, frame: object) -> np.ndarray:
     img = validate.image(name, frame)
     if img.ndim != 3 or img.shape[2] != 3:
@@ -449,9 +443,9 @@ class Tracker:
         if self._motion is not None:
             step, ok, flow = self._motion.update(gray, self._reported, self._knots if p.knot_flow else None)
         total = self._motion.total if self._motion is not None else motion.IDENTITY
-        scale = math.sqrt(abs(total[0, 0] * total[1, 1] - total[0, 1] * total[1, 0]))
-        down = total[:, :2] @ self._down0
-        down /= _length(down)
+        # The head's scale, and the mouth's downward normal turned with the head.
+        scale, down = _core.scale_and_turn(total, tuple(self._down0))
+        down = np.array(down)
         bounds_hi = np.array([self.width - 1.0, self.height - 1.0])
         reach = p.delta0 / (1.0 - p.sigma)
         if flow is None:
