@@ -10,6 +10,7 @@
 //! as the corner detector gives them.
 
 use crate::error::Result;
+use crate::extent::extent;
 use crate::flow::{LkParams, Pyramid};
 use crate::invalid;
 use crate::motion::{apply, follow_rigid, inside_quads, robust_similarity};
@@ -224,17 +225,12 @@ impl HeadFollower {
         let s = &self.settings;
         let grid = 1i64 << s.max_level;
         let pad = grid * s.window as i64 / 2 + CROP_MARGIN as i64;
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         let corners = self.zones.iter().flatten().copied();
-        let all = corners
-            .chain(self.points.iter().map(widen))
-            .chain(extra.iter().copied());
-        for p in all {
-            for a in 0..2 {
-                lo[a] = lo[a].min(p[a]);
-                hi[a] = hi[a].max(p[a]);
-            }
-        }
+        let (lo, hi) = extent(
+            corners
+                .chain(self.points.iter().map(widen))
+                .chain(extra.iter().copied()),
+        );
         let start = |v: f64| ((v.floor() as i64 - pad).div_euclid(grid) * grid).max(0) as usize;
         let end = |v: f64, size: usize| (v.ceil() as i64 + pad).clamp(0, size as i64) as usize;
         let crop = [

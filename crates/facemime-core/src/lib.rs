@@ -9,6 +9,7 @@
 pub mod adjust;
 mod border;
 pub mod error;
+pub mod extent;
 pub mod flow;
 pub mod head;
 pub mod lip_placement;

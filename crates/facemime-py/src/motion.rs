@@ -1,6 +1,6 @@
 //! Bindings of `facemime_core::motion`: the robust similarity fit of the head motion.
 
-use facemime_core::motion;
+use facemime_core::{extent, motion};
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 
@@ -41,7 +41,29 @@ fn scale_and_turn(m: PyReadonlyArray2<f64>, v: (f64, f64)) -> PyResult<(f64, (f6
     Ok((scale, (t[0], t[1])))
 }
 
+/// points: (N, 2) pixels; margin: pixels; width, height: the frame's. Returns the integer box
+/// (x0, y0, x1, y1), exclusive ends, from the floor of the points' smallest to the ceiling of
+/// their largest coordinates, grown by `margin` and clipped to the frame (empty, x1 <= x0 or
+/// y1 <= y0, when the points lie outside it).
+#[pyfunction]
+fn grown_box(
+    points: PyReadonlyArray2<f64>,
+    margin: i64,
+    width: usize,
+    height: usize,
+) -> PyResult<(i64, i64, i64, i64)> {
+    let pts = rows::<2>("points", &points)?;
+    if pts.is_empty() {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "a box needs at least one point",
+        ));
+    }
+    let [x0, y0, x1, y1] = extent::grown_box(pts, margin, width, height);
+    Ok((x0, y0, x1, y1))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(grown_box, m)?)?;
     m.add_function(wrap_pyfunction!(compose, m)?)?;
     m.add_function(wrap_pyfunction!(scale_and_turn, m)?)?;
     m.add_function(wrap_pyfunction!(robust_similarity, m)?)?;

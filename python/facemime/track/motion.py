@@ -136,10 +136,7 @@ class HeadMotion:
         """(x0, y0, x1, y1), exclusive ends: the ``zones``' box, from the floor of their
         smallest to the ceiling of their largest coordinates, grown by ``margin`` px, inside
         the frame."""
-        corners = np.reshape(zones, (-1, 2))
-        x0, y0 = np.maximum(np.floor(corners.min(axis=0)).astype(int) - margin, 0)
-        x1, y1 = np.minimum(np.ceil(corners.max(axis=0)).astype(int) + margin, [shape[1], shape[0]])
-        return int(x0), int(y0), int(x1), int(y1)
+        return _core.grown_box(as_points(zones), margin, shape[1], shape[0])
 
     def _detect(self, gray: np.ndarray, zones: np.ndarray | list[np.ndarray]) -> np.ndarray:
         """(M, 2) float32 corners in the ``zones``. The corner measure reads a few pixels around

@@ -10,6 +10,7 @@ use super::field::{Field, FIELD_CHANNELS};
 use super::frame_field::frame_field;
 use super::solver::{FrameInput, Problem, Solution};
 use crate::error::Result;
+use crate::extent::extent;
 use crate::raster::ImageRef;
 
 /// Knots whose field is read `margin` pixels around them at most.
@@ -39,13 +40,7 @@ pub struct FrameTimes {
 /// image (from the floor of the smallest to one past the ceiling of the largest coordinate),
 /// at least 4×4. `points` must not be empty.
 pub fn region(points: &[[f64; 2]], margin: f64, width: usize, height: usize) -> [usize; 4] {
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for p in points {
-        for a in 0..2 {
-            lo[a] = lo[a].min(p[a]);
-            hi[a] = hi[a].max(p[a]);
-        }
-    }
+    let (lo, hi) = extent(points.iter().copied());
     let (w, h) = (width as i64, height as i64);
     let x0 = ((lo[0] - margin).floor() as i64).max(0).min(w - 4);
     let y0 = ((lo[1] - margin).floor() as i64).max(0).min(h - 4);
