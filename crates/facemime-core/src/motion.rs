@@ -174,13 +174,28 @@ pub(crate) fn apply(m: &[[f64; 3]; 2], p: [f64; 2]) -> [f64; 2] {
     ]
 }
 
+/// `x·m0 + y·m1` rounded as numpy's small matrix products round it here (one fused
+/// multiply-add after the first product), so that the tracker's knots stay what they were
+/// when these steps ran in numpy.
+pub(crate) fn dot_after(x: f64, m0: f64, y: f64, m1: f64) -> f64 {
+    y.mul_add(m1, x * m0)
+}
+
+/// The 2×3 transform `m` applied to each of `points` (pixels).
+pub fn transformed(m: &[[f64; 3]; 2], points: &[[f64; 2]]) -> Vec<[f64; 2]> {
+    points
+        .iter()
+        .map(|p| std::array::from_fn(|j| dot_after(p[0], m[j][0], p[1], m[j][1]) + m[j][2]))
+        .collect()
+}
+
 /// The 2×3 transform `a ∘ b` (`b` first). Each entry of the linear product is rounded as
 /// numpy's matrix product rounds it (the second product fused with the sum of the first), so
 /// that the tracker's accumulated head motion stays what it was when numpy composed it.
 pub fn compose(a: &[[f64; 3]; 2], b: &[[f64; 3]; 2]) -> [[f64; 3]; 2] {
     std::array::from_fn(|i| {
         let mut row: [f64; 3] =
-            std::array::from_fn(|j| a[i][1].mul_add(b[1][j], a[i][0] * b[0][j]));
+            std::array::from_fn(|j| dot_after(a[i][0], b[0][j], a[i][1], b[1][j]));
         row[2] += a[i][2];
         row
     })

@@ -22,6 +22,20 @@ fn robust_similarity<'py>(
     Ok((array(py, &m), inliers.into_pyarray(py)))
 }
 
+/// m: 2×3 transform; points: (K, 2) pixels. Returns the (K, 2) transformed points.
+#[pyfunction]
+fn transformed<'py>(
+    py: Python<'py>,
+    m: PyReadonlyArray2<f64>,
+    points: PyReadonlyArray2<f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let m = matrix::<3>("m", &m)?;
+    Ok(array(
+        py,
+        &motion::transformed(&m, &rows::<2>("points", &points)?),
+    ))
+}
+
 /// a, b: 2×3 transforms. Returns the 2×3 transform a ∘ b (b first).
 #[pyfunction]
 fn compose<'py>(
@@ -65,6 +79,7 @@ fn grown_box(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(grown_box, m)?)?;
     m.add_function(wrap_pyfunction!(compose, m)?)?;
+    m.add_function(wrap_pyfunction!(transformed, m)?)?;
     m.add_function(wrap_pyfunction!(scale_and_turn, m)?)?;
     m.add_function(wrap_pyfunction!(robust_similarity, m)?)?;
     Ok(())

@@ -525,20 +525,6 @@ fn centre_group(
     Ok(())
 }
 
-/// m: 2×3 transform; points: (K, 2) pixels. Returns the (K, 2) transformed points.
-#[pyfunction]
-fn transformed<'py>(
-    py: Python<'py>,
-    m: PyReadonlyArray2<f64>,
-    points: PyReadonlyArray2<f64>,
-) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let m = matrix::<3>("m", &m)?;
-    Ok(array(
-        py,
-        &snake::transformed(&m, &rows::<2>("points", &points)?),
-    ))
-}
-
 /// step: the head's 2×3 similarity; knots: (K, 2) pixels of the previous frame; flow: (K, 2)
 /// their positions by the optical flow, NaN where it failed. Returns ((K, 2) starting knots:
 /// the flow's where it followed them, else where the step carries them; (K,) followed mask).
@@ -614,7 +600,6 @@ fn reported_knots<'py>(
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<SnakeSolver>()?;
-    m.add_function(wrap_pyfunction!(transformed, m)?)?;
     m.add_function(wrap_pyfunction!(start_knots, m)?)?;
     m.add_function(wrap_pyfunction!(chords_within, m)?)?;
     m.add_function(wrap_pyfunction!(reported_knots, m)?)?;

@@ -11,6 +11,7 @@ use super::frame_field::frame_field;
 use super::solver::{FrameInput, Problem, Solution};
 use crate::error::Result;
 use crate::extent::extent;
+use crate::motion::{dot_after, transformed};
 use crate::raster::ImageRef;
 
 /// Knots whose field is read `margin` pixels around them at most.
@@ -186,21 +187,6 @@ pub fn centre_group(
             knots[i][1] - shift * along[1],
         ];
     }
-}
-
-/// `x·m0 + y·m1` rounded as numpy's small matrix products round it here (one fused
-/// multiply-add after the first product), so that the tracker's knots stay what they were
-/// when these steps ran in numpy.
-fn dot_after(x: f64, m0: f64, y: f64, m1: f64) -> f64 {
-    y.mul_add(m1, x * m0)
-}
-
-/// The 2×3 transform `m` applied to each of `points` (pixels).
-pub fn transformed(m: &[[f64; 3]; 2], points: &[[f64; 2]]) -> Vec<[f64; 2]> {
-    points
-        .iter()
-        .map(|p| std::array::from_fn(|j| dot_after(p[0], m[j][0], p[1], m[j][1]) + m[j][2]))
-        .collect()
 }
 
 /// The knots' starting positions in a frame: where the head's `step` (a 2×3 similarity)

@@ -19,7 +19,7 @@ pub use energy::{CurveParams, Operator, PairKind, PairSpec};
 pub use field::{Field, FIELD_CHANNELS};
 pub use frame::{
     band_regions, centre_group, chords_within, region, reported_knots, solve_frame, start_knots,
-    transformed, Band, FrameTimes, Knots, MorePasses,
+    Band, FrameTimes, Knots, MorePasses,
 };
 pub use frame_field::{field_shape, frame_field, MAX_SIGMA};
 pub use rest::affine_rest;
