@@ -181,6 +181,12 @@ pub(crate) fn dot_after(x: f64, m0: f64, y: f64, m1: f64) -> f64 {
     y.mul_add(m1, x * m0)
 }
 
+/// `x·m0 + y·m1` rounded as numpy's small matrix-vector products round it here (one fused
+/// multiply-add after the second product).
+pub(crate) fn dot_before(x: f64, m0: f64, y: f64, m1: f64) -> f64 {
+    x.mul_add(m0, y * m1)
+}
+
 /// The 2×3 transform `m` applied to each of `points` (pixels).
 pub fn transformed(m: &[[f64; 3]; 2], points: &[[f64; 2]]) -> Vec<[f64; 2]> {
     points
@@ -206,8 +212,8 @@ pub fn compose(a: &[[f64; 3]; 2], b: &[[f64; 3]; 2]) -> [[f64; 3]; 2] {
 /// the product and the length).
 pub fn scale_and_turn(m: &[[f64; 3]; 2], v: [f64; 2]) -> (f64, [f64; 2]) {
     let scale = (m[0][0] * m[1][1] - m[0][1] * m[1][0]).abs().sqrt();
-    let t: [f64; 2] = std::array::from_fn(|j| v[0].mul_add(m[j][0], v[1] * m[j][1]));
-    let length = t[1].mul_add(t[1], t[0] * t[0]).sqrt();
+    let t: [f64; 2] = std::array::from_fn(|j| dot_before(v[0], m[j][0], v[1], m[j][1]));
+    let length = dot_after(t[0], t[0], t[1], t[1]).sqrt();
     (scale, [t[0] / length, t[1] / length])
 }
 

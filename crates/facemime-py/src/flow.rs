@@ -2,18 +2,12 @@
 //! (each built once, their memory reused) and the Lucas-Kanade flow between them.
 
 use facemime_core::flow::{self, LkParams, Pyramid};
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
-use crate::points::{array, rows, MaskedPoints};
-
-/// (N, 2) float64 array of points, NaN rows for None.
-fn point_rows<'py>(py: Python<'py>, pts: &[Option<[f64; 2]>]) -> Bound<'py, PyArray2<f64>> {
-    let rows: Vec<[f64; 2]> = pts.iter().map(|m| m.unwrap_or([f64::NAN; 2])).collect();
-    array(py, &rows)
-}
+use crate::points::{gray_view, point_rows, rows, MaskedPoints};
 
 /// See `facemime.track.flow` for the documented API.
 #[pyclass(module = "facemime._core")]
@@ -56,13 +50,10 @@ impl FlowFrames {
         gray: PyReadonlyArray2<u8>,
         crop: [usize; 4],
     ) -> PyResult<()> {
-        let shape = gray.as_array().shape().to_vec();
-        let data = gray
-            .as_slice()
-            .map_err(|_| PyValueError::new_err("gray must be a C-contiguous uint8 array"))?;
+        let (data, width, height) = gray_view(&gray)?;
         std::mem::swap(&mut self.prev, &mut self.cur);
         let (cur, max_level) = (&mut self.cur, self.max_level);
-        py.detach(|| cur.rebuild(data, shape[1], shape[0], crop, max_level))
+        py.detach(|| cur.rebuild(data, width, height, crop, max_level))
             .map_err(CoreErr)?;
         self.pushed += 1;
         Ok(())

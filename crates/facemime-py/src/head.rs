@@ -8,19 +8,10 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
-use crate::points::{array, matrix, rows};
+use crate::points::{array, gray_view, matrix, point_rows, rows};
 
 /// The head's similarity step or None, and the extra points' positions.
 type Step<'py> = (Option<Bound<'py, PyArray2<f64>>>, Bound<'py, PyArray2<f64>>);
-
-/// A (H, W) C-contiguous uint8 image: its pixels, width and height.
-fn gray_view<'a>(gray: &'a PyReadonlyArray2<'_, u8>) -> PyResult<(&'a [u8], usize, usize)> {
-    let shape = gray.as_array().shape().to_vec();
-    let data = gray
-        .as_slice()
-        .map_err(|_| PyValueError::new_err("gray must be a C-contiguous uint8 array"))?;
-    Ok((data, shape[1], shape[0]))
-}
 
 /// The rows of a (M, 2) float32 point array.
 fn points_f32(points: &PyReadonlyArray2<f32>) -> PyResult<Vec<[f32; 2]>> {
@@ -122,12 +113,10 @@ impl HeadFollower {
         let got = py
             .detach(|| head.follow(data, width, height, &brows, &extra))
             .map_err(CoreErr)?;
-        let moved: Vec<[f64; 2]> = got
-            .extra
-            .iter()
-            .map(|m| m.unwrap_or([f64::NAN; 2]))
-            .collect();
-        Ok((got.similarity.map(|m| array(py, &m)), array(py, &moved)))
+        Ok((
+            got.similarity.map(|m| array(py, &m)),
+            point_rows(py, &got.extra),
+        ))
     }
 
     /// step: the head's 2×3 similarity from the previous frame. Returns whether new points

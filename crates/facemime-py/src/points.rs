@@ -1,6 +1,6 @@
 //! Point arrays from numpy: (K, 2) pixel or (K, 3) model coordinates as fixed-size rows.
 
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -57,3 +57,18 @@ pub fn array<'py, const D: usize>(py: Python<'py>, rows: &[[f64; D]]) -> Bound<'
 /// (K, 2) float64 points and a (K,) mask over them (the inliers of a fit, the points a flow
 /// followed).
 pub type MaskedPoints<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>);
+
+/// (N, 2) float64 array of points, NaN rows where a point is None (lost).
+pub fn point_rows<'py>(py: Python<'py>, pts: &[Option<[f64; 2]>]) -> Bound<'py, PyArray2<f64>> {
+    let rows: Vec<[f64; 2]> = pts.iter().map(|m| m.unwrap_or([f64::NAN; 2])).collect();
+    array(py, &rows)
+}
+
+/// A (H, W) C-contiguous uint8 gray image: its pixels, width and height.
+pub fn gray_view<'a>(gray: &'a PyReadonlyArray2<'_, u8>) -> PyResult<(&'a [u8], usize, usize)> {
+    let shape = gray.shape().to_vec();
+    let data = gray
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("gray must be a C-contiguous uint8 array"))?;
+    Ok((data, shape[1], shape[0]))
+}

@@ -8,10 +8,11 @@ use std::time::{Duration, Instant};
 
 use super::field::{Field, FIELD_CHANNELS};
 use super::frame_field::frame_field;
+use super::rest::mean_of;
 use super::solver::{FrameInput, Problem, Solution};
 use crate::error::Result;
 use crate::extent::extent;
-use crate::motion::{dot_after, transformed};
+use crate::motion::{dot_after, dot_before, transformed};
 use crate::raster::ImageRef;
 
 /// Knots whose field is read `margin` pixels around them at most.
@@ -166,21 +167,13 @@ pub fn centre_group(
     along: [f64; 2],
     amount: f64,
 ) {
-    let mean = |pts: &[[f64; 2]], idx: &[usize]| {
-        let s = idx
-            .iter()
-            .fold([0.0, 0.0], |s, &i| [s[0] + pts[i][0], s[1] + pts[i][1]]);
-        let n = idx.len() as f64;
-        [s[0] / n, s[1] / n]
-    };
-    let (mi, mo) = (mean(knots, inner), mean(knots, outer));
-    let (ri, ro) = (mean(rest, inner), mean(rest, outer));
+    let (mi, mo) = (mean_of(knots, inner), mean_of(knots, outer));
+    let (ri, ro) = (mean_of(rest, inner), mean_of(rest, outer));
     let drift = [
         (mi[0] - mo[0]) - (ri[0] - ro[0]),
         (mi[1] - mo[1]) - (ri[1] - ro[1]),
     ];
-    // The dot product rounded as numpy's (one fused multiply-add), for the same tracks.
-    let shift = amount * drift[1].mul_add(along[1], drift[0] * along[0]);
+    let shift = amount * dot_after(drift[0], along[0], drift[1], along[1]);
     for &i in inner {
         knots[i] = [
             knots[i][0] - shift * along[0],
@@ -251,8 +244,7 @@ pub fn reported_knots(
         .collect();
     for (&u, &l) in upper.iter().zip(lower) {
         let d = [out[l][0] - out[u][0], out[l][1] - out[u][1]];
-        // Rounded as numpy's matrix-vector product rounds it (the fused product first).
-        let gap = d[0].mul_add(down[0], d[1] * down[1]);
+        let gap = dot_before(d[0], down[0], d[1], down[1]);
         if gap < 0.0 {
             let shift = [0.5 * gap * down[0], 0.5 * gap * down[1]];
             out[u] = [out[u][0] + shift[0], out[u][1] + shift[1]];

@@ -3,6 +3,15 @@
 //! onto the knots' starting positions, so that a mouth narrowing into an "O" or opening wide is
 //! not pulled back to its neutral shape. Points are pixels.
 
+/// The mean of the points of `pts` at `idx` (not empty), summed in index order.
+pub(crate) fn mean_of(pts: &[[f64; 2]], idx: &[usize]) -> [f64; 2] {
+    let s = idx
+        .iter()
+        .fold([0.0, 0.0], |s, &i| [s[0] + pts[i][0], s[1] + pts[i][1]]);
+    let n = idx.len() as f64;
+    [s[0] / n, s[1] / n]
+}
+
 /// `carried` with each group of knot indices moved `amount` (0: not at all, 1: fully) of the
 /// way to its affine least-squares fit to `start` (the same knots' starting positions): the
 /// linear part from the centred points by the normal equations, or, where the group is
@@ -21,14 +30,7 @@ pub fn affine_rest(
     );
     let mut rest = carried.to_vec();
     for idx in groups.iter().filter(|idx| !idx.is_empty()) {
-        let n = idx.len() as f64;
-        let centroid = |pts: &[[f64; 2]]| {
-            let s = idx
-                .iter()
-                .fold([0.0, 0.0], |s, &i| [s[0] + pts[i][0], s[1] + pts[i][1]]);
-            [s[0] / n, s[1] / n]
-        };
-        let (ca, cb) = (centroid(carried), centroid(start));
+        let (ca, cb) = (mean_of(carried, idx), mean_of(start, idx));
         // Scatter of the centred carried points (gram) and their cross-scatter with the
         // centred starts (cross[r][c] = Σ d_r e_c).
         let (mut gram, mut cross) = ([[0.0; 2]; 2], [[0.0; 2]; 2]);
