@@ -38,6 +38,7 @@ import cv2
 import numpy as np
 
 import facemime.track.tracker as tracker_module
+from facemime.track import motion
 from facemime.track import Tracker
 from facemime.track.contours import CONTOUR_NAMES, from_face_mesh
 
@@ -77,7 +78,7 @@ class TimedMethods:
 def stage_seconds(frames: list[np.ndarray], init: dict[str, np.ndarray], clock: StageClock) -> float:
     """Seconds the default tracker took on frames 1.., its native stages timed into ``clock``."""
     with mock.patch.object(cv2, "cvtColor", clock.wrap("gray conversion", cv2.cvtColor)), \
-            mock.patch.object(cv2, "goodFeaturesToTrack", clock.wrap("corner detection", cv2.goodFeaturesToTrack)), \
+            mock.patch.object(motion.HeadMotion, "_detect", clock.wrap("corner detection", motion.HeadMotion._detect)), \
             mock.patch.object(tracker_module, "build_field", clock.wrap("image field", tracker_module.build_field)):
         tracker = Tracker(frames[0], init)
         clock.seconds.clear()  # the first frame's set-up is not a frame's work

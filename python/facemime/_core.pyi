@@ -111,6 +111,15 @@ class LipPlacer:
 def compose(a: npt.NDArray[np.float64], b: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
 def scale_and_turn(m: npt.NDArray[np.float64], v: tuple[float, float]) -> tuple[float, tuple[float, float]]: ...
 def grown_box(points: npt.NDArray[np.float64], margin: int, width: int, height: int) -> tuple[int, int, int, int]: ...
+def good_features(
+    gray: npt.NDArray[np.uint8],
+    area: tuple[int, int, int, int],
+    mask: npt.NDArray[np.uint8],
+    max_corners: int,
+    quality: float,
+    min_distance: float,
+    block: int,
+) -> npt.NDArray[np.float32]: ...
 def robust_similarity(
     src: npt.NDArray[np.float64],
     dst: npt.NDArray[np.float64],

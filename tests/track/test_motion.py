@@ -10,7 +10,7 @@ import pytest
 from facemime.io.video import VideoReader
 from facemime.track import Tracker
 from facemime.track.contours import from_face_mesh
-from facemime.track.motion import HeadMotion, apply, robust_similarity
+from facemime.track.motion import CORNER_BLOCK, DETECT_MARGIN, QUALITY, HeadMotion, apply, robust_similarity
 from facemime.track.synthetic import band_face
 
 NOSE_BRIDGE = [6, 197, 195, 5]  # Face Mesh landmarks on the nose, between the eyes and the tip
@@ -92,3 +92,22 @@ def test_a_jump_too_blurred_for_the_flow_is_measured_by_the_coarse_search(shared
     # The flow followed no point; new ones were found, with new identities.
     assert len(head.followed[0]) == 0
     assert len(head.ids) > 0 and head.ids.min() > first.max()
+
+
+def test_the_corners_found_in_the_rigid_zones_are_opencvs(shared):
+    # Through lp_d12's head turn, where new corners are found often: the core's corner
+    # detector picks the same corners, in the same order, as OpenCV's goodFeaturesToTrack.
+    frames, lm, _ = gray_frames(shared, "lp_d12", 40)
+    head = HeadMotion(frames[0], from_face_mesh(lm[0]))
+    for t in range(1, len(frames)):
+        head.update(frames[t], from_face_mesh(lm[t - 1]))
+        zones = head._head.zones  # noqa: SLF001 - the zones the detector searches
+        x0, y0, x1, y1 = head._zones_box(zones, frames[t].shape, DETECT_MARGIN)  # noqa: SLF001
+        mask = np.zeros((y1 - y0, x1 - x0), np.uint8)
+        for poly in zones:
+            cv2.fillConvexPoly(mask, np.round(poly - [x0, y0]).astype(np.int32), 255)
+        theirs = cv2.goodFeaturesToTrack(frames[t][y0:y1, x0:x1], head._max_points, QUALITY,  # noqa: SLF001
+                                         head._min_distance, mask=mask, blockSize=CORNER_BLOCK)  # noqa: SLF001
+        ours = head._detect(frames[t], zones)  # noqa: SLF001
+        assert ours.dtype == np.float32 and len(ours) > 20
+        np.testing.assert_array_equal(ours, theirs.reshape(-1, 2) + [x0, y0])

@@ -8,6 +8,7 @@
 
 pub mod adjust;
 mod border;
+pub mod corners;
 pub mod error;
 pub mod extent;
 pub mod flow;

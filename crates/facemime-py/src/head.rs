@@ -1,6 +1,7 @@
 //! Bindings of `facemime_core::head`: `HeadFollower`, the head's rigid points followed from
 //! frame to frame.
 
+use facemime_core::corners::{self, CornerSettings};
 use facemime_core::flow::LkParams;
 use facemime_core::head::{self, FollowSettings, Quad};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2, PyReadonlyArray3};
@@ -25,14 +26,20 @@ fn points_f32(points: &PyReadonlyArray2<f32>) -> PyResult<Vec<[f32; 2]>> {
     Ok(v.rows().into_iter().map(|r| [r[0], r[1]]).collect())
 }
 
+/// (M, 2) float32 points.
+fn f32_rows<'py>(py: Python<'py>, pts: &[[f32; 2]]) -> Bound<'py, PyArray2<f32>> {
+    let flat: Vec<f32> = pts.iter().flatten().copied().collect();
+    ndarray::Array2::from_shape_vec((pts.len(), 2), flat)
+        .expect("M x 2")
+        .into_pyarray(py)
+}
+
 /// (M, 2) float32 points and their (M,) int64 identities.
 fn identified<'py>(
     py: Python<'py>,
     (pts, ids): (&[[f32; 2]], &[i64]),
 ) -> (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<i64>>) {
-    let flat: Vec<f32> = pts.iter().flatten().copied().collect();
-    let pts = ndarray::Array2::from_shape_vec((pts.len(), 2), flat).expect("M x 2");
-    (pts.into_pyarray(py), ids.to_vec().into_pyarray(py))
+    (f32_rows(py, pts), ids.to_vec().into_pyarray(py))
 }
 
 /// See `facemime.track.motion.HeadMotion` for the documented API.
@@ -165,7 +172,39 @@ impl HeadFollower {
     }
 }
 
+/// (M, 2) float32 corners (frame pixels) of the (H, W) uint8 `gray` in the box `area` = (x0,
+/// y0, x1, y1), exclusive ends, where the (y1 − y0, x1 − x0) uint8 `mask` is nonzero, as
+/// OpenCV's goodFeaturesToTrack finds them; see `facemime_core::corners::good_features`.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn good_features<'py>(
+    py: Python<'py>,
+    gray: PyReadonlyArray2<'py, u8>,
+    area: [usize; 4],
+    mask: PyReadonlyArray2<'py, u8>,
+    max_corners: usize,
+    quality: f64,
+    min_distance: f64,
+    block: usize,
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let (data, width, height) = gray_view(&gray)?;
+    let m = mask
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("mask must be a C-contiguous uint8 array"))?;
+    let settings = CornerSettings {
+        max_corners,
+        quality,
+        min_distance,
+        block,
+    };
+    let found = py
+        .detach(|| corners::good_features(data, width, height, area, m, &settings))
+        .map_err(CoreErr)?;
+    Ok(f32_rows(py, &found))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(good_features, m)?)?;
     m.add_class::<HeadFollower>()?;
     Ok(())
 }

@@ -37,6 +37,8 @@ GUIDED_LEVELS = 2
 MIN_POINTS = 6
 FIT_ROUNDS = 10  # rounds of the robust similarity fit at most
 DETECT_MARGIN = 8  # px around the zones for the corner measure (block 5, Sobel 3)
+QUALITY = 0.01  # a corner's measure is above this fraction of the zones' strongest
+CORNER_BLOCK = 5  # px: side of the square over which the corner measure sums gradients
 
 
 def face_frame(contours: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
@@ -94,8 +96,9 @@ class HeadMotion:
     """Follows the head from frame to frame. Feed gray (H, W) uint8 frames to :meth:`update`
     with the contours tracked in the previous frame: they place the rigid zones, so the points
     stay on the face even when the accumulated motion drifts. The flow, the fit and the zones
-    run in the core (``facemime._core.HeadFollower``); finding corners and the coarse fallback
-    are OpenCV's, here.
+    run in the core (``facemime._core.HeadFollower``), and so does finding corners
+    (``facemime._core.good_features``, OpenCV's ``goodFeaturesToTrack``); the coarse fallback
+    is OpenCV's, here.
 
     ``total`` is the accumulated transform from the first frame to the current one. ``points``
     (M, 2) float32 are the rigid points followed into the current frame and ``ids`` (M,) int64
@@ -139,18 +142,18 @@ class HeadMotion:
         return _core.grown_box(as_points(zones), margin, shape[1], shape[0])
 
     def _detect(self, gray: np.ndarray, zones: np.ndarray | list[np.ndarray]) -> np.ndarray:
-        """(M, 2) float32 corners in the ``zones``. The corner measure reads a few pixels around
+        """(M, 2) float32 corners in the ``zones`` (OpenCV's ``goodFeaturesToTrack``, computed
+        by ``facemime._core.good_features``). The corner measure reads a few pixels around
         each pixel, so it runs on the zones' box grown by :data:`DETECT_MARGIN` px only: the
         same corners as on the whole frame, for a fraction of the work."""
         x0, y0, x1, y1 = self._zones_box(zones, gray.shape, DETECT_MARGIN)
-        pts = None
-        if x1 - x0 > 2 * DETECT_MARGIN and y1 - y0 > 2 * DETECT_MARGIN:
-            mask = np.zeros((y1 - y0, x1 - x0), np.uint8)
-            for poly in zones:
-                cv2.fillConvexPoly(mask, np.round(poly - [x0, y0]).astype(np.int32), 255)
-            pts = cv2.goodFeaturesToTrack(gray[y0:y1, x0:x1], self._max_points, 0.01, self._min_distance, mask=mask,
-                                          blockSize=5)
-        return np.zeros((0, 2), np.float32) if pts is None else (pts.reshape(-1, 2) + [x0, y0]).astype(np.float32)
+        if x1 - x0 <= 2 * DETECT_MARGIN or y1 - y0 <= 2 * DETECT_MARGIN:
+            return np.zeros((0, 2), np.float32)
+        mask = np.zeros((y1 - y0, x1 - x0), np.uint8)
+        for poly in zones:
+            cv2.fillConvexPoly(mask, np.round(poly - [x0, y0]).astype(np.int32), 255)
+        return _core.good_features(gray, (x0, y0, x1, y1), mask, self._max_points, QUALITY, self._min_distance,
+                                   CORNER_BLOCK)
 
     def _coarse_shift(self, gray: np.ndarray) -> tuple[np.ndarray, bool]:
         """Fallback for motion too fast or blurred for the flow: the translation that best
