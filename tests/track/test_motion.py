@@ -54,7 +54,7 @@ def test_the_head_motion_carries_the_nose_with_the_face(shared):
     frames, lm, iod = gray_frames(shared, "lp_d0", 60)
     head = HeadMotion(frames[0], from_face_mesh(lm[0]))
     for t in range(1, len(frames)):
-        _, ok, _ = head.update(frames[t], from_face_mesh(lm[t - 1]))
+        _, ok, _ = head.update(frames[t], head.brow_points(from_face_mesh(lm[t - 1])))
         assert ok
         moved = apply(head.total, lm[0][NOSE_BRIDGE, :2])
         assert np.abs(moved - lm[t][NOSE_BRIDGE, :2]).max() < 0.03 * iod[t], t
@@ -67,7 +67,7 @@ def test_points_keep_their_identity_while_followed_and_new_ones_get_new_ones(sha
     found_again = 0
     for t in range(1, len(frames)):
         before = set(head.ids.tolist())
-        _, _, moved = head.update(frames[t], from_face_mesh(lm[t - 1]), extra=lm[t - 1][NOSE_BRIDGE, :2])
+        _, _, moved = head.update(frames[t], head.brow_points(from_face_mesh(lm[t - 1])), extra=lm[t - 1][NOSE_BRIDGE, :2])
         followed = head.followed[1].tolist()
         assert set(followed) <= before
         assert moved.shape == (len(NOSE_BRIDGE), 2)
@@ -84,7 +84,7 @@ def test_a_jump_too_blurred_for_the_flow_is_measured_by_the_coarse_search(shared
     head = HeadMotion(frames[0], from_face_mesh(lm[0]))
     first = head.ids.copy()
     jumped = cv2.GaussianBlur(np.roll(frames[0], 12, axis=1), (0, 0), blur)
-    step, ok, moved = head.update(jumped, from_face_mesh(lm[0]))
+    step, ok, moved = head.update(jumped, head.brow_points(from_face_mesh(lm[0])))
     assert ok and moved is None
     # The search runs at a quarter of the size: within 4 px of the 12 px jump.
     assert abs(step[0, 2] - 12.0) <= 4.0 and abs(step[1, 2]) <= 4.0
@@ -100,7 +100,7 @@ def test_the_corners_found_in_the_rigid_zones_are_opencvs(shared):
     frames, lm, _ = gray_frames(shared, "lp_d12", 40)
     head = HeadMotion(frames[0], from_face_mesh(lm[0]))
     for t in range(1, len(frames)):
-        head.update(frames[t], from_face_mesh(lm[t - 1]))
+        head.update(frames[t], head.brow_points(from_face_mesh(lm[t - 1])))
         zones = head._head.zones  # noqa: SLF001 - the zones the detector searches
         x0, y0, x1, y1 = head._zones_box(zones, frames[t].shape, DETECT_MARGIN)  # noqa: SLF001
         mask = np.zeros((y1 - y0, x1 - x0), np.uint8)

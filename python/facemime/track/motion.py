@@ -112,10 +112,10 @@ class HeadMotion:
         self._max_points = max_points
         self.total = IDENTITY.copy()
         self._prev = gray
-        self._brows = [n for n in contours if n.startswith("brow")]
+        self._brows = tuple(n for n in contours if n.startswith("brow"))
         zones = zone_polygons(contours)
         self._head = _core.HeadFollower(
-            np.ascontiguousarray(gray, np.uint8), self._brow_points(contours), np.stack(zones),
+            np.ascontiguousarray(gray, np.uint8), self.brow_points(contours), np.stack(zones),
             self._detect(gray, zones), WINDOW, LEVELS, GUIDED_LEVELS, FB_LIMIT, MIN_POINTS, FIT_ROUNDS, ITERATIONS,
             EPSILON, MIN_EIGEN)
 
@@ -131,7 +131,13 @@ class HeadMotion:
     def followed(self) -> tuple[np.ndarray, np.ndarray]:
         return self._head.followed
 
-    def _brow_points(self, contours: Mapping[str, np.ndarray]) -> np.ndarray:
+    @property
+    def brows(self) -> tuple[str, ...]:
+        """The brow contours' names, in the order :meth:`brow_points` joins them."""
+        return self._brows
+
+    def brow_points(self, contours: Mapping[str, np.ndarray]) -> np.ndarray:
+        """(N, 2) float64 px: the brow contours' points joined, as :meth:`update` takes them."""
         return as_points(np.concatenate([contours[n] for n in self._brows]))
 
     @staticmethod
@@ -179,12 +185,13 @@ class HeadMotion:
         self._head.drop_points()
         return step, True
 
-    def update(self, gray: np.ndarray, contours: Mapping[str, np.ndarray],
+    def update(self, gray: np.ndarray, brows: np.ndarray,
                extra: np.ndarray | None = None) -> tuple[np.ndarray, bool, np.ndarray | None]:
         """Motion from the previous frame to ``gray``.
 
-        ``contours``: the previous frame's tracked contours; their brows (the most reliably
-        tracked feature) place the rigid zones.
+        ``brows``: (N, 2) px, the brow points tracked in the previous frame
+        (:meth:`brow_points` of its contours); the brows, the most reliably tracked feature,
+        place the rigid zones.
         ``extra``: optional (N, 2) points of the previous frame to follow by the same flow.
         Returns (step, measured, moved): the 2×3 similarity (identity when too few points agreed
         and the coarse fallback failed), whether it was measured, and the extra points' new
@@ -192,7 +199,7 @@ class HeadMotion:
         """
         gray = np.ascontiguousarray(gray, np.uint8)
         extra_pts = as_points(np.zeros((0, 2)) if extra is None else extra)
-        fit, moved = self._head.follow(gray, self._brow_points(contours), extra_pts)
+        fit, moved = self._head.follow(gray, as_points(brows), extra_pts)
         step, ok = (fit, True) if fit is not None else self._coarse_shift(gray)
         self.total = compose(step, self.total)
         if self._head.advance(step):

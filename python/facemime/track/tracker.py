@@ -310,8 +310,12 @@ class Tracker:
         self._mouth_curves = np.array([n.startswith("mouth") for n in CONTOUR_NAMES])
         self._solver, self._targets0 = self._build_solver()
         self._field_buffer = np.empty(0, np.float32)
+        self._bounds_hi = np.array([self.width - 1.0, self.height - 1.0])  # the last pixel's centre
         gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
         self._motion = motion.HeadMotion(gray, contours) if p.motion else None
+        if self._motion is not None:
+            # The knots of the brow points the head motion takes, in its order.
+            self._brow_knots = np.concatenate([self._index[n] for n in self._motion.brows])
         self._prev, self._gray = frame, gray
         self._mouth_lost_for = 0  # frames in a row with a mouth feature lost
         self.frame_index = 0
@@ -331,7 +335,7 @@ class Tracker:
         self._down = self._down0
         self._response0 = np.maximum(self._responses(frame, edges, edges, self._down0, self._targets0), 1e-6)
         self._brow_search = {f: BrowSearch(gray, edges[self._features[f]]) for f in ("brow_left", "brow_right")}
-        self._reported = self._named(self._reported_knots())
+        self._reported = self._reported_knots()
 
     def _build_solver(self) -> tuple[_core.SnakeSolver, np.ndarray]:
         p = self.params
@@ -441,12 +445,12 @@ class Tracker:
         step, ok, flow = motion.IDENTITY, True, None
         gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
         if self._motion is not None:
-            step, ok, flow = self._motion.update(gray, self._reported, self._knots if p.knot_flow else None)
+            step, ok, flow = self._motion.update(gray, self._reported[self._brow_knots],
+                                                 self._knots if p.knot_flow else None)
         total = self._motion.total if self._motion is not None else motion.IDENTITY
         # The head's scale, and the mouth's downward normal turned with the head.
         scale, down = _core.scale_and_turn(total, tuple(self._down0))
         down = np.array(down)
-        bounds_hi = np.array([self.width - 1.0, self.height - 1.0])
         reach = p.delta0 / (1.0 - p.sigma)
         if flow is None:
             start = _core.transformed(step, self._knots)
@@ -457,7 +461,7 @@ class Tracker:
                 self._mouth_sideways(gray, start, followed, step, down, reach)
             if self._lips is not None:
                 self._lips.move(frame, start, ~followed, scale)
-        start = np.minimum(np.maximum(start, 0.0), bounds_hi)  # = np.clip, less overhead
+        start = np.minimum(np.maximum(start, 0.0), self._bounds_hi)  # = np.clip, less overhead
         carried = _core.transformed(total, self._knots0)
         rest = self._mouth_rest(carried, start)
         targets = self._targets0 * scale
@@ -514,10 +518,10 @@ class Tracker:
         self._linear = total[:, :2]
         self._down = down
         self._prev, self._gray = frame, gray
-        reported = self._reported_knots()
-        # The head motion reads the contours next frame: its own copy, not the caller's.
-        self._reported = self._named(reported)
-        return FrameResult(self.frame_index, self._named(self._scale.to_frame(reported)), confidence, lost, iters, ok)
+        # The head motion reads the brows' reported knots next frame.
+        self._reported = self._reported_knots()
+        return FrameResult(self.frame_index, self._named(self._scale.to_frame(self._reported)), confidence, lost,
+                           iters, ok)
 
     def _mouth_sideways(self, gray: np.ndarray, start: np.ndarray, followed: np.ndarray, step: np.ndarray,
                         down: np.ndarray, reach: float) -> None:
