@@ -68,36 +68,47 @@ pub fn good_features(
              finite and not negative"
         );
     }
+    let search = Search {
+        gray,
+        width,
+        area,
+        mask,
+        settings: s,
+    };
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: AVX2 is present.
-        return Ok(unsafe { corners_avx2(gray, width, area, mask, s) });
+        return Ok(unsafe { corners_avx2(&search) });
     }
-    Ok(corners(gray, width, area, mask, s))
+    Ok(corners(&search))
+}
+
+/// [`good_features`]'s checked arguments.
+struct Search<'a> {
+    gray: &'a [u8],
+    width: usize,
+    area: [usize; 4],
+    mask: &'a [u8],
+    settings: &'a CornerSettings,
 }
 
 /// [`corners`] compiled for AVX2: the same integer sums and f64 steps, so the same corners.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn corners_avx2(
-    gray: &[u8],
-    width: usize,
-    area: [usize; 4],
-    mask: &[u8],
-    s: &CornerSettings,
-) -> Vec<[f32; 2]> {
-    corners(gray, width, area, mask, s)
+unsafe fn corners_avx2(search: &Search) -> Vec<[f32; 2]> {
+    corners(search)
 }
 
 /// [`good_features`] on checked arguments.
 #[inline(always)]
-fn corners(
-    gray: &[u8],
-    width: usize,
-    area: [usize; 4],
-    mask: &[u8],
-    s: &CornerSettings,
-) -> Vec<[f32; 2]> {
+fn corners(search: &Search) -> Vec<[f32; 2]> {
+    let &Search {
+        gray,
+        width,
+        area,
+        mask,
+        settings: s,
+    } = search;
     let [x0, y0, x1, y1] = area;
     let (bw, bh) = (x1 - x0, y1 - y0);
     let measure = Measure {
@@ -204,31 +215,20 @@ impl Band {
     }
 }
 
-/// Index of the first nonzero byte of `row`, 8 at a time.
-fn first_nonzero(row: &[u8]) -> Option<usize> {
-    let words = row.chunks_exact(8);
-    let tail = words.remainder();
-    for (k, w) in words.enumerate() {
-        let v = u64::from_le_bytes(w.try_into().expect("8 bytes"));
+/// The indices of the first and the last nonzero byte of `row`, read 8 bytes at a time.
+fn nonzero_ends(row: &[u8]) -> Option<[usize; 2]> {
+    let mut ends: Option<[usize; 2]> = None;
+    for (k, bytes) in row.chunks(8).enumerate() {
+        let mut word = [0u8; 8];
+        word[..bytes.len()].copy_from_slice(bytes);
+        let v = u64::from_le_bytes(word);
         if v != 0 {
-            return Some(8 * k + v.trailing_zeros() as usize / 8);
+            let last = 8 * k + 7 - v.leading_zeros() as usize / 8;
+            let first = ends.map_or(8 * k + v.trailing_zeros() as usize / 8, |e| e[0]);
+            ends = Some([first, last]);
         }
     }
-    let base = row.len() - tail.len();
-    tail.iter().position(|&m| m != 0).map(|i| base + i)
-}
-
-/// Index of the last nonzero byte of `row`, 8 at a time.
-fn first_nonzero_from_end(row: &[u8]) -> Option<usize> {
-    let words = row.rchunks_exact(8);
-    let head = words.remainder();
-    for (k, w) in words.enumerate() {
-        let v = u64::from_le_bytes(w.try_into().expect("8 bytes"));
-        if v != 0 {
-            return Some(row.len() - 8 * k - 1 - v.leading_zeros() as usize / 8);
-        }
-    }
-    head.iter().rposition(|&m| m != 0)
+    ends
 }
 
 /// The bands of a `w`×`h` mask: for each run of rows with nonzero pixels, [x0, y0, x1, y1) of
@@ -237,7 +237,7 @@ fn mask_bands(mask: &[u8], w: usize, h: usize) -> Vec<[usize; 4]> {
     let mut out: Vec<[usize; 4]> = Vec::new();
     let mut open = false;
     for (y, row) in mask.chunks(w).take(h).enumerate() {
-        let (Some(first), Some(last)) = (first_nonzero(row), first_nonzero_from_end(row)) else {
+        let Some([first, last]) = nonzero_ends(row) else {
             open = false;
             continue;
         };
@@ -442,27 +442,18 @@ mod tests {
     fn keeps_the_strongest_first_spaced_and_inside_the_mask() {
         // Two rectangles, eight corners.
         let img = rectangles(&[[5, 8, 17, 20], [25, 10, 52, 40]]);
-        let all = find(&img, [0, 0, 60, 50], None, &SETTINGS);
+        let whole = |s: CornerSettings| find(&img, [0, 0, 60, 50], None, &s);
+        let all = whole(SETTINGS);
         assert_eq!(all.len(), 8, "{all:?}");
-        let two = find(
-            &img,
-            [0, 0, 60, 50],
-            None,
-            &CornerSettings {
-                max_corners: 2,
-                ..SETTINGS
-            },
-        );
+        let two = whole(CornerSettings {
+            max_corners: 2,
+            ..SETTINGS
+        });
         assert_eq!(two, all[..2]);
-        let apart = find(
-            &img,
-            [0, 0, 60, 50],
-            None,
-            &CornerSettings {
-                min_distance: 10.0,
-                ..SETTINGS
-            },
-        );
+        let apart = whole(CornerSettings {
+            min_distance: 10.0,
+            ..SETTINGS
+        });
         for (i, p) in apart.iter().enumerate() {
             for q in &apart[i + 1..] {
                 assert!((p[0] - q[0]).hypot(p[1] - q[1]) >= 10.0, "{p:?} {q:?}");
