@@ -139,7 +139,7 @@ pub(crate) fn image(
     for seg in 0..m {
         let (a, b) = (idx[seg], idx[seg + 1]);
         let dir = sub(knots[b], knots[a]);
-        let len = dir[0].hypot(dir[1]);
+        let len = (dir[0] * dir[0] + dir[1] * dir[1]).sqrt();
         let normal = if len > 1e-9 {
             [-dir[1] / len, dir[0] / len]
         } else {
