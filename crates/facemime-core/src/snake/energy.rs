@@ -19,7 +19,7 @@
 //! weighted per channel: `H = wL·(n·∇L) + wC·(n·∇C)`; the signs of wL, wC give the polarity of the
 //! edge. For `Magnitude`, `H = wL·|∇L| + wC·|∇C|`. The normal is held fixed while differentiating.
 
-use super::field::{Field, CX, CY, L, LPREV, LX, LY};
+use super::field::{Field, CX, CY, FIELD_CHANNELS, L, LPREV, LX, LY};
 
 /// The image operator H of a curve.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -164,7 +164,12 @@ pub(crate) fn image(
 /// H and (L − L')² at one point with their (x, y) gradients.
 #[inline]
 fn point_terms(field: &Field<'_>, x: f64, y: f64, nrm: P2, p: &CurveParams) -> (f64, P2, f64, P2) {
-    let s = field.sample(x, y);
+    // The derivative channels come first; the lumas only feed the temporal term.
+    let s = if p.gamma == 0.0 {
+        field.sample::<{ CY + 1 }>(x, y)
+    } else {
+        field.sample::<FIELD_CHANNELS>(x, y)
+    };
     let (v, dx, dy) = (&s.v, &s.dx, &s.dy);
     let f = |a: f32| a as f64;
     let (h, gh) = match p.operator {

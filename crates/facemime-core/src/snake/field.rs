@@ -58,10 +58,10 @@ impl<'a> Field<'a> {
         })
     }
 
-    /// Samples at frame point (x, y). Outside the block the border value is used and the
-    /// derivative across the border is zero.
+    /// Samples at frame point (x, y) the first `N` channels (the others are 0). Outside the
+    /// block the border value is used and the derivative across the border is zero.
     #[inline]
-    pub(crate) fn sample(&self, x: f64, y: f64) -> Sample {
+    pub(crate) fn sample<const N: usize>(&self, x: f64, y: f64) -> Sample {
         let (fx, cx, x0) = axis(x - self.origin[0], self.width);
         let (fy, cy, y0) = axis(y - self.origin[1], self.height);
         let row = self.width * FIELD_CHANNELS;
@@ -79,7 +79,7 @@ impl<'a> Field<'a> {
             dx: [0.0; FIELD_CHANNELS],
             dy: [0.0; FIELD_CHANNELS],
         };
-        for ch in 0..FIELD_CHANNELS {
+        for ch in 0..N.min(FIELD_CHANNELS) {
             let (va, vb) = (top[ch], top[FIELD_CHANNELS + ch]);
             let (vc, vd) = (bot[ch], bot[FIELD_CHANNELS + ch]);
             let top = va + fx * (vb - va);
@@ -130,20 +130,36 @@ mod tests {
     fn bilinear_value_and_derivatives_of_a_plane_are_exact() {
         let d = ramp(8, 6);
         let f = Field::new(&d, 8, 6, [10.0, 20.0]).unwrap();
-        let s = f.sample(13.25, 22.5);
+        let s = f.sample::<FIELD_CHANNELS>(13.25, 22.5);
         assert!((s.v[L] - (2.0 * 3.25 + 3.0 * 2.5)).abs() < 1e-5);
         assert!((s.dx[L] - 2.0).abs() < 1e-6 && (s.dy[L] - 3.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn sampling_the_first_channels_gives_them_as_sampling_all_does() {
+        let mut d = ramp(8, 6);
+        d.iter_mut()
+            .enumerate()
+            .for_each(|(i, v)| *v += (i % 7) as f32 * 0.37);
+        let f = Field::new(&d, 8, 6, [0.0, 0.0]).unwrap();
+        for (x, y) in [(3.3, 2.7), (-1.0, 4.2), (6.9, 5.5)] {
+            let (all, first) = (f.sample::<FIELD_CHANNELS>(x, y), f.sample::<4>(x, y));
+            for (a, b) in [(all.v, first.v), (all.dx, first.dx), (all.dy, first.dy)] {
+                assert_eq!(a[..4], b[..4]);
+                assert_eq!(b[4..], [0.0; 2]);
+            }
+        }
     }
 
     #[test]
     fn outside_the_block_takes_the_border_with_zero_derivative_across_it() {
         let d = ramp(8, 6);
         let f = Field::new(&d, 8, 6, [0.0, 0.0]).unwrap();
-        let s = f.sample(-5.0, 2.0);
+        let s = f.sample::<FIELD_CHANNELS>(-5.0, 2.0);
         assert_eq!(s.v[L], 6.0);
         assert_eq!(s.dx[L], 0.0);
         assert!((s.dy[L] - 3.0).abs() < 1e-6);
-        let s = f.sample(100.0, 100.0);
+        let s = f.sample::<FIELD_CHANNELS>(100.0, 100.0);
         assert_eq!(s.v[L], 2.0 * 7.0 + 3.0 * 5.0);
     }
 
