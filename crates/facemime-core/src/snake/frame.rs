@@ -7,7 +7,7 @@
 use std::time::{Duration, Instant};
 
 use super::field::{Field, FIELD_CHANNELS};
-use super::frame_field::frame_field;
+use super::frame_field::band_field;
 use super::rest::mean_of;
 use super::solver::{FrameInput, Problem, Solution};
 use crate::error::Result;
@@ -88,7 +88,8 @@ pub struct Knots<'a> {
 }
 
 /// One frame's knots from `knots`' start: the field of `frame` (and `prev`, see
-/// [`frame_field`]) smoothed by `smoothing` pixels in the `bands` around the start, written
+/// [`frame_field`]) smoothed by `smoothing` pixels in the `bands` around the start (see
+/// [`band_field`]: the solver reads only there), written
 /// into `buffer` (grown as needed and reused), a pass of the solver over every curve, then
 /// `more`'s passes. Returns the solution (iterations added up; each curve's response from the
 /// last pass that solved it) and the time of each stage.
@@ -112,7 +113,7 @@ pub fn solve_frame(
         buffer.resize(size, 0.0);
     }
     let data = &mut buffer[..size];
-    frame_field(frame, prev, b, smoothing, Some(&boxes), data)?;
+    band_field(frame, prev, b, smoothing, &boxes, data)?;
     let input = FrameInput {
         field: Field::new(data, w, h, [b[0] as f64, b[1] as f64])?,
         start: knots.start,
@@ -256,7 +257,99 @@ pub fn reported_knots(
 
 #[cfg(test)]
 mod tests {
+    use super::super::energy::{CurveParams, Operator};
+    use super::super::solver::Settings;
     use super::*;
+
+    #[test]
+    fn the_passes_read_the_field_only_inside_their_bands() {
+        // Bright ground, a dark bar for a brow (rows 20..26) and one for the lips (70..78);
+        // a brow curve 4 px above its bar's edge, a lip curve 6 px above its own, which gets
+        // more passes while it moves.
+        let (w, h) = (120, 100);
+        let rgb: Vec<u8> = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .flat_map(|(x, y)| {
+                let dark = ((20..26).contains(&y) && (25..95).contains(&x))
+                    || ((70..78).contains(&y) && (35..85).contains(&x));
+                let v = if dark { 60 } else { 200 } + ((x * 7 + y * 3) % 5) as u8;
+                [v, v - 10, v]
+            })
+            .collect();
+        let frame = ImageRef::new(&rgb, w, h, 3).unwrap();
+        let line = |x0: f64, y: f64| (0..5).map(move |k| [x0 + 12.0 * k as f64, y]);
+        let start: Vec<[f64; 2]> = line(30.0, 16.0).chain(line(36.0, 64.0)).collect();
+        let params = CurveParams {
+            alpha: 1.0,
+            beta: 1.0,
+            tau: 0.1,
+            rho: 1.0,
+            gamma: 0.0,
+            luma: -1.0,
+            chroma: 0.0,
+            operator: Operator::Directional,
+        };
+        let settings = Settings {
+            points_per_segment: 3,
+            delta0: 2.0,
+            sigma: 0.75,
+            iterations: 15,
+            tol: 0.0,
+        };
+        let (brow, lip): (Vec<usize>, Vec<usize>) = ((0..5).collect(), (5..10).collect());
+        let curves = vec![(brow.clone(), params), (lip.clone(), params)];
+        let problem = Problem::new(curves, vec![], 10, settings).unwrap();
+        // The tracker's margins: its passes' reach, the smoothing's and the cell's.
+        let margin = |passes: f64| passes * 8.0 + 4.0 * 1.5 + 2.0;
+        let bands = [
+            Band {
+                knots: &brow,
+                margin: margin(1.0),
+            },
+            Band {
+                knots: &lip,
+                margin: margin(3.0),
+            },
+        ];
+        let more = MorePasses {
+            knots: &lip,
+            curves: &[false, true],
+            passes: 3,
+            fast: 0.5,
+        };
+        let knots = Knots {
+            start: &start,
+            rest: &start,
+            down: [0.0, 1.0],
+            pair_targets: &[],
+            bounds: [w, h],
+        };
+        let mut buffer = Vec::new();
+        let (sol, _) = solve_frame(
+            &problem,
+            &frame,
+            None,
+            1.5,
+            &bands,
+            &more,
+            &knots,
+            &mut buffer,
+        )
+        .unwrap();
+        // Outside the bands the field holds NaN in debug builds: a read there would show here.
+        assert!(
+            sol.response.iter().all(|r| r.is_finite()),
+            "{:?}",
+            sol.response
+        );
+        assert!(sol.knots.iter().flatten().all(|v| v.is_finite()));
+        assert!(sol.iterations > 15, "the lips took more than one pass");
+        assert!(
+            lip.iter().all(|&i| (sol.knots[i][1] - 69.5).abs() < 1.5),
+            "{:?}",
+            sol.knots
+        );
+    }
 
     #[test]
     fn regions_cover_the_points_with_their_margin_inside_the_image() {
