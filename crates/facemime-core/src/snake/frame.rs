@@ -113,7 +113,11 @@ pub fn solve_frame(
         buffer.resize(size, 0.0);
     }
     let data = &mut buffer[..size];
-    band_field(frame, prev, b, smoothing, &boxes, data)?;
+    let colour: Vec<bool> = bands
+        .iter()
+        .map(|band| problem.reads_colour(band.knots))
+        .collect();
+    band_field(frame, prev, b, smoothing, (&boxes, &colour), data)?;
     let input = FrameInput {
         field: Field::new(data, w, h, [b[0] as f64, b[1] as f64])?,
         start: knots.start,

@@ -30,31 +30,47 @@ pub fn frame_field(
     bands: Option<&[[usize; 4]]>,
     out: &mut [f32],
 ) -> Result<()> {
+    let colour = bands.map(|b| vec![true; b.len()]);
+    let bands = bands.zip(colour.as_deref());
     field_into(frame, prev, region, sigma, bands, true, out)
 }
 
 /// [`frame_field`] with `bands`, for a reader that stays inside them (the solver of a frame,
 /// whose bands' margins cover every knot's reach): the pixels outside the bands are left as
 /// they were (NaN in debug builds, so that a read there shows), which saves zeroing the rows
-/// between the brows and the mouth frame after frame.
+/// between the brows and the mouth frame after frame. The colour derivatives are computed only
+/// in the bands flagged in `colour` (one flag per band), and are 0 in the others: the brows'
+/// curves do not weigh the colour channel.
 pub(crate) fn band_field(
     frame: &ImageRef,
     prev: Option<&ImageRef>,
     region: [usize; 4],
     sigma: f64,
-    bands: &[[usize; 4]],
+    (bands, colour): (&[[usize; 4]], &[bool]),
     out: &mut [f32],
 ) -> Result<()> {
-    field_into(frame, prev, region, sigma, Some(bands), false, out)
+    if colour.len() != bands.len() {
+        return invalid!("{} colour flags for {} bands", colour.len(), bands.len());
+    }
+    field_into(
+        frame,
+        prev,
+        region,
+        sigma,
+        Some((bands, colour)),
+        false,
+        out,
+    )
 }
 
-/// [`frame_field`], the pixels outside the bands set to 0 when `zero`.
+/// [`frame_field`]: the colour derivatives computed in the bands flagged, the pixels outside
+/// the bands set to 0 when `zero`.
 fn field_into(
     frame: &ImageRef,
     prev: Option<&ImageRef>,
     region: [usize; 4],
     sigma: f64,
-    bands: Option<&[[usize; 4]]>,
+    bands: Option<(&[[usize; 4]], &[bool])>,
     zero: bool,
     out: &mut [f32],
 ) -> Result<()> {
@@ -66,32 +82,49 @@ fn field_into(
         );
     }
     let [x0, y0, x1, y1] = region;
-    let wanted: Vec<Span> = match bands {
-        None => vec![[0, x1 - x0]; y1 - y0],
-        Some(b) => (y0..y1)
+    // Per region row, the span of the bands (those flagged, with `only`) holding it.
+    let spans = |only: bool| -> Vec<Span> {
+        let Some((b, colour)) = bands else {
+            return vec![[0, x1 - x0]; y1 - y0];
+        };
+        (y0..y1)
             .map(|y| {
                 let mut span = NONE;
-                for &[bx0, by0, bx1, by1] in b {
-                    if (by0..by1).contains(&y) {
+                for (&[bx0, by0, bx1, by1], &c) in b.iter().zip(colour) {
+                    if (by0..by1).contains(&y) && (c || !only) {
                         join(&mut span, bx0.clamp(x0, x1) - x0, bx1.clamp(x0, x1) - x0);
                     }
                 }
                 span
             })
-            .collect(),
+            .collect()
+    };
+    let rows = Rows {
+        wanted: spans(false),
+        colour: spans(true),
+        zero,
     };
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx512f") {
         // SAFETY: AVX-512F is present.
-        unsafe { build_avx512(frame, prev, region, sigma, (&wanted, zero), out) };
+        unsafe { build_avx512(frame, prev, region, sigma, &rows, out) };
         return Ok(());
     } else if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: AVX2 is present.
-        unsafe { build_avx2(frame, prev, region, sigma, (&wanted, zero), out) };
+        unsafe { build_avx2(frame, prev, region, sigma, &rows, out) };
         return Ok(());
     }
-    build(frame, prev, region, sigma, (&wanted, zero), out);
+    build(frame, prev, region, sigma, &rows, out);
     Ok(())
+}
+
+/// What [`build`] computes, per region row: the columns of every channel (`wanted`), those of
+/// the colour derivatives among them (`colour`; 0 in the rest of `wanted`), and whether the
+/// columns outside `wanted` are set to 0.
+struct Rows {
+    wanted: Vec<Span>,
+    colour: Vec<Span>,
+    zero: bool,
 }
 
 /// The columns `[c0, c1)` of one region row that a stage computes; empty when c0 ≥ c1.
@@ -249,29 +282,35 @@ fn blur(
     }
 }
 
-/// Luma and R − G planes of the region of `frame`, in its spans `spans` (the rest as it was).
+/// The luma plane of the region of `frame` in its spans `spans`, and with `chroma`, the R − G
+/// plane in that plane's spans (the rest as it was).
 #[inline(always)]
 fn planes(
     frame: &ImageRef,
     region: [usize; 4],
     spans: &[Span],
     luma: &mut Vec<f32>,
-    mut chroma: Option<&mut Vec<f32>>,
+    chroma: Option<(&mut Vec<f32>, &[Span])>,
 ) {
     let [x0, y0, x1, y1] = region;
     let w = x1 - x0;
-    luma.resize(w * (y1 - y0), 0.0);
-    if let Some(c) = chroma.as_deref_mut() {
-        c.resize(w * (y1 - y0), 0.0);
-    }
-    for (y, &[c0, c1]) in spans.iter().enumerate().filter(|(_, s)| s[0] < s[1]) {
+    // The pixels of row y's columns [c0, c1).
+    let pixels = |y: usize, c0: usize, c1: usize| {
         let row = &frame.data[((y0 + y) * frame.width + x0 + c0) * 3..][..(c1 - c0) * 3];
+        row.chunks_exact(3)
+    };
+    luma.resize(w * (y1 - y0), 0.0);
+    for (y, &[c0, c1]) in spans.iter().enumerate().filter(|(_, s)| s[0] < s[1]) {
         let at = y * w + c0;
-        for (l, p) in luma[at..at + c1 - c0].iter_mut().zip(row.chunks_exact(3)) {
+        for (l, p) in luma[at..at + c1 - c0].iter_mut().zip(pixels(y, c0, c1)) {
             *l = 0.299 * p[0] as f32 + 0.587 * p[1] as f32 + 0.114 * p[2] as f32;
         }
-        if let Some(c) = chroma.as_deref_mut() {
-            for (c, p) in c[at..at + c1 - c0].iter_mut().zip(row.chunks_exact(3)) {
+    }
+    if let Some((c, spans)) = chroma {
+        c.resize(w * (y1 - y0), 0.0);
+        for (y, &[c0, c1]) in spans.iter().enumerate().filter(|(_, s)| s[0] < s[1]) {
+            let at = y * w + c0;
+            for (c, p) in c[at..at + c1 - c0].iter_mut().zip(pixels(y, c0, c1)) {
                 *c = p[0] as f32 - p[1] as f32;
             }
         }
@@ -309,13 +348,14 @@ fn build(
     prev: Option<&ImageRef>,
     region: [usize; 4],
     sigma: f64,
-    (wanted, zero): (&[Span], bool),
+    rows: &Rows,
     out: &mut [f32],
 ) {
     let [x0, y0, x1, y1] = region;
     let (w, h) = (x1 - x0, y1 - y0);
     let taps = gaussian(sigma);
-    let (smoothed, across, converted) = needed(wanted, taps.len() / 2, w);
+    let (smoothed, across, converted) = needed(&rows.wanted, taps.len() / 2, w);
+    let (c_smoothed, c_across, c_converted) = needed(&rows.colour, taps.len() / 2, w);
     // Taken out and put back rather than borrowed in `SCRATCH.with(|s| ...)`, and no
     // `prev.map(|p| ...)`: a closure would not inherit `build_avx2`'s target feature.
     let mut scratch = SCRATCH.take();
@@ -325,10 +365,15 @@ fn build(
         prev_luma,
         blur: buffers,
     } = &mut scratch;
-    planes(frame, region, &converted, luma, Some(chroma));
-    for plane in [&mut *luma, &mut *chroma] {
-        blur(plane, w, &taps, &smoothed, &across, buffers);
-    }
+    planes(
+        frame,
+        region,
+        &converted,
+        luma,
+        Some((chroma, &c_converted)),
+    );
+    blur(luma, w, &taps, &smoothed, &across, buffers);
+    blur(chroma, w, &taps, &c_smoothed, &c_across, buffers);
     if let Some(p) = prev {
         planes(p, region, &converted, prev_luma, None);
         blur(prev_luma, w, &taps, &smoothed, &across, buffers);
@@ -344,12 +389,13 @@ fn build(
     fn line(plane: &[f32], w: usize, y: usize) -> &[f32] {
         &plane[y * w..][..w]
     }
-    for (y, (o, &[c0, c1])) in out
+    for (y, ((o, &[c0, c1]), &colour)) in out
         .chunks_exact_mut(w * FIELD_CHANNELS)
-        .zip(wanted)
+        .zip(&rows.wanted)
+        .zip(&rows.colour)
         .enumerate()
     {
-        let outside = if zero {
+        let outside = if rows.zero {
             Some(0.0)
         } else if cfg!(debug_assertions) {
             Some(f32::NAN)
@@ -366,9 +412,15 @@ fn build(
         // Central differences with mirrored borders: across an edge both neighbours are the
         // same pixel, so the first and last columns (and rows) get 0.
         let (up, down) = (reflect101(y as isize - 1, h), reflect101(y as isize + 1, h));
-        let (i0, i1) = (c0.max(1), c1.min(w - 1));
         let [dlx, dly, dcx, dcy] = &mut d;
-        for (plane, dx, dy) in [(luma, dlx, dly), (chroma, dcx, dcy)] {
+        // The colour derivatives are 0 in the wanted columns outside the colour span.
+        dcx[c0..c1].fill(0.0);
+        dcy[c0..c1].fill(0.0);
+        for (plane, dx, dy, [a0, a1]) in [(luma, dlx, dly, [c0, c1]), (chroma, dcx, dcy, colour)] {
+            if a0 >= a1 {
+                continue;
+            }
+            let (i0, i1) = (a0.max(1), a1.min(w - 1));
             let l = line(plane, w, y);
             dx[0] = 0.0;
             dx[w - 1] = 0.0;
@@ -378,7 +430,7 @@ fn build(
                 }
             }
             let (u, v) = (line(plane, w, up), line(plane, w, down));
-            for ((o, a), b) in dy[c0..c1].iter_mut().zip(&v[c0..]).zip(&u[c0..]) {
+            for ((o, a), b) in dy[a0..a1].iter_mut().zip(&v[a0..]).zip(&u[a0..]) {
                 *o = 0.5 * (a - b);
             }
         }
@@ -401,10 +453,10 @@ fn build_avx2(
     prev: Option<&ImageRef>,
     region: [usize; 4],
     sigma: f64,
-    wanted: (&[Span], bool),
+    rows: &Rows,
     out: &mut [f32],
 ) {
-    build(frame, prev, region, sigma, wanted, out)
+    build(frame, prev, region, sigma, rows, out)
 }
 
 /// [`build`] compiled for AVX-512; the same operations in the same order, so the same values.
@@ -415,14 +467,15 @@ fn build_avx512(
     prev: Option<&ImageRef>,
     region: [usize; 4],
     sigma: f64,
-    wanted: (&[Span], bool),
+    rows: &Rows,
     out: &mut [f32],
 ) {
-    build(frame, prev, region, sigma, wanted, out)
+    build(frame, prev, region, sigma, rows, out)
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::field::{CX, CY, L, LX, LY};
     use super::*;
 
     /// [`frame_field`] into a buffer of NaN: every value it leaves is one it wrote.
@@ -514,28 +567,34 @@ mod tests {
                 _ => NONE,
             })
             .collect();
-        let mut portable = vec![f32::NAN; 58 * 43 * FIELD_CHANNELS];
-        build(
-            &img,
-            Some(&img),
-            region,
-            1.5,
-            (&wanted, true),
-            &mut portable,
-        );
+        // Every band in colour (as frame_field computes it), and the lower one only.
+        let lower: Vec<Span> = wanted
+            .iter()
+            .zip(2..)
+            .map(|(&s, y)| if y >= 40 { s } else { NONE })
+            .collect();
+        let all = Rows {
+            wanted: wanted.clone(),
+            colour: wanted.clone(),
+            zero: true,
+        };
+        let part = Rows {
+            wanted,
+            colour: lower,
+            zero: true,
+        };
+        let portable = |rows: &Rows| {
+            let mut out = vec![f32::NAN; 58 * 43 * FIELD_CHANNELS];
+            build(&img, Some(&img), region, 1.5, rows, &mut out);
+            out
+        };
         let got = field(&img, Some(&img), region, 1.5, Some(&bands)).unwrap();
-        assert_eq!(got, portable);
+        assert_eq!(got, portable(&all));
         // Each SIMD build this machine has, not only the one `frame_field` picks.
         #[cfg(target_arch = "x86_64")]
         {
-            type Build = unsafe fn(
-                &ImageRef,
-                Option<&ImageRef>,
-                [usize; 4],
-                f64,
-                (&[Span], bool),
-                &mut [f32],
-            );
+            type Build =
+                unsafe fn(&ImageRef, Option<&ImageRef>, [usize; 4], f64, &Rows, &mut [f32]);
             let builds: [(&str, bool, Build); 2] = [
                 (
                     "avx2",
@@ -549,14 +608,47 @@ mod tests {
                 ),
             ];
             for (name, present, build) in builds {
-                if present {
-                    let mut out = vec![f32::NAN; portable.len()];
-                    // SAFETY: the CPU has the build's feature.
-                    unsafe { build(&img, Some(&img), region, 1.5, (&wanted, true), &mut out) };
-                    assert_eq!(out, portable, "{name}");
+                for rows in [&all, &part] {
+                    if present {
+                        let mut out = vec![f32::NAN; 58 * 43 * FIELD_CHANNELS];
+                        // SAFETY: the CPU has the build's feature.
+                        unsafe { build(&img, Some(&img), region, 1.5, rows, &mut out) };
+                        assert_eq!(out, portable(rows), "{name}");
+                    }
                 }
             }
         }
+    }
+
+    #[test]
+    fn the_colour_derivatives_are_computed_only_in_the_bands_that_want_them() {
+        let data = textured(50, 60);
+        let img = ImageRef::new(&data, 50, 60, 3).unwrap();
+        let region = [2, 3, 48, 57];
+        let bands = [[5, 6, 40, 15], [10, 40, 45, 52]];
+        let full = field(&img, None, region, 1.5, Some(&bands)).unwrap();
+        let mut out = vec![f32::NAN; full.len()];
+        band_field(&img, None, region, 1.5, (&bands, &[false, true]), &mut out).unwrap();
+        let w = region[2] - region[0];
+        for (i, (px, want)) in out
+            .chunks(FIELD_CHANNELS)
+            .zip(full.chunks(FIELD_CHANNELS))
+            .enumerate()
+        {
+            let (x, y) = (region[0] + i % w, region[1] + i / w);
+            let inside = |b: &[usize; 4]| (b[0]..b[2]).contains(&x) && (b[1]..b[3]).contains(&y);
+            if inside(&bands[1]) {
+                assert_eq!(px, want, "({x}, {y})");
+            } else if inside(&bands[0]) {
+                assert_eq!([px[CX], px[CY]], [0.0, 0.0], "({x}, {y})");
+                assert_eq!(
+                    [px[LX], px[LY], px[L]],
+                    [want[LX], want[LY], want[L]],
+                    "({x}, {y})"
+                );
+            }
+        }
+        assert!(band_field(&img, None, region, 1.5, (&bands, &[true]), &mut out).is_err());
     }
 
     #[test]

@@ -152,6 +152,13 @@ impl Problem {
         self.n_knots
     }
 
+    /// Whether a curve that weighs the colour channel has one of `knots`.
+    pub(crate) fn reads_colour(&self, knots: &[usize]) -> bool {
+        self.curves
+            .iter()
+            .any(|(idx, p)| p.chroma != 0.0 && idx.iter().any(|i| knots.contains(i)))
+    }
+
     pub fn n_curves(&self) -> usize {
         self.curves.len()
     }
