@@ -183,6 +183,45 @@ def frame_field(
     out: npt.NDArray[np.float32] | None = None,
 ) -> npt.NDArray[np.float32]: ...
 
+class FramePlan:
+    def __init__(
+        self,
+        knots0: npt.NDArray[np.float64],
+        down0: tuple[float, float],
+        targets0: npt.NDArray[np.float64],
+        response0: npt.NDArray[np.float64],
+        bounds: tuple[float, float],
+        mouth: npt.NDArray[np.uintp],
+        mouth_patch: float,
+        affine_groups: list[list[int]],
+        mouth_affine: float,
+        inner: npt.NDArray[np.uintp],
+        outer: npt.NDArray[np.uintp],
+        centring: float,
+        chord_ends: npt.NDArray[np.uintp],
+        least_chord: npt.NDArray[np.float64],
+        feature_curves: npt.NDArray[np.uintp],
+    ) -> None: ...
+    def begin(
+        self,
+        step: npt.NDArray[np.float64],
+        total: npt.NDArray[np.float64],
+        knots: npt.NDArray[np.float64],
+        flow: npt.NDArray[np.float64] | None,
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_] | None, bool, float, npt.NDArray[np.float64]]: ...
+    def settle(
+        self, start: npt.NDArray[np.float64], total: npt.NDArray[np.float64], scale: float
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+    def confidences(self, response: npt.NDArray[np.float64]) -> tuple[npt.NDArray[np.float64], list[float]]: ...
+    def assess(
+        self,
+        knots: npt.NDArray[np.float64],
+        rest: npt.NDArray[np.float64],
+        down: tuple[float, float],
+        response: npt.NDArray[np.float64],
+        carried: npt.NDArray[np.float64],
+    ) -> tuple[npt.NDArray[np.float64], list[float], list[bool]]: ...
+
 class SnakeSolver:
     """Curves over one shared knot array, solved jointly by sign descent (see facemime.track)."""
 

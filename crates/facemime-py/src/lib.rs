@@ -9,6 +9,7 @@ mod flow;
 mod head;
 mod lip_search;
 mod motion;
+mod plan;
 mod points;
 mod pose;
 mod raster;
@@ -22,6 +23,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     head::register(m)?;
     lip_search::register(m)?;
     motion::register(m)?;
+    plan::register(m)?;
     pose::register(m)?;
     raster::register(m)?;
     snake::register(m)?;

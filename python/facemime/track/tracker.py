@@ -304,13 +304,11 @@ class Tracker:
         ends = np.cumsum([0] + [len(self._index[n]) for n in CONTOUR_NAMES]).tolist()
         self._spans = list(zip(CONTOUR_NAMES, ends[:-1], ends[1:]))
         self._feature_rows = {f: np.array([CONTOUR_NAMES.index(n) for n in names]) for f, names in FEATURES.items()}
-        self._upper_rows, self._lower_rows = np.array(list(self._feature_rows.values())).T
         # Curve masks of the features solved on their own: the mouth's second pass, a brow found again.
         self._feature_curves = {f: np.isin(np.arange(len(CONTOUR_NAMES)), rows) for f, rows in self._feature_rows.items()}
         self._mouth_curves = np.array([n.startswith("mouth") for n in CONTOUR_NAMES])
         self._solver, self._targets0 = self._build_solver()
         self._field_buffer = np.empty(0, np.float32)
-        self._bounds_hi = np.array([self.width - 1.0, self.height - 1.0])  # the last pixel's centre
         gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
         self._motion = motion.HeadMotion(gray, contours) if p.motion else None
         if self._motion is not None:
@@ -336,6 +334,13 @@ class Tracker:
         self._response0 = np.maximum(self._responses(frame, edges, edges, self._down0, self._targets0), 1e-6)
         self._brow_search = {f: BrowSearch(gray, edges[self._features[f]]) for f in ("brow_left", "brow_right")}
         self._reported = self._reported_knots()
+        # The frame's steps around the solver, in the core: the start, the rest shape and gap
+        # targets, then the confidences and shape checks.
+        self._plan = _core.FramePlan(
+            self._knots0, tuple(self._down0), self._targets0, self._response0, (self.width - 1.0, self.height - 1.0),
+            self._mouth_uintp, p.mouth_patch, self._affine_groups, p.mouth_affine, self._inner_uintp,
+            self._outer_uintp, CENTRING, self._chord_ends, self._least_chord,
+            np.array(list(self._feature_rows.values()), np.uintp))
 
     def _build_solver(self) -> tuple[_core.SnakeSolver, np.ndarray]:
         p = self.params
@@ -425,13 +430,10 @@ class Tracker:
                                                    targets, curves, held)
         return knots, iters, resp
 
-    def _ratio(self, resp: np.ndarray) -> np.ndarray:
-        """Edge responses as fractions of the first frame's, clipped to 0..1 (the confidence)."""
-        return np.minimum(np.maximum(resp / self._response0, 0.0), 1.0)  # = np.clip, less overhead
-
-    def _confidences(self, ratio: np.ndarray) -> dict[str, float]:
-        """Each feature's confidence: the mean of its two curves' ``ratio`` (:meth:`_ratio`)."""
-        return dict(zip(FEATURES, ((ratio[self._upper_rows] + ratio[self._lower_rows]) / 2.0).tolist()))
+    def _confidences(self, resp: np.ndarray) -> dict[str, float]:
+        """Each feature's confidence: the mean of its two curves' edge responses ``resp`` as
+        fractions of the first frame's, clipped to 0..1 (``facemime._core.FramePlan``)."""
+        return dict(zip(FEATURES, self._plan.confidences(resp)[1]))
 
     def update(self, frame: np.ndarray) -> FrameResult:
         """Track one more frame, (H, W, 3) uint8 RGB of the first frame's size."""
@@ -448,33 +450,27 @@ class Tracker:
             step, ok, flow = self._motion.update(gray, self._reported[self._brow_knots],
                                                  self._knots if p.knot_flow else None)
         total = self._motion.total if self._motion is not None else motion.IDENTITY
-        # The head's scale, and the mouth's downward normal turned with the head.
-        scale, down = _core.scale_and_turn(total, tuple(self._down0))
-        down = np.array(down)
+        # Where the flow followed a knot, else where the head's step carries it; the head's
+        # scale, and the mouth's downward normal turned with the head.
+        start, followed, mouth_unfollowed, scale, down = self._plan.begin(step, total, self._knots, flow)
         reach = p.delta0 / (1.0 - p.sigma)
-        if flow is None:
-            start = _core.transformed(step, self._knots)
-        else:
-            # Where the flow followed a knot, else where the head's step carries it.
-            start, followed = _core.start_knots(step, self._knots, flow)
-            if np.count_nonzero(followed[self._mouth_knots]) < p.mouth_patch * len(self._mouth_knots):
+        if followed is not None:
+            if mouth_unfollowed:
                 self._mouth_sideways(gray, start, followed, step, down, reach)
             if self._lips is not None:
                 self._lips.move(frame, start, ~followed, scale)
-        start = np.minimum(np.maximum(start, 0.0), self._bounds_hi)  # = np.clip, less overhead
-        carried = _core.transformed(total, self._knots0)
-        rest = self._mouth_rest(carried, start)
-        targets = self._targets0 * scale
+        # The start inside the frame, the first frame's knots carried by the head, the rest
+        # shape (:meth:`_mouth_rest`) and the pairs' gaps at the head's scale.
+        carried, rest, targets = self._plan.settle(start, total, scale)
         # The field around the start, a solver pass, then more for the mouth while a mouth knot
         # moved FAST of a pass's reach in the last.
         knots, iters, resp = self._solver.track(frame, self._previous(), start, rest, tuple(down), targets,
                                                 (self.width, self.height), p.smoothing, self._frame_bands,
                                                 self._mouth_uintp, self._mouth_curves, p.mouth_passes, FAST * reach)
-        self._centre_inner(knots, rest, down)
+        # The inner mouth centred (:meth:`_centre_inner`), the confidences and shape checks.
+        ratio, confs, shapes = self._plan.assess(knots, rest, tuple(down), resp, carried)
+        confidences, shapes_ok = dict(zip(FEATURES, confs)), dict(zip(FEATURES, shapes))
         confidence, lost = {}, []
-        ratio = self._ratio(resp)
-        confidences = self._confidences(ratio)
-        shapes_ok = self._shapes_ok(knots, carried)
         for feature in FEATURES:
             rows, idx = self._feature_rows[feature], self._features[feature]
             conf = confidences[feature]
@@ -490,7 +486,7 @@ class Tracker:
                         again, more, again_resp = self._solve(self._field(frame, fallback, ((idx, 1),)), fallback,
                                                               rest, down, targets, self._feature_curves[feature])
                         iters += more
-                        conf_again = self._confidences(self._ratio(again_resp))[feature]
+                        conf_again = self._confidences(again_resp)[feature]
                         if conf_again > conf or not shape_ok:
                             knots[idx], conf = again[idx], conf_again
                             shape_ok = self._shape_ok(knots, carried, feature)
@@ -507,7 +503,7 @@ class Tracker:
                 confidence.update(found)
                 lost = [f for f in lost if not f.startswith("mouth")]
         if p.inner_search > 0 and "mouth_inner" in lost:
-            found, more = self._search_inner(frame, knots, rest, down, targets, carried, ratio)
+            found, more = self._search_inner(frame, knots, rest, down, targets, carried, confidences["mouth_inner"])
             iters += more
             if found is not None:
                 confidence["mouth_inner"] = found
@@ -539,12 +535,12 @@ class Tracker:
             start[mouth[~followed[mouth]]] += sideways * along
 
     def _search_inner(self, frame: np.ndarray, knots: np.ndarray, rest: np.ndarray, down: np.ndarray,
-                      targets: np.ndarray, carried: np.ndarray, ratio: np.ndarray) -> tuple[float | None, int]:
+                      targets: np.ndarray, carried: np.ndarray, conf: float) -> tuple[float | None, int]:
         """Look for a lost inner mouth (``inner_search``): each inner curve in turn, upper first, is
         moved along ``down`` by ±1 to ±``inner_search`` solver reaches and the inner mouth settled
         from there by a solver pass in which the outer mouth stays; the placement that gives the
-        inner mouth the highest confidence (``ratio``: the curves' confidences now) is kept when
-        higher than before. The inner knots are replaced (in place) when the inner mouth then
+        inner mouth the highest confidence (``conf``: its confidence now) is kept when higher than
+        before. The inner knots are replaced (in place) when the inner mouth then
         holds its edges (confidence at least ``lost_response``, shape sound against
         ``carried``). Returns its confidence then, else None; and the solver's iterations."""
         p = self.params
@@ -555,7 +551,7 @@ class Tracker:
         image = self._field(frame, knots, ((self._mouth_knots, p.inner_search + 1),))
         held = np.ones(len(knots), bool)
         held[inner] = False
-        placed, best, iters = knots.copy(), self._confidences(ratio)["mouth_inner"], 0
+        placed, best, iters = knots.copy(), conf, 0
         for name in FEATURES["mouth_inner"]:
             idx, found = self._index[name][1:-1], None
             for steps in range(-p.inner_search, p.inner_search + 1):
@@ -565,8 +561,8 @@ class Tracker:
                 trial[idx] += steps * reach * down
                 settled, more, resp = self._solve(image, trial, rest, down, targets, self._mouth_curves, held)
                 iters += more
-                if (conf := self._confidences(self._ratio(resp))["mouth_inner"]) > best:
-                    found, best = settled[inner], conf
+                if (trial_conf := self._confidences(resp)["mouth_inner"]) > best:
+                    found, best = settled[inner], trial_conf
             if found is not None:
                 placed[inner] = found
         if best >= p.lost_response and self._shape_ok(placed, carried, "mouth_inner"):
@@ -597,7 +593,7 @@ class Tracker:
                                            self._mouth_curves)
         self._centre_inner(settled, rest, down)
         features = ("mouth_outer", "mouth_inner")
-        confidence = {f: c for f, c in self._confidences(self._ratio(resp)).items() if f in features}
+        confidence = {f: c for f, c in self._confidences(resp).items() if f in features}
         if all(confidence[f] >= self.params.lost_response and self._shape_ok(settled, carried, f)
                for f in features):
             knots[mouth] = settled[mouth]

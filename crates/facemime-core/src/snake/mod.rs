@@ -12,6 +12,7 @@ mod energy;
 mod field;
 mod frame;
 mod frame_field;
+mod plan;
 mod rest;
 mod solver;
 
@@ -22,5 +23,6 @@ pub use frame::{
     Band, FrameTimes, Knots, MorePasses,
 };
 pub use frame_field::{field_shape, frame_field, MAX_SIGMA};
+pub use plan::{Assessed, Begun, FramePlan, Settled};
 pub use rest::affine_rest;
 pub use solver::{FrameInput, Problem, Settings, Solution};

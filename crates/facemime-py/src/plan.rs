@@ -1,0 +1,208 @@
+//! Bindings of `facemime_core::snake::FramePlan`: a tracker frame's steps around its solver
+//! passes, a call each.
+
+use facemime_core::snake;
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadwriteArray2,
+};
+use pyo3::prelude::*;
+
+use crate::error::CoreErr;
+use crate::points::{array, matrix, rows, same_length};
+
+/// (start (K, 2), followed (K,) or None, whether the mouth was followed too little, scale,
+/// down (2,)).
+type Begun<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Option<Bound<'py, PyArray1<bool>>>,
+    bool,
+    f64,
+    Bound<'py, PyArray1<f64>>,
+);
+
+/// (carried (K, 2), rest (K, 2), pair targets (P,)).
+type Settled<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<f64>>,
+);
+
+/// Each curve's confidence (C,) and each feature's.
+type Confidences<'py> = (Bound<'py, PyArray1<f64>>, Vec<f64>);
+
+/// Each curve's confidence (C,), each feature's, and each feature's shape check.
+type Assessed<'py> = (Bound<'py, PyArray1<f64>>, Vec<f64>, Vec<bool>);
+
+/// The rows of an (N, 2) index array.
+fn pairs(name: &str, a: &PyReadonlyArray2<usize>) -> PyResult<Vec<[usize; 2]>> {
+    let v = a.as_array();
+    if v.ncols() != 2 {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "{name} must have shape (N, 2), got {:?}",
+            v.shape()
+        )));
+    }
+    Ok(v.rows().into_iter().map(|r| [r[0], r[1]]).collect())
+}
+
+/// Writes `pts` into the (K, 2) array `out`.
+fn write(out: &mut PyReadwriteArray2<f64>, pts: &[[f64; 2]]) {
+    for (mut row, p) in out.as_array_mut().rows_mut().into_iter().zip(pts) {
+        row[0] = p[0];
+        row[1] = p[1];
+    }
+}
+
+/// See `facemime.track.tracker.Tracker` (its frame steps) and
+/// `facemime_core::snake::FramePlan` for the fields.
+#[pyclass(module = "facemime._core", frozen)]
+pub struct FramePlan {
+    plan: snake::FramePlan,
+}
+
+#[pymethods]
+impl FramePlan {
+    #[new]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        knots0: PyReadonlyArray2<f64>,
+        down0: (f64, f64),
+        targets0: PyReadonlyArray1<f64>,
+        response0: PyReadonlyArray1<f64>,
+        bounds: (f64, f64),
+        mouth: PyReadonlyArray1<usize>,
+        mouth_patch: f64,
+        affine_groups: Vec<Vec<usize>>,
+        mouth_affine: f64,
+        inner: PyReadonlyArray1<usize>,
+        outer: PyReadonlyArray1<usize>,
+        centring: f64,
+        chord_ends: PyReadonlyArray2<usize>,
+        least_chord: PyReadonlyArray1<f64>,
+        feature_curves: PyReadonlyArray2<usize>,
+    ) -> PyResult<Self> {
+        let plan = snake::FramePlan {
+            knots0: rows::<2>("knots0", &knots0)?,
+            down0: [down0.0, down0.1],
+            targets0: targets0.as_array().to_vec(),
+            response0: response0.as_array().to_vec(),
+            bounds: [bounds.0, bounds.1],
+            mouth: mouth.as_array().to_vec(),
+            mouth_patch,
+            affine_groups,
+            mouth_affine,
+            inner: inner.as_array().to_vec(),
+            outer: outer.as_array().to_vec(),
+            centring,
+            chord_ends: pairs("chord_ends", &chord_ends)?,
+            least_chord: least_chord.as_array().to_vec(),
+            feature_curves: pairs("feature_curves", &feature_curves)?,
+        };
+        plan.check().map_err(CoreErr)?;
+        Ok(Self { plan })
+    }
+
+    /// step, total: the head's 2×3 step from the previous frame and motion since the first;
+    /// knots: (K, 2) the previous frame's; flow: (K, 2) where the flow put them (NaN where it
+    /// failed) or None. Returns (start (K, 2), followed (K,) or None, whether the flow
+    /// followed too few mouth knots, the head's scale, down (2,)).
+    fn begin<'py>(
+        &self,
+        py: Python<'py>,
+        step: PyReadonlyArray2<f64>,
+        total: PyReadonlyArray2<f64>,
+        knots: PyReadonlyArray2<f64>,
+        flow: Option<PyReadonlyArray2<f64>>,
+    ) -> PyResult<Begun<'py>> {
+        let (step, total) = (matrix::<3>("step", &step)?, matrix::<3>("total", &total)?);
+        let knots = rows::<2>("knots", &knots)?;
+        same_length(&[("knots", knots.len()), ("knots0", self.plan.knots0.len())])?;
+        let flow = flow.map(|f| rows::<2>("flow", &f)).transpose()?;
+        if let Some(f) = &flow {
+            same_length(&[("knots", knots.len()), ("flow", f.len())])?;
+        }
+        let b = self.plan.begin(&step, &total, &knots, flow.as_deref());
+        Ok((
+            array(py, &b.start),
+            b.followed.map(|f| f.into_pyarray(py)),
+            b.mouth_unfollowed,
+            b.scale,
+            b.down.to_vec().into_pyarray(py),
+        ))
+    }
+
+    /// start: (K, 2), clipped to the frame in place; total: the head's 2×3 motion since the
+    /// first frame; scale: its scale. Returns (carried, rest, pair targets).
+    fn settle<'py>(
+        &self,
+        py: Python<'py>,
+        mut start: PyReadwriteArray2<f64>,
+        total: PyReadonlyArray2<f64>,
+        scale: f64,
+    ) -> PyResult<Settled<'py>> {
+        let total = matrix::<3>("total", &total)?;
+        let mut pts = rows::<2>("start", &start)?;
+        same_length(&[("start", pts.len()), ("knots0", self.plan.knots0.len())])?;
+        let s = self.plan.settle(&mut pts, &total, scale);
+        write(&mut start, &pts);
+        Ok((
+            array(py, &s.carried),
+            array(py, &s.rest),
+            s.targets.into_pyarray(py),
+        ))
+    }
+
+    /// response: (C,) each curve's edge response. Returns (each curve's confidence (C,), each
+    /// feature's).
+    fn confidences<'py>(
+        &self,
+        py: Python<'py>,
+        response: PyReadonlyArray1<f64>,
+    ) -> PyResult<Confidences<'py>> {
+        let response = response.as_array().to_vec();
+        same_length(&[
+            ("response", response.len()),
+            ("response0", self.plan.response0.len()),
+        ])?;
+        let (ratio, confidence) = self.plan.confidences(&response);
+        Ok((ratio.into_pyarray(py), confidence))
+    }
+
+    /// knots: (K, 2), the inner mouth slid back in place; rest, carried: (K, 2); down: unit
+    /// vector; response: (C,). Returns (each curve's confidence (C,), each feature's, each
+    /// feature's shape check).
+    fn assess<'py>(
+        &self,
+        py: Python<'py>,
+        mut knots: PyReadwriteArray2<f64>,
+        rest: PyReadonlyArray2<f64>,
+        down: (f64, f64),
+        response: PyReadonlyArray1<f64>,
+        carried: PyReadonlyArray2<f64>,
+    ) -> PyResult<Assessed<'py>> {
+        let mut pts = rows::<2>("knots", &knots)?;
+        let (rest, carried) = (rows::<2>("rest", &rest)?, rows::<2>("carried", &carried)?);
+        let response = response.as_array().to_vec();
+        let k = self.plan.knots0.len();
+        same_length(&[
+            ("knots", pts.len()),
+            ("rest", rest.len()),
+            ("carried", carried.len()),
+            ("knots0", k),
+        ])?;
+        same_length(&[
+            ("response", response.len()),
+            ("response0", self.plan.response0.len()),
+        ])?;
+        let a = self
+            .plan
+            .assess(&mut pts, &rest, [down.0, down.1], &response, &carried);
+        write(&mut knots, &pts);
+        Ok((a.ratio.into_pyarray(py), a.confidence, a.shape_ok))
+    }
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<FramePlan>()?;
+    Ok(())
+}
