@@ -22,20 +22,6 @@ fn robust_similarity<'py>(
     Ok((array(py, &m), inliers.into_pyarray(py)))
 }
 
-/// m: 2×3 transform; points: (K, 2) pixels. Returns the (K, 2) transformed points.
-#[pyfunction]
-fn transformed<'py>(
-    py: Python<'py>,
-    m: PyReadonlyArray2<f64>,
-    points: PyReadonlyArray2<f64>,
-) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let m = matrix::<3>("m", &m)?;
-    Ok(array(
-        py,
-        &motion::transformed(&m, &rows::<2>("points", &points)?),
-    ))
-}
-
 /// a, b: 2×3 transforms. Returns the 2×3 transform a ∘ b (b first).
 #[pyfunction]
 fn compose<'py>(
@@ -45,14 +31,6 @@ fn compose<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let (a, b) = (matrix::<3>("a", &a)?, matrix::<3>("b", &b)?);
     Ok(array(py, &motion::compose(&a, &b)))
-}
-
-/// m: a 2×3 similarity; v: a unit vector. Returns (the similarity's scale, v turned by it as a
-/// unit vector).
-#[pyfunction]
-fn scale_and_turn(m: PyReadonlyArray2<f64>, v: (f64, f64)) -> PyResult<(f64, (f64, f64))> {
-    let (scale, t) = motion::scale_and_turn(&matrix::<3>("m", &m)?, [v.0, v.1]);
-    Ok((scale, (t[0], t[1])))
 }
 
 /// points: (N, 2) pixels; margin: pixels; width, height: the frame's. Returns the integer box
@@ -79,8 +57,6 @@ fn grown_box(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(grown_box, m)?)?;
     m.add_function(wrap_pyfunction!(compose, m)?)?;
-    m.add_function(wrap_pyfunction!(transformed, m)?)?;
-    m.add_function(wrap_pyfunction!(scale_and_turn, m)?)?;
     m.add_function(wrap_pyfunction!(robust_similarity, m)?)?;
     Ok(())
 }

@@ -14,7 +14,7 @@ use pyo3::prelude::*;
 use std::sync::Mutex;
 
 use crate::error::CoreErr;
-use crate::points::{array, matrix, rows, same_length, MaskedPoints};
+use crate::points::{array, matrix, rows, same_length};
 
 fn err(msg: String) -> PyErr {
     PyValueError::new_err(msg)
@@ -525,23 +525,6 @@ fn centre_group(
     Ok(())
 }
 
-/// step: the head's 2×3 similarity; knots: (K, 2) pixels of the previous frame; flow: (K, 2)
-/// their positions by the optical flow, NaN where it failed. Returns ((K, 2) starting knots:
-/// the flow's where it followed them, else where the step carries them; (K,) followed mask).
-#[pyfunction]
-fn start_knots<'py>(
-    py: Python<'py>,
-    step: PyReadonlyArray2<f64>,
-    knots: PyReadonlyArray2<f64>,
-    flow: PyReadonlyArray2<f64>,
-) -> PyResult<MaskedPoints<'py>> {
-    let step = matrix::<3>("step", &step)?;
-    let (knots, flow) = (rows::<2>("knots", &knots)?, rows::<2>("flow", &flow)?);
-    same_length(&[("knots", knots.len()), ("flow", flow.len())])?;
-    let (start, followed) = snake::start_knots(&step, &knots, &flow);
-    Ok((array(py, &start), followed.into_pyarray(py)))
-}
-
 /// knots, rest: (K, 2) pixels; ends: (F, 2) knot index pairs (uintp); least: (F,) factors.
 /// Returns, per pair, whether its chord in `knots` is within `least` to 2 times its chord in
 /// `rest`.
@@ -600,7 +583,6 @@ fn reported_knots<'py>(
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<SnakeSolver>()?;
-    m.add_function(wrap_pyfunction!(start_knots, m)?)?;
     m.add_function(wrap_pyfunction!(chords_within, m)?)?;
     m.add_function(wrap_pyfunction!(reported_knots, m)?)?;
     m.add_function(wrap_pyfunction!(centre_group, m)?)?;
