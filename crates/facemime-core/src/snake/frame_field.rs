@@ -389,19 +389,20 @@ fn build(
     fn line(plane: &[f32], w: usize, y: usize) -> &[f32] {
         &plane[y * w..][..w]
     }
+    // What the columns outside the wanted ones get: 0, or nothing (NaN in debug builds).
+    let outside = if rows.zero {
+        Some(0.0)
+    } else if cfg!(debug_assertions) {
+        Some(f32::NAN)
+    } else {
+        None
+    };
     for (y, ((o, &[c0, c1]), &colour)) in out
         .chunks_exact_mut(w * FIELD_CHANNELS)
         .zip(&rows.wanted)
         .zip(&rows.colour)
         .enumerate()
     {
-        let outside = if rows.zero {
-            Some(0.0)
-        } else if cfg!(debug_assertions) {
-            Some(f32::NAN)
-        } else {
-            None
-        };
         if let Some(v) = outside {
             o[..c0.min(c1) * FIELD_CHANNELS].fill(v);
             o[c1 * FIELD_CHANNELS..].fill(v);
