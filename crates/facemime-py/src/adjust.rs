@@ -48,12 +48,12 @@ fn elastic_adjust<'py>(
     iterations: usize,
     tolerance: f64,
 ) -> PyResult<Adjusted<'py>> {
-    let mut pts = rows::<2>("points", &points)?;
+    let mut pts = rows::<2, _>("points", &points)?;
     let chain_list: Vec<usize> = chains.as_array().iter().map(|&i| i as usize).collect();
     let chain_runs = runs("chains", &chain_list, chain_lengths.as_slice()?)?;
     let target_runs = runs(
         "targets",
-        &rows::<2>("targets", &targets)?,
+        &rows::<2, _>("targets", &targets)?,
         target_lengths.as_slice()?,
     )?;
     if chain_runs.len() != target_runs.len() {

@@ -73,7 +73,7 @@ impl FlowFrames {
         min_eigen: f64,
     ) -> PyResult<MaskedPoints<'py>> {
         self.ready()?;
-        let pts = rows::<2>("points", &points)?;
+        let pts = rows::<2, _>("points", &points)?;
         let params = LkParams {
             iterations,
             epsilon,

@@ -14,18 +14,6 @@ use crate::points::{array, gray_view, matrix, point_rows, rows};
 /// The head's similarity step or None, and the extra points' positions.
 type Step<'py> = (Option<Bound<'py, PyArray2<f64>>>, Bound<'py, PyArray2<f64>>);
 
-/// The rows of a (M, 2) float32 point array.
-fn points_f32(points: &PyReadonlyArray2<f32>) -> PyResult<Vec<[f32; 2]>> {
-    let v = points.as_array();
-    if v.shape()[1] != 2 {
-        return Err(PyValueError::new_err(format!(
-            "points must have shape (M, 2), got {:?}",
-            v.shape()
-        )));
-    }
-    Ok(v.rows().into_iter().map(|r| [r[0], r[1]]).collect())
-}
-
 /// (M, 2) float32 points.
 fn f32_rows<'py>(py: Python<'py>, pts: &[[f32; 2]]) -> Bound<'py, PyArray2<f32>> {
     let flat: Vec<f32> = pts.iter().flatten().copied().collect();
@@ -35,10 +23,10 @@ fn f32_rows<'py>(py: Python<'py>, pts: &[[f32; 2]]) -> Bound<'py, PyArray2<f32>>
 }
 
 /// (M, 2) float32 points and their (M,) int64 identities.
-fn identified<'py>(
-    py: Python<'py>,
-    (pts, ids): (&[[f32; 2]], &[i64]),
-) -> (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<i64>>) {
+type Identified<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<i64>>);
+
+/// [`Identified`] from the core's points and identities.
+fn identified<'py>(py: Python<'py>, (pts, ids): (&[[f32; 2]], &[i64])) -> Identified<'py> {
     (f32_rows(py, pts), ids.to_vec().into_pyarray(py))
 }
 
@@ -97,8 +85,8 @@ impl HeadFollower {
                 min_eigen,
             },
         };
-        let brows = rows::<2>("brows", &brows)?;
-        let points = points_f32(&points)?;
+        let brows = rows::<2, _>("brows", &brows)?;
+        let points = rows::<2, _>("points", &points)?;
         let head = head::HeadFollower::new(data, width, height, brows, zones, points, settings)
             .map_err(CoreErr)?;
         Ok(Self { head })
@@ -115,7 +103,10 @@ impl HeadFollower {
         extra: PyReadonlyArray2<f64>,
     ) -> PyResult<Step<'py>> {
         let (data, width, height) = gray_view(&gray)?;
-        let (brows, extra) = (rows::<2>("brows", &brows)?, rows::<2>("extra", &extra)?);
+        let (brows, extra) = (
+            rows::<2, _>("brows", &brows)?,
+            rows::<2, _>("extra", &extra)?,
+        );
         let head = &mut self.head;
         let got = py
             .detach(|| head.follow(data, width, height, &brows, &extra))
@@ -134,7 +125,7 @@ impl HeadFollower {
 
     /// points: (M, 2) float32, new corners replacing the rigid points (new identities).
     fn detected(&mut self, points: PyReadonlyArray2<f32>) -> PyResult<()> {
-        self.head.detected(points_f32(&points)?);
+        self.head.detected(rows::<2, _>("points", &points)?);
         Ok(())
     }
 
@@ -155,19 +146,13 @@ impl HeadFollower {
 
     /// ((M, 2) float32, (M,) int64): the rigid points now and their identities.
     #[getter]
-    fn points<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<i64>>) {
+    fn points<'py>(&self, py: Python<'py>) -> Identified<'py> {
         identified(py, self.head.points())
     }
 
     /// ((M, 2) float32, (M,) int64): the points followed from the previous frame.
     #[getter]
-    fn followed<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<i64>>) {
+    fn followed<'py>(&self, py: Python<'py>) -> Identified<'py> {
         identified(py, self.head.followed())
     }
 }

@@ -9,7 +9,7 @@ use numpy::{
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
-use crate::points::rows;
+use crate::points::{rows, write_rows};
 use crate::snake::rgb_view;
 
 /// The core's lip colour from (w_r, w_g, bias).
@@ -63,7 +63,7 @@ impl LipPlacer {
         edges: PyReadonlyArray2<f64>,
     ) -> PyResult<Self> {
         let img = rgb_view("frame", &frame)?;
-        let edges = rows::<2>("edges", &edges)?;
+        let edges = rows::<2, _>("edges", &edges)?;
         let colour = lip_colour(colour);
         let placer = py
             .detach(|| {
@@ -85,15 +85,11 @@ impl LipPlacer {
         scale: f64,
     ) -> PyResult<()> {
         let img = rgb_view("frame", &frame)?;
-        let mut pts = rows::<2>("knots", &knots)?;
+        let mut pts = rows::<2, _>("knots", &knots)?;
         let unfollowed = unfollowed.as_array().to_vec();
         py.detach(|| self.placer.place(&img, &mut pts, &unfollowed, scale))
             .map_err(CoreErr)?;
-        let mut out = knots.as_array_mut();
-        for (mut row, p) in out.rows_mut().into_iter().zip(&pts) {
-            row[0] = p[0];
-            row[1] = p[1];
-        }
+        write_rows(&mut knots, &pts);
         Ok(())
     }
 }

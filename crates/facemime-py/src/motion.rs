@@ -16,7 +16,7 @@ fn robust_similarity<'py>(
     limit: f64,
     rounds: usize,
 ) -> PyResult<MaskedPoints<'py>> {
-    let (s, d) = (rows::<2>("src", &src)?, rows::<2>("dst", &dst)?);
+    let (s, d) = (rows::<2, _>("src", &src)?, rows::<2, _>("dst", &dst)?);
     same_length(&[("src", s.len()), ("dst", d.len())])?;
     let (m, inliers) = py.detach(|| motion::robust_similarity(&s, &d, limit, rounds));
     Ok((array(py, &m), inliers.into_pyarray(py)))
@@ -44,7 +44,7 @@ fn grown_box(
     width: usize,
     height: usize,
 ) -> PyResult<(i64, i64, i64, i64)> {
-    let pts = rows::<2>("points", &points)?;
+    let pts = rows::<2, _>("points", &points)?;
     if pts.is_empty() {
         return Err(pyo3::exceptions::PyValueError::new_err(
             "a box needs at least one point",

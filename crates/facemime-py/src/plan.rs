@@ -8,7 +8,7 @@ use numpy::{
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
-use crate::points::{array, matrix, rows, same_length};
+use crate::points::{array, matrix, rows, same_length, write_rows};
 
 /// (start (K, 2), followed (K,) or None, whether the mouth was followed too little, scale,
 /// down (2,)).
@@ -32,26 +32,6 @@ type Confidences<'py> = (Bound<'py, PyArray1<f64>>, Vec<f64>);
 
 /// Each curve's confidence (C,), each feature's, and each feature's shape check.
 type Assessed<'py> = (Bound<'py, PyArray1<f64>>, Vec<f64>, Vec<bool>);
-
-/// The rows of an (N, 2) index array.
-fn pairs(name: &str, a: &PyReadonlyArray2<usize>) -> PyResult<Vec<[usize; 2]>> {
-    let v = a.as_array();
-    if v.ncols() != 2 {
-        return Err(pyo3::exceptions::PyValueError::new_err(format!(
-            "{name} must have shape (N, 2), got {:?}",
-            v.shape()
-        )));
-    }
-    Ok(v.rows().into_iter().map(|r| [r[0], r[1]]).collect())
-}
-
-/// Writes `pts` into the (K, 2) array `out`.
-fn write(out: &mut PyReadwriteArray2<f64>, pts: &[[f64; 2]]) {
-    for (mut row, p) in out.as_array_mut().rows_mut().into_iter().zip(pts) {
-        row[0] = p[0];
-        row[1] = p[1];
-    }
-}
 
 /// See `facemime.track.tracker.Tracker` (its frame steps) and
 /// `facemime_core::snake::FramePlan` for the fields.
@@ -82,7 +62,7 @@ impl FramePlan {
         feature_curves: PyReadonlyArray2<usize>,
     ) -> PyResult<Self> {
         let plan = snake::FramePlan {
-            knots0: rows::<2>("knots0", &knots0)?,
+            knots0: rows::<2, _>("knots0", &knots0)?,
             down0: [down0.0, down0.1],
             targets0: targets0.as_array().to_vec(),
             response0: response0.as_array().to_vec(),
@@ -94,9 +74,9 @@ impl FramePlan {
             inner: inner.as_array().to_vec(),
             outer: outer.as_array().to_vec(),
             centring,
-            chord_ends: pairs("chord_ends", &chord_ends)?,
+            chord_ends: rows::<2, _>("chord_ends", &chord_ends)?,
             least_chord: least_chord.as_array().to_vec(),
-            feature_curves: pairs("feature_curves", &feature_curves)?,
+            feature_curves: rows::<2, _>("feature_curves", &feature_curves)?,
         };
         plan.check().map_err(CoreErr)?;
         Ok(Self { plan })
@@ -115,9 +95,9 @@ impl FramePlan {
         flow: Option<PyReadonlyArray2<f64>>,
     ) -> PyResult<Begun<'py>> {
         let (step, total) = (matrix::<3>("step", &step)?, matrix::<3>("total", &total)?);
-        let knots = rows::<2>("knots", &knots)?;
+        let knots = rows::<2, _>("knots", &knots)?;
         same_length(&[("knots", knots.len()), ("knots0", self.plan.knots0.len())])?;
-        let flow = flow.map(|f| rows::<2>("flow", &f)).transpose()?;
+        let flow = flow.map(|f| rows::<2, _>("flow", &f)).transpose()?;
         if let Some(f) = &flow {
             same_length(&[("knots", knots.len()), ("flow", f.len())])?;
         }
@@ -141,10 +121,10 @@ impl FramePlan {
         scale: f64,
     ) -> PyResult<Settled<'py>> {
         let total = matrix::<3>("total", &total)?;
-        let mut pts = rows::<2>("start", &start)?;
+        let mut pts = rows::<2, _>("start", &start)?;
         same_length(&[("start", pts.len()), ("knots0", self.plan.knots0.len())])?;
         let s = self.plan.settle(&mut pts, &total, scale);
-        write(&mut start, &pts);
+        write_rows(&mut start, &pts);
         Ok((
             array(py, &s.carried),
             array(py, &s.rest),
@@ -180,8 +160,11 @@ impl FramePlan {
         response: PyReadonlyArray1<f64>,
         carried: PyReadonlyArray2<f64>,
     ) -> PyResult<Assessed<'py>> {
-        let mut pts = rows::<2>("knots", &knots)?;
-        let (rest, carried) = (rows::<2>("rest", &rest)?, rows::<2>("carried", &carried)?);
+        let mut pts = rows::<2, _>("knots", &knots)?;
+        let (rest, carried) = (
+            rows::<2, _>("rest", &rest)?,
+            rows::<2, _>("carried", &carried)?,
+        );
         let response = response.as_array().to_vec();
         let k = self.plan.knots0.len();
         same_length(&[
@@ -197,7 +180,7 @@ impl FramePlan {
         let a = self
             .plan
             .assess(&mut pts, &rest, [down.0, down.1], &response, &carried);
-        write(&mut knots, &pts);
+        write_rows(&mut knots, &pts);
         Ok((a.ratio.into_pyarray(py), a.confidence, a.shape_ok))
     }
 }

@@ -1,11 +1,18 @@
 //! Point arrays from numpy: (K, 2) pixel or (K, 3) model coordinates as fixed-size rows.
 
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{
+    Element, IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyReadwriteArray2,
+    PyUntypedArrayMethods,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-/// The rows of a (K, D) float64 array; a clear error naming `name` for another shape.
-pub fn rows<const D: usize>(name: &str, a: &PyReadonlyArray2<f64>) -> PyResult<Vec<[f64; D]>> {
+/// The rows of a (K, D) array (float64 points, float32 corners, index pairs); a clear error
+/// naming `name` for another shape.
+pub fn rows<const D: usize, T: Element + Copy>(
+    name: &str,
+    a: &PyReadonlyArray2<T>,
+) -> PyResult<Vec<[T; D]>> {
     let v = a.as_array();
     if v.shape()[1] != D {
         return Err(PyValueError::new_err(format!(
@@ -19,10 +26,18 @@ pub fn rows<const D: usize>(name: &str, a: &PyReadonlyArray2<f64>) -> PyResult<V
         .collect())
 }
 
+/// Writes `pts` into the (K, 2) array `out`, row by row.
+pub fn write_rows(out: &mut PyReadwriteArray2<f64>, pts: &[[f64; 2]]) {
+    for (mut row, p) in out.as_array_mut().rows_mut().into_iter().zip(pts) {
+        row[0] = p[0];
+        row[1] = p[1];
+    }
+}
+
 /// A (2, C) float64 array (a 2×3 transform, a 2×2 linear map) as its two rows; a clear error
 /// naming `name` for another shape.
 pub fn matrix<const C: usize>(name: &str, m: &PyReadonlyArray2<f64>) -> PyResult<[[f64; C]; 2]> {
-    match rows::<C>(name, m)?.as_slice() {
+    match rows::<C, _>(name, m)?.as_slice() {
         &[a, b] => Ok([a, b]),
         r => Err(PyValueError::new_err(format!(
             "{name} must have shape (2, {C}), got ({}, {C})",

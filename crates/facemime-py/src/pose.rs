@@ -22,8 +22,8 @@ fn fit_pose(
     iterations: usize,
 ) -> PyResult<[f64; 6]> {
     let (x, t) = (
-        rows::<3>("model_points", &model_points)?,
-        rows::<2>("image_points", &image_points)?,
+        rows::<3, _>("model_points", &model_points)?,
+        rows::<2, _>("image_points", &image_points)?,
     );
     same_length(&[("model_points", x.len()), ("image_points", t.len())])?;
     let settings = FitSettings {

@@ -249,7 +249,7 @@ impl SnakeSolver {
         let img = rgb_view("frame", &frame)?;
         frame_size(bounds.0, bounds.1)?;
         let before = prev.as_ref().map(|p| rgb_view("prev", p)).transpose()?;
-        let (start, rest) = (rows::<2>("start", &start)?, rows::<2>("rest", &rest)?);
+        let (start, rest) = (rows::<2, _>("start", &start)?, rows::<2, _>("rest", &rest)?);
         let n = self.problem.n_knots();
         if start.len() != n || rest.len() != n {
             return Err(err(format!(
@@ -371,8 +371,8 @@ impl<'a> FrameArgs<'a> {
             shape,
             origin: [origin.0, origin.1],
             bounds: [bounds.0, bounds.1],
-            start: rows::<2>("start", start)?,
-            rest: rows::<2>("rest", rest)?,
+            start: rows::<2, _>("start", start)?,
+            rest: rows::<2, _>("rest", rest)?,
             down: [down.0, down.1],
             targets: pair_targets.as_array().to_vec(),
         })
@@ -466,7 +466,10 @@ fn affine_rest<'py>(
     groups: Vec<Vec<usize>>,
     amount: f64,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let (a, b) = (rows::<2>("carried", &carried)?, rows::<2>("start", &start)?);
+    let (a, b) = (
+        rows::<2, _>("carried", &carried)?,
+        rows::<2, _>("start", &start)?,
+    );
     same_length(&[("carried", a.len()), ("start", b.len())])?;
     if let Some(&k) = groups.iter().flatten().find(|&&k| k >= a.len()) {
         return Err(err(format!("knot index {k} is past the {} knots", a.len())));
@@ -486,7 +489,7 @@ fn field_regions(
     width: usize,
     height: usize,
 ) -> PyResult<([usize; 4], Vec<[usize; 4]>)> {
-    let knots = rows::<2>("knots", &knots)?;
+    let knots = rows::<2, _>("knots", &knots)?;
     let bands = bands_of(&bands, knots.len())?;
     frame_size(width, height)?;
     Ok(snake::band_regions(&knots, &bands, width, height))
@@ -505,7 +508,7 @@ fn centre_group(
     along: (f64, f64),
     amount: f64,
 ) -> PyResult<()> {
-    let (mut pts, rest) = (rows::<2>("knots", &knots)?, rows::<2>("rest", &rest)?);
+    let (mut pts, rest) = (rows::<2, _>("knots", &knots)?, rows::<2, _>("rest", &rest)?);
     same_length(&[("knots", pts.len()), ("rest", rest.len())])?;
     let indices = |a: &PyReadonlyArray1<usize>, name: &str| -> PyResult<Vec<usize>> {
         let v = a.as_array().to_vec();
@@ -535,16 +538,9 @@ fn chords_within(
     ends: PyReadonlyArray2<usize>,
     least: PyReadonlyArray1<f64>,
 ) -> PyResult<Vec<bool>> {
-    let (knots, rest) = (rows::<2>("knots", &knots)?, rows::<2>("rest", &rest)?);
-    let e = ends.as_array();
-    if e.ncols() != 2 || least.len() != e.nrows() {
-        return Err(err(format!(
-            "ends must be (F, 2) and least (F,), got {:?} and ({},)",
-            e.shape(),
-            least.len()
-        )));
-    }
-    let ends: Vec<[usize; 2]> = e.rows().into_iter().map(|r| [r[0], r[1]]).collect();
+    let (knots, rest) = (rows::<2, _>("knots", &knots)?, rows::<2, _>("rest", &rest)?);
+    let ends = rows::<2, _>("ends", &ends)?;
+    same_length(&[("ends", ends.len()), ("least", least.len())])?;
     within("ends", ends.as_flattened(), knots.len().min(rest.len()))?;
     Ok(snake::chords_within(
         &knots,
@@ -568,7 +564,10 @@ fn reported_knots<'py>(
     upper: PyReadonlyArray1<usize>,
     lower: PyReadonlyArray1<usize>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let (knots, offset) = (rows::<2>("knots", &knots)?, rows::<2>("offset", &offset)?);
+    let (knots, offset) = (
+        rows::<2, _>("knots", &knots)?,
+        rows::<2, _>("offset", &offset)?,
+    );
     same_length(&[("knots", knots.len()), ("offset", offset.len())])?;
     let linear = matrix::<2>("linear", &linear)?;
     let (upper, lower) = (upper.as_array().to_vec(), lower.as_array().to_vec());
