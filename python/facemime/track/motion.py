@@ -94,11 +94,11 @@ IDENTITY = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 
 class HeadMotion:
     """Follows the head from frame to frame. Feed gray (H, W) uint8 frames to :meth:`update`
-    with the contours tracked in the previous frame: they place the rigid zones, so the points
-    stay on the face even when the accumulated motion drifts. The flow, the fit and the zones
-    run in the core (``facemime._core.HeadFollower``), and so does finding corners
-    (``facemime._core.good_features``, OpenCV's ``goodFeaturesToTrack``); the coarse fallback
-    is OpenCV's, here.
+    with the brow points tracked in the previous frame (:meth:`brow_points` of its contours):
+    they place the rigid zones, so the points stay on the face even when the accumulated motion
+    drifts. The flow, the fit and the zones run in the core (``facemime._core.HeadFollower``),
+    and so does finding corners (``facemime._core.good_features``, OpenCV's
+    ``goodFeaturesToTrack``); the coarse fallback is OpenCV's, here.
 
     ``total`` is the accumulated transform from the first frame to the current one. ``points``
     (M, 2) float32 are the rigid points followed into the current frame and ``ids`` (M,) int64
