@@ -58,7 +58,7 @@ class HeadFollower:
 
     def __init__(
         self,
-        gray: npt.NDArray[np.uint8],
+        frame: npt.NDArray[np.uint8],
         brows: npt.NDArray[np.float64],
         zones: npt.NDArray[np.float64],
         points: npt.NDArray[np.float32],
@@ -73,7 +73,7 @@ class HeadFollower:
         min_eigen: float,
     ) -> None: ...
     def follow(
-        self, gray: npt.NDArray[np.uint8], brows: npt.NDArray[np.float64], extra: npt.NDArray[np.float64]
+        self, frame: npt.NDArray[np.uint8], brows: npt.NDArray[np.float64], extra: npt.NDArray[np.float64]
     ) -> tuple[npt.NDArray[np.float64] | None, npt.NDArray[np.float64]]: ...
     def advance(self, step: npt.NDArray[np.float64]) -> bool: ...
     def detected(self, points: npt.NDArray[np.float32]) -> None: ...

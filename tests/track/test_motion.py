@@ -60,6 +60,25 @@ def test_the_head_motion_carries_the_nose_with_the_face(shared):
         assert np.abs(moved - lm[t][NOSE_BRIDGE, :2]).max() < 0.03 * iod[t], t
 
 
+def test_rgb_frames_are_followed_as_their_opencv_grey_levels(shared):
+    # The core converts the part of an RGB frame the flow reads itself; the head's track is
+    # the one OpenCV's RGB2GRAY frames give, bit for bit (lp_d12 turns its head: new corners
+    # are found in RGB frames too).
+    with VideoReader(shared / "video" / "lp_d12.mp4") as reader:
+        frames = list(itertools.islice(reader, 30))
+    lm = np.load(shared / "video" / "lp_d12.landmarks.npz")["landmarks"]
+    rgb = HeadMotion(frames[0], from_face_mesh(lm[0]))
+    grey = HeadMotion(cv2.cvtColor(frames[0], cv2.COLOR_RGB2GRAY), from_face_mesh(lm[0]))
+    for t in range(1, len(frames)):
+        brows = rgb.brow_points(from_face_mesh(lm[t - 1]))
+        a = rgb.update(frames[t], brows, extra=lm[t - 1][:, :2])
+        b = grey.update(cv2.cvtColor(frames[t], cv2.COLOR_RGB2GRAY), brows, extra=lm[t - 1][:, :2])
+        np.testing.assert_array_equal(a[0], b[0])
+        np.testing.assert_array_equal(a[2], b[2])
+        np.testing.assert_array_equal(rgb.points, grey.points)
+        np.testing.assert_array_equal(rgb.ids, grey.ids)
+
+
 def test_points_keep_their_identity_while_followed_and_new_ones_get_new_ones(shared):
     # lp_d12 turns its head: points fail the similarity fit and new ones are found often.
     frames, lm, _ = gray_frames(shared, "lp_d12", 40)

@@ -14,6 +14,7 @@ use crate::extent::extent;
 use crate::flow::{LkParams, Pyramid};
 use crate::invalid;
 use crate::motion::{apply, follow_rigid, inside_quads, robust_similarity};
+use crate::raster::ImageRef;
 
 /// A convex quadrilateral, corners in order (pixels).
 pub type Quad = [[f64; 2]; 4];
@@ -74,14 +75,12 @@ fn widen(p: &[f32; 2]) -> [f64; 2] {
 }
 
 impl HeadFollower {
-    /// Starts on the first frame, a row-major `width`×`height` grey image: `brows0` are its
+    /// Starts on the first frame, a grey or RGB image: `brows0` are its
     /// brow points (later frames' brows are matched to them point by point), `zones0` its
     /// rigid zones, `points` the corners found in them (they get identities 0, 1, ...; from
     /// then on, fewer than half as many, or than `min_points`, call for new ones).
     pub fn new(
-        gray: &[u8],
-        width: usize,
-        height: usize,
+        frame: &ImageRef,
         brows0: Vec<[f64; 2]>,
         zones0: Vec<Quad>,
         points: Vec<[f32; 2]>,
@@ -106,7 +105,7 @@ impl HeadFollower {
         head.detected(points);
         head.followed = (head.points.clone(), head.ids.clone());
         head.wanted = settings.min_points.max(head.points.len() / 2);
-        head.push(gray, width, height, &[])?;
+        head.push(frame, &[])?;
         Ok(head)
     }
 
@@ -138,15 +137,13 @@ impl HeadFollower {
         self.ids.clear();
     }
 
-    /// The next frame: the zones placed by the previous frame's `brows` (as many as the first
-    /// frame's), the frame's pyramid built, the rigid points followed into it and fitted, and
+    /// The next `frame` (grey or RGB, the first frame's size): the zones placed by the previous
+    /// frame's `brows` (as many as the first frame's), the frame's pyramid built, the rigid points followed into it and fitted, and
     /// the `extra` points (pixels of the previous frame) followed alike. With a similarity the
     /// rigid points that fit it are kept at their new positions; without one, they stay.
     pub fn follow(
         &mut self,
-        gray: &[u8],
-        width: usize,
-        height: usize,
+        frame: &ImageRef,
         brows: &[[f64; 2]],
         extra: &[[f64; 2]],
     ) -> Result<Followed> {
@@ -159,7 +156,7 @@ impl HeadFollower {
         }
         let (place, _) = robust_similarity(&self.brows0, brows, PLACE_LIMIT, PLACE_ROUNDS);
         self.zones = self.moved_zones(&self.zones0, &place);
-        self.push(gray, width, height, extra)?;
+        self.push(frame, extra)?;
         let s = &self.settings;
         let none = || vec![None; extra.len()];
         if self.points.len() < s.min_points {
@@ -170,8 +167,8 @@ impl HeadFollower {
         }
         let points: Vec<[f64; 2]> = self.points.iter().map(widen).collect();
         let step = follow_rigid(
-            &self.prev,
-            &self.cur,
+            &mut self.prev,
+            &mut self.cur,
             &points,
             extra,
             s.extra_levels,
@@ -221,7 +218,7 @@ impl HeadFollower {
     /// Builds the frame's pyramid on the part of it the flow uses: the zones, rigid points and
     /// `extra` points with room for the coarsest level's window, its corner on a multiple of
     /// that level's scale so that consecutive frames' levels sample the same grid.
-    fn push(&mut self, gray: &[u8], width: usize, height: usize, extra: &[[f64; 2]]) -> Result<()> {
+    fn push(&mut self, frame: &ImageRef, extra: &[[f64; 2]]) -> Result<()> {
         let s = &self.settings;
         let grid = 1i64 << s.max_level;
         let pad = grid * s.window as i64 / 2 + CROP_MARGIN as i64;
@@ -236,18 +233,18 @@ impl HeadFollower {
         let crop = [
             start(lo[0]),
             start(lo[1]),
-            end(hi[0], width),
-            end(hi[1], height),
+            end(hi[0], frame.width),
+            end(hi[1], frame.height),
         ];
         std::mem::swap(&mut self.prev, &mut self.cur);
-        self.cur.rebuild(gray, width, height, crop, s.max_level)
+        self.cur.rebuild(frame, crop, s.max_level)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flow::tests::{texture, PARAMS};
+    use crate::flow::tests::{gray, texture, PARAMS};
 
     const SETTINGS: FollowSettings = FollowSettings {
         window: 21,
@@ -274,14 +271,20 @@ mod tests {
         let (w, h) = (192, 160);
         let zone: Quad = [[60.0, 50.0], [120.0, 50.0], [120.0, 110.0], [60.0, 110.0]];
         let first = texture(w, h, 0.0, 0.0);
-        let mut head =
-            HeadFollower::new(&first, w, h, brows(), vec![zone], grid_points(), SETTINGS).unwrap();
+        let mut head = HeadFollower::new(
+            &gray(&first, w, h),
+            brows(),
+            vec![zone],
+            grid_points(),
+            SETTINGS,
+        )
+        .unwrap();
         assert_eq!(head.points().1, (0..16).collect::<Vec<i64>>());
         // The image moves 2 px right: the brows with it, so the zone does too.
         let next = texture(w, h, 2.0, 0.0);
         let moved: Vec<[f64; 2]> = brows().iter().map(|p| [p[0] + 2.0, p[1]]).collect();
         let got = head
-            .follow(&next, w, h, &moved, &[[95.0, 75.0], [f64::NAN, 1.0]])
+            .follow(&gray(&next, w, h), &moved, &[[95.0, 75.0], [f64::NAN, 1.0]])
             .unwrap();
         let m = got.similarity.expect("a similarity");
         assert!(
@@ -297,7 +300,7 @@ mod tests {
         assert!((head.zones()[0][0][0] - 64.0).abs() < 0.1);
         // Brows that put the zone 40 px left leave only its left column's points... too few.
         let far: Vec<[f64; 2]> = moved.iter().map(|p| [p[0] - 40.0, p[1]]).collect();
-        let again = head.follow(&next, w, h, &far, &[]).unwrap();
+        let again = head.follow(&gray(&next, w, h), &far, &[]).unwrap();
         let step = again.similarity.expect("a similarity");
         assert!(
             head.advance(&step),
@@ -316,11 +319,16 @@ mod tests {
         let zone: Quad = [[60.0, 50.0], [120.0, 50.0], [120.0, 110.0], [60.0, 110.0]];
         let img = texture(w, h, 0.0, 0.0);
         let few = grid_points()[..4].to_vec();
-        let mut head = HeadFollower::new(&img, w, h, brows(), vec![zone], few, SETTINGS).unwrap();
-        let got = head.follow(&img, w, h, &brows(), &[[90.0, 80.0]]).unwrap();
+        let mut head =
+            HeadFollower::new(&gray(&img, w, h), brows(), vec![zone], few, SETTINGS).unwrap();
+        let got = head
+            .follow(&gray(&img, w, h), &brows(), &[[90.0, 80.0]])
+            .unwrap();
         assert_eq!(got.similarity, None);
         assert_eq!(got.extra, [None]);
-        assert!(head.follow(&img, w, h, &brows()[..2], &[]).is_err());
-        assert!(HeadFollower::new(&img, w, h, vec![], vec![zone], vec![], SETTINGS).is_err());
+        assert!(head.follow(&gray(&img, w, h), &brows()[..2], &[]).is_err());
+        assert!(
+            HeadFollower::new(&gray(&img, w, h), vec![], vec![zone], vec![], SETTINGS).is_err()
+        );
     }
 }

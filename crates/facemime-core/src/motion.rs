@@ -241,8 +241,8 @@ const IDENTITY: [[f64; 3]; 2] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
 /// each point, its inverse on the way back, and runs through `levels` levels above the frame
 /// at most.
 fn forward_backward(
-    prev: &Pyramid,
-    next: &Pyramid,
+    prev: &mut Pyramid,
+    next: &mut Pyramid,
     start: &[[f64; 2]],
     (m, levels): (&[[f64; 3]; 2], usize),
     lk: &LkParams,
@@ -275,8 +275,8 @@ fn forward_backward(
 /// check then, or all of them without a similarity, are followed like the rigid points.
 #[allow(clippy::too_many_arguments)]
 pub fn follow_rigid(
-    prev: &Pyramid,
-    next: &Pyramid,
+    prev: &mut Pyramid,
+    next: &mut Pyramid,
     points: &[[f64; 2]],
     extra: &[[f64; 2]],
     extra_levels: usize,
@@ -397,12 +397,12 @@ mod tests {
         use crate::flow::tests::{pyramid, texture, PARAMS};
         let (w, h) = (96, 96);
         let (a, b) = (texture(w, h, 0.0, 0.0), texture(w, h, 1.5, -0.5));
-        let (pa, pb) = (pyramid(&a, w, h), pyramid(&b, w, h));
+        let (mut pa, mut pb) = (pyramid(&a, w, h), pyramid(&b, w, h));
         let points: Vec<[f64; 2]> = (0..9)
             .map(|k| [30.0 + 6.0 * (k % 3) as f64, 30.0 + 6.0 * (k / 3) as f64])
             .collect();
         let extra = [[48.0, 50.0], [f64::NAN, 3.0], [-500.0, 40.0]];
-        let step = follow_rigid(&pa, &pb, &points, &extra, 1, &PARAMS, 1.0, 6, 10).unwrap();
+        let step = follow_rigid(&mut pa, &mut pb, &points, &extra, 1, &PARAMS, 1.0, 6, 10).unwrap();
         let m = step.similarity.expect("a similarity");
         for p in &points {
             let q = apply(&m, *p);
@@ -413,7 +413,8 @@ mod tests {
         assert!((e[0] - 49.5).abs() < 0.05 && (e[1] - 49.5).abs() < 0.05);
         assert_eq!(step.extra[1..], [None, None]);
         // Fewer points than the minimum: no similarity, nothing kept.
-        let few = follow_rigid(&pa, &pb, &points[..5], &[], 1, &PARAMS, 1.0, 6, 10).unwrap();
+        let few =
+            follow_rigid(&mut pa, &mut pb, &points[..5], &[], 1, &PARAMS, 1.0, 6, 10).unwrap();
         assert_eq!((few.similarity, few.kept.len()), (None, 0));
     }
 
@@ -431,12 +432,12 @@ mod tests {
                 b[y * w + x] = part[y * w + x];
             }
         }
-        let (pa, pb) = (pyramid(&a, w, h), pyramid(&b, w, h));
+        let (mut pa, mut pb) = (pyramid(&a, w, h), pyramid(&b, w, h));
         let points: Vec<[f64; 2]> = (0..12)
             .map(|k| [220.0 + 12.0 * (k % 4) as f64, 120.0 + 15.0 * (k / 4) as f64])
             .collect();
         let extra = [[240.0, 150.0], [70.0, 130.0]];
-        let step = follow_rigid(&pa, &pb, &points, &extra, 0, &PARAMS, 1.0, 6, 10).unwrap();
+        let step = follow_rigid(&mut pa, &mut pb, &points, &extra, 0, &PARAMS, 1.0, 6, 10).unwrap();
         let m = step.similarity.expect("a similarity");
         assert!(
             (m[0][2] - 30.0).abs() < 0.1 && (m[1][2] + 20.0).abs() < 0.1,
@@ -461,10 +462,12 @@ mod tests {
         );
         // On the frame's level alone, the first is not found from where it was, nor the
         // second from where the head moved it.
-        let alone = crate::flow::lucas_kanade_from(&pa, &pb, &extra, &extra, 0, &PARAMS).unwrap();
+        let alone =
+            crate::flow::lucas_kanade_from(&mut pa, &mut pb, &extra, &extra, 0, &PARAMS).unwrap();
         assert!(off(alone[0], [270.0, 130.0]) > 1.0, "{:?}", alone[0]);
         let moved = [apply(&m, extra[1])];
-        let guided = crate::flow::lucas_kanade_from(&pa, &pb, &extra[1..], &moved, 0, &PARAMS);
+        let guided =
+            crate::flow::lucas_kanade_from(&mut pa, &mut pb, &extra[1..], &moved, 0, &PARAMS);
         assert!(off(guided.unwrap()[0], [40.0, 110.0]) > 1.0);
     }
 

@@ -2,6 +2,7 @@
 //! (each built once, their memory reused) and the Lucas-Kanade flow between them.
 
 use facemime_core::flow::{self, LkParams, Pyramid};
+use facemime_core::raster::ImageRef;
 use numpy::{IntoPyArray, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -51,9 +52,10 @@ impl FlowFrames {
         crop: [usize; 4],
     ) -> PyResult<()> {
         let (data, width, height) = gray_view(&gray)?;
+        let frame = ImageRef::named("gray", data, width, height, 1).map_err(CoreErr)?;
         std::mem::swap(&mut self.prev, &mut self.cur);
         let (cur, max_level) = (&mut self.cur, self.max_level);
-        py.detach(|| cur.rebuild(data, width, height, crop, max_level))
+        py.detach(|| cur.rebuild(&frame, crop, max_level))
             .map_err(CoreErr)?;
         self.pushed += 1;
         Ok(())
@@ -64,7 +66,7 @@ impl FlowFrames {
     /// (N,) mask of the points followed).
     #[pyo3(signature = (points, backward, iterations, epsilon, min_eigen))]
     fn track<'py>(
-        &self,
+        &mut self,
         py: Python<'py>,
         points: PyReadonlyArray2<f64>,
         backward: bool,
@@ -80,9 +82,9 @@ impl FlowFrames {
             min_eigen,
         };
         let (from, to) = if backward {
-            (&self.cur, &self.prev)
+            (&mut self.cur, &mut self.prev)
         } else {
-            (&self.prev, &self.cur)
+            (&mut self.prev, &mut self.cur)
         };
         let moved = py
             .detach(|| flow::lucas_kanade(from, to, &pts, &params))

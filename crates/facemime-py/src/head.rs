@@ -4,12 +4,15 @@
 use facemime_core::corners::{self, CornerSettings};
 use facemime_core::flow::LkParams;
 use facemime_core::head::{self, FollowSettings, Quad};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2, PyReadonlyArray3};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2, PyReadonlyArray3,
+    PyReadonlyArrayDyn,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
-use crate::points::{array, gray_view, matrix, point_rows, rows};
+use crate::points::{array, frame_view, gray_view, matrix, point_rows, rows};
 
 /// The head's similarity step or None, and the extra points' positions.
 type Step<'py> = (Option<Bound<'py, PyArray2<f64>>>, Bound<'py, PyArray2<f64>>);
@@ -38,15 +41,15 @@ pub struct HeadFollower {
 
 #[pymethods]
 impl HeadFollower {
-    /// gray: the first frame, (H, W) uint8; brows: (N, 2) its brow points; zones: (Z, 4, 2)
+    /// frame: the first frame, (H, W) grey or (H, W, 3) RGB uint8; brows: (N, 2) its brow points; zones: (Z, 4, 2)
     /// its rigid zones; points: (M, 2) float32 corners found in them; window, max_level,
     /// extra_levels, limit, min_points, rounds, iterations, epsilon, min_eigen: see
     /// `facemime_core::head::FollowSettings` and `facemime_core::flow::LkParams`.
     #[new]
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (gray, brows, zones, points, window, max_level, extra_levels, limit, min_points, rounds, iterations, epsilon, min_eigen))]
+    #[pyo3(signature = (frame, brows, zones, points, window, max_level, extra_levels, limit, min_points, rounds, iterations, epsilon, min_eigen))]
     fn new(
-        gray: PyReadonlyArray2<u8>,
+        frame: PyReadonlyArrayDyn<u8>,
         brows: PyReadonlyArray2<f64>,
         zones: PyReadonlyArray3<f64>,
         points: PyReadonlyArray2<f32>,
@@ -60,7 +63,7 @@ impl HeadFollower {
         epsilon: f64,
         min_eigen: f64,
     ) -> PyResult<Self> {
-        let (data, width, height) = gray_view(&gray)?;
+        let frame = frame_view("frame", &frame)?;
         let z = zones.as_array();
         if z.shape()[1..] != [4, 2] {
             return Err(PyValueError::new_err(format!(
@@ -87,29 +90,29 @@ impl HeadFollower {
         };
         let brows = rows::<2, _>("brows", &brows)?;
         let points = rows::<2, _>("points", &points)?;
-        let head = head::HeadFollower::new(data, width, height, brows, zones, points, settings)
-            .map_err(CoreErr)?;
+        let head =
+            head::HeadFollower::new(&frame, brows, zones, points, settings).map_err(CoreErr)?;
         Ok(Self { head })
     }
 
-    /// gray: the next frame, (H, W) uint8; brows: (N, 2) the previous frame's brow points;
+    /// frame: the next frame, (H, W) grey or (H, W, 3) RGB uint8; brows: (N, 2) the previous frame's brow points;
     /// extra: (E, 2) other points of the previous frame. Returns (the head's 2×3 similarity
     /// step or None, the extra points' (E, 2) positions, NaN where the flow failed).
     fn follow<'py>(
         &mut self,
         py: Python<'py>,
-        gray: PyReadonlyArray2<u8>,
+        frame: PyReadonlyArrayDyn<u8>,
         brows: PyReadonlyArray2<f64>,
         extra: PyReadonlyArray2<f64>,
     ) -> PyResult<Step<'py>> {
-        let (data, width, height) = gray_view(&gray)?;
+        let frame = frame_view("frame", &frame)?;
         let (brows, extra) = (
             rows::<2, _>("brows", &brows)?,
             rows::<2, _>("extra", &extra)?,
         );
         let head = &mut self.head;
         let got = py
-            .detach(|| head.follow(data, width, height, &brows, &extra))
+            .detach(|| head.follow(&frame, &brows, &extra))
             .map_err(CoreErr)?;
         Ok((
             got.similarity.map(|m| array(py, &m)),

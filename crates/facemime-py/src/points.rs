@@ -1,11 +1,15 @@
-//! Point arrays from numpy: (K, 2) pixel or (K, 3) model coordinates as fixed-size rows.
+//! Point arrays from numpy: (K, 2) pixel or (K, 3) model coordinates as fixed-size rows; and
+//! grey or colour images as core views.
 
+use facemime_core::raster::ImageRef;
 use numpy::{
-    Element, IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyReadwriteArray2,
-    PyUntypedArrayMethods,
+    Element, IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyReadonlyArrayDyn,
+    PyReadwriteArray2, PyUntypedArrayMethods,
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+
+use crate::error::CoreErr;
 
 /// The rows of a (K, D) array (float64 points, float32 corners, index pairs); a clear error
 /// naming `name` for another shape.
@@ -86,4 +90,22 @@ pub fn gray_view<'a>(gray: &'a PyReadonlyArray2<'_, u8>) -> PyResult<(&'a [u8], 
         .as_slice()
         .map_err(|_| PyValueError::new_err("gray must be a C-contiguous uint8 array"))?;
     Ok((data, shape[1], shape[0]))
+}
+
+/// A (H, W) grey or (H, W, C) C-contiguous uint8 image as a core image view.
+pub fn frame_view<'a>(name: &str, img: &'a PyReadonlyArrayDyn<'_, u8>) -> PyResult<ImageRef<'a>> {
+    let shape = img.shape().to_vec();
+    let data = img
+        .as_slice()
+        .map_err(|_| PyValueError::new_err(format!("{name} must be a C-contiguous uint8 array")))?;
+    let channels = match shape.len() {
+        2 => 1,
+        3 => shape[2],
+        n => {
+            return Err(PyValueError::new_err(format!(
+                "{name} must be a (H, W) or (H, W, C) image, got {n} dimensions"
+            )))
+        }
+    };
+    Ok(ImageRef::named(name, data, shape[1], shape[0], channels).map_err(CoreErr)?)
 }

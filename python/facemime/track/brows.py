@@ -13,7 +13,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from facemime.track.match import crop_box, find
+from facemime.track.match import crop_box, find, gray_crop
 
 #: The template is the box of the brow's knots grown by this fraction of the brow's width.
 MARGIN = 0.12
@@ -24,19 +24,19 @@ MIN_MATCH = 0.5
 
 
 class BrowSearch:
-    """Finds one brow again. ``gray``: the first frame, (H, W) uint8; ``knots``: that brow's
-    knots on it, (K, 2) px."""
+    """Finds one brow again. ``image``: the first frame, (H, W) grey or (H, W, 3) RGB uint8;
+    ``knots``: that brow's knots on it, (K, 2) px."""
 
-    def __init__(self, gray: np.ndarray, knots: np.ndarray):
+    def __init__(self, image: np.ndarray, knots: np.ndarray):
         self._knots0 = np.asarray(knots, np.float64)
         self._width = float(np.ptp(self._knots0[:, 0]))
-        lo, hi = crop_box(self._knots0, MARGIN * self._width, gray.shape[1], gray.shape[0])
-        self._template = gray[lo[1]:hi[1], lo[0]:hi[0]].copy()
+        lo, hi = crop_box(self._knots0, MARGIN * self._width, image.shape[1], image.shape[0])
+        self._template = gray_crop(image, lo, hi).copy()
         self._centre0 = (lo + hi - 1) / 2.0  # the template's centre, px of the first frame
         self.active = min(self._template.shape) >= 8 and self._template.std() >= 1.0
 
-    def find(self, gray: np.ndarray, scale: float, expected: np.ndarray) -> np.ndarray | None:
-        """The brow's knots in ``gray`` ((K, 2) px: the first frame's, scaled by ``scale`` about the
+    def find(self, image: np.ndarray, scale: float, expected: np.ndarray) -> np.ndarray | None:
+        """The brow's knots in ``image`` (grey or RGB; (K, 2) px: the first frame's, scaled by ``scale`` about the
         match), or None when nothing matched. ``scale``: the head's scale since the first frame;
         ``expected``: (K, 2) px, where the head motion put the knots."""
         if not self.active:
@@ -45,5 +45,5 @@ class BrowSearch:
         if abs(scale - 1.0) > 0.02:
             templ = cv2.resize(templ, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR)
         centre = np.asarray(expected, np.float64).mean(axis=0) + (self._centre0 - self._knots0.mean(axis=0)) * scale
-        found = find(gray, templ, centre, REACH * self._width * scale, MIN_MATCH)
+        found = find(image, templ, centre, REACH * self._width * scale, MIN_MATCH)
         return None if found is None else (self._knots0 - self._centre0) * scale + found

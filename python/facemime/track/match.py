@@ -27,18 +27,27 @@ def crop_box(points: np.ndarray, margin: float, width: int, height: int) -> tupl
     return np.maximum(lo, 0), np.minimum(hi, [width, height])
 
 
-def find(gray: np.ndarray, template: np.ndarray, centre: np.ndarray, reach: float, min_match: float) -> np.ndarray | None:
-    """Where the centre of ``template`` ((h, w) uint8) matches ``gray`` ((H, W) uint8) best,
-    (2,) px, searched within ± ``reach`` px of ``centre`` (x, y) px; None where the window does
-    not hold the template or the best correlation is below ``min_match``."""
+def gray_crop(image: np.ndarray, lo: np.ndarray | tuple[int, int], hi: np.ndarray | tuple[int, int]) -> np.ndarray:
+    """The (y1 − y0, x1 − x0) uint8 grey levels of ``image`` ((H, W) uint8 grey, or (H, W, 3)
+    uint8 RGB converted as OpenCV's ``RGB2GRAY``) in the box from ``lo`` = (x0, y0) to ``hi`` =
+    (x1, y1) px, ``hi`` exclusive; a view of a grey ``image``."""
+    part = image[lo[1]:hi[1], lo[0]:hi[0]]
+    return part if part.ndim == 2 else cv2.cvtColor(part, cv2.COLOR_RGB2GRAY)
+
+
+def find(image: np.ndarray, template: np.ndarray, centre: np.ndarray, reach: float, min_match: float) -> np.ndarray | None:
+    """Where the centre of ``template`` ((h, w) uint8 grey) matches ``image`` ((H, W) grey or
+    (H, W, 3) RGB uint8, see :func:`gray_crop`) best, (2,) px, searched within ± ``reach`` px of
+    ``centre`` (x, y) px; None where the window does not hold the template or the best
+    correlation is below ``min_match``."""
     th, tw = template.shape
     x0 = max(int(round(centre[0] - (tw - 1) / 2.0 - reach)), 0)
     y0 = max(int(round(centre[1] - (th - 1) / 2.0 - reach)), 0)
-    x1 = min(int(round(centre[0] + (tw - 1) / 2.0 + reach)) + 1, gray.shape[1])
-    y1 = min(int(round(centre[1] + (th - 1) / 2.0 + reach)) + 1, gray.shape[0])
+    x1 = min(int(round(centre[0] + (tw - 1) / 2.0 + reach)) + 1, image.shape[1])
+    y1 = min(int(round(centre[1] + (th - 1) / 2.0 + reach)) + 1, image.shape[0])
     if x1 - x0 < tw or y1 - y0 < th:
         return None
-    scores = cv2.matchTemplate(gray[y0:y1, x0:x1], template, cv2.TM_CCOEFF_NORMED)
+    scores = cv2.matchTemplate(gray_crop(image, (x0, y0), (x1, y1)), template, cv2.TM_CCOEFF_NORMED)
     _, best, _, (bx, by) = cv2.minMaxLoc(scores)
     if not best >= min_match:
         return None

@@ -18,6 +18,7 @@ import numpy as np
 
 from facemime import _core
 from facemime.track.flow import EPSILON, ITERATIONS, LEVELS, MIN_EIGEN, WINDOW, as_points
+from facemime.track.match import gray_crop
 
 #: Rigid zones in face coordinates (s, t) of the first frame: a point is ``c + s·W·u + t·v``
 #: where ``c`` is the centre of the brows, ``v`` runs from it to the centre of the mouth, ``u`` is
@@ -93,12 +94,13 @@ IDENTITY = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 
 
 class HeadMotion:
-    """Follows the head from frame to frame. Feed gray (H, W) uint8 frames to :meth:`update`
-    with the brow points tracked in the previous frame (:meth:`brow_points` of its contours):
-    they place the rigid zones, so the points stay on the face even when the accumulated motion
-    drifts. The flow, the fit and the zones run in the core (``facemime._core.HeadFollower``),
-    and so does finding corners (``facemime._core.good_features``, OpenCV's
-    ``goodFeaturesToTrack``); the coarse fallback is OpenCV's, here.
+    """Follows the head from frame to frame. Feed frames, (H, W) grey or (H, W, 3) RGB uint8
+    (RGB is read as OpenCV's ``RGB2GRAY`` grey), to :meth:`update` with the brow points tracked
+    in the previous frame (:meth:`brow_points` of its contours): they place the rigid zones, so
+    the points stay on the face even when the accumulated motion drifts. The flow, the fit and
+    the zones run in the core (``facemime._core.HeadFollower``, which converts only the part of
+    an RGB frame the flow reads), and so does finding corners (``facemime._core.good_features``,
+    OpenCV's ``goodFeaturesToTrack``); the coarse fallback is OpenCV's, here.
 
     ``total`` is the accumulated transform from the first frame to the current one. ``points``
     (M, 2) float32 are the rigid points followed into the current frame and ``ids`` (M,) int64
@@ -107,16 +109,15 @@ class HeadMotion:
     (points, ids) pair of the points followed from the previous frame, before any re-detection.
     """
 
-    def __init__(self, gray: np.ndarray, contours: Mapping[str, np.ndarray], max_points: int = 60):
+    def __init__(self, frame: np.ndarray, contours: Mapping[str, np.ndarray], max_points: int = 60):
         self._min_distance = max(3.0, face_frame(contours)[3] / 30.0)
         self._max_points = max_points
         self.total = IDENTITY.copy()
-        self._prev = gray
+        self._prev = frame = np.ascontiguousarray(frame, np.uint8)
         self._brows = tuple(n for n in contours if n.startswith("brow"))
         zones = zone_polygons(contours)
         self._head = _core.HeadFollower(
-            np.ascontiguousarray(gray, np.uint8), self.brow_points(contours), np.stack(zones),
-            self._detect(gray, zones), WINDOW, LEVELS, GUIDED_LEVELS, FB_LIMIT, MIN_POINTS, FIT_ROUNDS, ITERATIONS,
+            frame, self.brow_points(contours), np.stack(zones), self._detect(frame, zones), WINDOW, LEVELS, GUIDED_LEVELS, FB_LIMIT, MIN_POINTS, FIT_ROUNDS, ITERATIONS,
             EPSILON, MIN_EIGEN)
 
     @property
@@ -147,32 +148,35 @@ class HeadMotion:
         the frame."""
         return _core.grown_box(as_points(zones), margin, shape[1], shape[0])
 
-    def _detect(self, gray: np.ndarray, zones: np.ndarray | list[np.ndarray]) -> np.ndarray:
+    def _detect(self, frame: np.ndarray, zones: np.ndarray | list[np.ndarray]) -> np.ndarray:
         """(M, 2) float32 corners in the ``zones`` (OpenCV's ``goodFeaturesToTrack``, computed
         by ``facemime._core.good_features``). The corner measure reads a few pixels around
         each pixel, so it runs on the zones' box grown by :data:`DETECT_MARGIN` px only: the
         same corners as on the whole frame, for a fraction of the work."""
-        x0, y0, x1, y1 = self._zones_box(zones, gray.shape, DETECT_MARGIN)
+        x0, y0, x1, y1 = self._zones_box(zones, frame.shape, DETECT_MARGIN)
         if x1 - x0 <= 2 * DETECT_MARGIN or y1 - y0 <= 2 * DETECT_MARGIN:
             return np.zeros((0, 2), np.float32)
         mask = np.zeros((y1 - y0, x1 - x0), np.uint8)
         for poly in zones:
             cv2.fillConvexPoly(mask, np.round(poly - [x0, y0]).astype(np.int32), 255)
-        return _core.good_features(gray, (x0, y0, x1, y1), mask, self._max_points, QUALITY, self._min_distance,
-                                   CORNER_BLOCK)
+        gray = np.ascontiguousarray(gray_crop(frame, (x0, y0), (x1, y1)))
+        found = _core.good_features(gray, (0, 0, x1 - x0, y1 - y0), mask, self._max_points, QUALITY,
+                                    self._min_distance, CORNER_BLOCK)
+        return found + np.array([x0, y0], np.float32)
 
-    def _coarse_shift(self, gray: np.ndarray) -> tuple[np.ndarray, bool]:
+    def _coarse_shift(self, frame: np.ndarray) -> tuple[np.ndarray, bool]:
         """Fallback for motion too fast or blurred for the flow: the translation that best
         matches the previous frame's face zones (normalised cross-correlation at 1/4 scale,
         searched up to half the zone size away); the rigid points are then dropped."""
-        x0, y0, x1, y1 = self._zones_box(self._head.zones, gray.shape, 0)
+        x0, y0, x1, y1 = self._zones_box(self._head.zones, frame.shape, 0)
         if x1 - x0 < 16 or y1 - y0 < 16:
             return IDENTITY.copy(), False
         rx, ry = (x1 - x0) // 2, (y1 - y0) // 2
         sx0, sy0 = max(x0 - rx, 0), max(y0 - ry, 0)
-        sx1, sy1 = min(x1 + rx, gray.shape[1]), min(y1 + ry, gray.shape[0])
+        sx1, sy1 = min(x1 + rx, frame.shape[1]), min(y1 + ry, frame.shape[0])
         small = lambda img: cv2.resize(img, None, fx=0.25, fy=0.25, interpolation=cv2.INTER_AREA)  # noqa: E731
-        templ, search = small(self._prev[y0:y1, x0:x1]), small(gray[sy0:sy1, sx0:sx1])
+        templ = small(gray_crop(self._prev, (x0, y0), (x1, y1)))
+        search = small(gray_crop(frame, (sx0, sy0), (sx1, sy1)))
         if templ.shape[0] > search.shape[0] or templ.shape[1] > search.shape[1] or templ.std() < 1.0:
             return IDENTITY.copy(), False
         scores = cv2.matchTemplate(search, templ, cv2.TM_CCOEFF_NORMED)
@@ -185,9 +189,9 @@ class HeadMotion:
         self._head.drop_points()
         return step, True
 
-    def update(self, gray: np.ndarray, brows: np.ndarray,
+    def update(self, frame: np.ndarray, brows: np.ndarray,
                extra: np.ndarray | None = None) -> tuple[np.ndarray, bool, np.ndarray | None]:
-        """Motion from the previous frame to ``gray``.
+        """Motion from the previous frame to ``frame`` (grey or RGB, as the first).
 
         ``brows``: (N, 2) px, the brow points tracked in the previous frame
         (:meth:`brow_points` of its contours); the brows, the most reliably tracked feature,
@@ -197,12 +201,12 @@ class HeadMotion:
         and the coarse fallback failed), whether it was measured, and the extra points' new
         positions (NaN where the flow failed its forward-backward check).
         """
-        gray = np.ascontiguousarray(gray, np.uint8)
+        frame = np.ascontiguousarray(frame, np.uint8)
         extra_pts = as_points(np.zeros((0, 2)) if extra is None else extra)
-        fit, moved = self._head.follow(gray, as_points(brows), extra_pts)
-        step, ok = (fit, True) if fit is not None else self._coarse_shift(gray)
+        fit, moved = self._head.follow(frame, as_points(brows), extra_pts)
+        step, ok = (fit, True) if fit is not None else self._coarse_shift(frame)
         self.total = compose(step, self.total)
         if self._head.advance(step):
-            self._head.detected(self._detect(gray, self._head.zones))
-        self._prev = gray
+            self._head.detected(self._detect(frame, self._head.zones))
+        self._prev = frame
         return step, ok, None if extra is None else moved

@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from facemime import _core
-from facemime.track.match import Placement, crop_box, find, locate
+from facemime.track.match import Placement, crop_box, find, gray_crop, locate
 
 #: The template is the box of the previous frame's mouth knots grown by this fraction of the
 #: mouth's width (some skin around the lips: measured on the six videos, 0.1 followed the mouth
@@ -56,19 +56,20 @@ CLIP = 2.0
 GAIN = 0.5
 
 
-def mouth_shift(prev_gray: np.ndarray, gray: np.ndarray, prev: np.ndarray, carried: np.ndarray) -> np.ndarray | None:
-    """How far the mouth moved from ``prev_gray`` to ``gray`` ((H, W) uint8) beyond the head:
+def mouth_shift(prev_image: np.ndarray, image: np.ndarray, prev: np.ndarray, carried: np.ndarray) -> np.ndarray | None:
+    """How far the mouth moved from ``prev_image`` to ``image`` ((H, W) grey or (H, W, 3) RGB
+    uint8) beyond the head:
     the (2,) px from ``carried`` ((K, 2) px, the mouth's knots ``prev`` of the previous frame
     moved by the head motion) to where the previous frame's mouth region matched best; None when
     it matched nowhere."""
-    height, width = gray.shape
+    height, width = image.shape[:2]
     size = float(np.ptp(prev[:, 0]))
     lo, hi = crop_box(prev, MARGIN * size, width, height)
-    template = prev_gray[lo[1]:hi[1], lo[0]:hi[0]]
+    template = gray_crop(prev_image, lo, hi)
     if min(template.shape) < 8 or template.std() < 1.0:
         return None
     expected = (lo + hi - 1) / 2.0 + carried.mean(axis=0) - prev.mean(axis=0)
-    found = find(gray, template, expected, REACH * size, MIN_MATCH)
+    found = find(image, template, expected, REACH * size, MIN_MATCH)
     return None if found is None else found - expected
 
 

@@ -40,7 +40,6 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
-import cv2
 import numpy as np
 
 from facemime import _core, validate
@@ -309,12 +308,11 @@ class Tracker:
         self._mouth_curves = np.array([n.startswith("mouth") for n in CONTOUR_NAMES])
         self._solver, self._targets0 = self._build_solver()
         self._field_buffer = np.empty(0, np.float32)
-        gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
-        self._motion = motion.HeadMotion(gray, contours) if p.motion else None
+        self._motion = motion.HeadMotion(frame, contours) if p.motion else None
         if self._motion is not None:
             # The knots of the brow points the head motion takes, in its order.
             self._brow_knots = np.concatenate([self._index[n] for n in self._motion.brows])
-        self._prev, self._gray = frame, gray
+        self._prev = frame
         self._mouth_lost_for = 0  # frames in a row with a mouth feature lost
         self.frame_index = 0
         # The snakes settle on the image edges, which may sit a little off the given contours
@@ -332,7 +330,7 @@ class Tracker:
         self._linear = np.eye(2)
         self._down = self._down0
         self._response0 = np.maximum(self._responses(frame, edges, edges, self._down0, self._targets0), 1e-6)
-        self._brow_search = {f: BrowSearch(gray, edges[self._features[f]]) for f in ("brow_left", "brow_right")}
+        self._brow_search = {f: BrowSearch(frame, edges[self._features[f]]) for f in ("brow_left", "brow_right")}
         self._reported = self._reported_knots()
         # The frame's steps around the solver, in the core: the start, the rest shape and gap
         # targets, then the confidences and shape checks.
@@ -445,9 +443,8 @@ class Tracker:
         p = self.params
         self.frame_index += 1
         step, ok, flow = motion.IDENTITY, True, None
-        gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
         if self._motion is not None:
-            step, ok, flow = self._motion.update(gray, self._reported[self._brow_knots],
+            step, ok, flow = self._motion.update(frame, self._reported[self._brow_knots],
                                                  self._knots if p.knot_flow else None)
         total = self._motion.total if self._motion is not None else motion.IDENTITY
         # Where the flow followed a knot, else where the head's step carries it; the head's
@@ -456,7 +453,7 @@ class Tracker:
         reach = p.delta0 / (1.0 - p.sigma)
         if followed is not None:
             if mouth_unfollowed:
-                self._mouth_sideways(gray, start, followed, step, down, reach)
+                self._mouth_sideways(frame, start, followed, step, down, reach)
             if self._lips is not None:
                 self._lips.move(frame, start, ~followed, scale)
         # The start inside the frame, the first frame's knots carried by the head, the rest
@@ -478,7 +475,7 @@ class Tracker:
             shape_ok = shapes_ok[feature]
             search = self._brow_search.get(feature)
             if search is not None and (ratio[rows].min() < p.brow_search or not shape_ok):
-                found = search.find(gray, scale, start[idx])
+                found = search.find(frame, scale, start[idx])
                 if found is not None:
                     fallback = knots.copy()
                     fallback[idx] = found
@@ -513,20 +510,20 @@ class Tracker:
         self._knots = knots
         self._linear = total[:, :2]
         self._down = down
-        self._prev, self._gray = frame, gray
+        self._prev = frame
         # The head motion reads the brows' reported knots next frame.
         self._reported = self._reported_knots()
         return FrameResult(self.frame_index, self._named(self._scale.to_frame(self._reported)), confidence, lost,
                            iters, ok)
 
-    def _mouth_sideways(self, gray: np.ndarray, start: np.ndarray, followed: np.ndarray, step: np.ndarray,
+    def _mouth_sideways(self, frame: np.ndarray, start: np.ndarray, followed: np.ndarray, step: np.ndarray,
                         down: np.ndarray, reach: float) -> None:
         """Move the mouth knots the flow lost (``followed`` False) along the mouth line by how far
         the previous frame's mouth region moved that way beyond the head's ``step``, when that is
         at least :data:`AGREE` × ``reach`` px (in place; the mouth's motion up and down, an
         opening, is the lip searches' to follow)."""
         mouth = self._mouth_knots
-        shift = mouth_shift(self._gray, gray, self._knots[mouth], motion.apply(step, self._knots[mouth]))
+        shift = mouth_shift(self._prev, frame, self._knots[mouth], motion.apply(step, self._knots[mouth]))
         if shift is None:
             return
         along = np.array([down[1], -down[0]])

@@ -47,6 +47,18 @@ impl Shape {
         (self.win + 2).div_ceil(LANES) * LANES
     }
 
+    /// The (columns, rows) of plane values from the grid's top-left sample's integer part that
+    /// [`sample`] of `rows` rows reads.
+    pub fn sampled_block(&self, rows: usize) -> [usize; 2] {
+        [self.sampled() + 1, rows + 1]
+    }
+
+    /// The (columns, rows) of plane values from the grid's top-left sample's integer part that
+    /// [`correlate`] reads.
+    pub fn correlated_block(&self) -> [usize; 2] {
+        [self.cols + 1, self.win + 1]
+    }
+
     /// Mirrored pixels a plane needs on every side for windows whose corner's integer part
     /// lies in [−`win`, size): the kernels read from one pixel left of (above) the corner to
     /// `win` + 1 pixels below it and `cols` pixels right of it (sampling the grown window,
