@@ -9,9 +9,9 @@ segment, at most 15 iterations.
 
 Each measurement is run ``--repeats`` times, the runs of the three alternating, and the fastest
 run of each counts (on a shared machine the slower runs measure the neighbours). With
-``--stages``, one more run of the tracker times its native stages (head motion: pyramid and
-optical flow; image field, snake solver, gray conversion, corner detection) by wrapping their
-calls, and prints where a frame's time goes.
+``--stages``, one more run of the tracker times its native stages (head motion: grey levels,
+pyramid and optical flow; image field, snake solver, corner detection) by wrapping their calls,
+and prints where a frame's time goes.
 
     python benchmarks/track.py [--data ../shared/data] [--frames 200] [--repeats 3] [--stages]
 
@@ -77,8 +77,7 @@ class TimedMethods:
 
 def stage_seconds(frames: list[np.ndarray], init: dict[str, np.ndarray], clock: StageClock) -> float:
     """Seconds the default tracker took on frames 1.., its native stages timed into ``clock``."""
-    with mock.patch.object(cv2, "cvtColor", clock.wrap("gray conversion", cv2.cvtColor)), \
-            mock.patch.object(motion.HeadMotion, "_detect", clock.wrap("corner detection", motion.HeadMotion._detect)), \
+    with mock.patch.object(motion.HeadMotion, "_detect", clock.wrap("corner detection", motion.HeadMotion._detect)), \
             mock.patch.object(tracker_module, "build_field", clock.wrap("image field", tracker_module.build_field)):
         tracker = Tracker(frames[0], init)
         clock.seconds.clear()  # the first frame's set-up is not a frame's work
@@ -87,7 +86,7 @@ def stage_seconds(frames: list[np.ndarray], init: dict[str, np.ndarray], clock: 
         tracker._solver = TimedMethods(solver, clock, {"solve": "snake solver",  # noqa: SLF001
                                                        "evaluate": "snake solver"})
         head = tracker._motion  # noqa: SLF001
-        head._head = TimedMethods(head._head, clock, {"follow": "head motion (pyramid, optical flow)"})  # noqa: SLF001
+        head._head = TimedMethods(head._head, clock, {"follow": "head motion (grey levels, pyramid, optical flow)"})  # noqa: SLF001
         t0 = time.perf_counter()
         for frame in frames[1:]:
             tracker.update(frame)

@@ -257,17 +257,13 @@ impl Pyramid {
     fn fill_tile(&mut self, tx: usize, ty: usize) {
         self.filled[ty * self.tiles_across + tx] = true;
         let base = &mut self.levels[0];
-        let (s, p, w, h) = (base.stride(), base.pad, base.width, base.height);
-        let (c0, c1) = (tx * TILE, ((tx + 1) * TILE).min(s));
-        let (inner0, inner1) = (c0.clamp(p, p + w), c1.clamp(p, p + w));
-        for r in ty * TILE..((ty + 1) * TILE).min(h + 2 * p) {
-            let src = &self.gray[reflect101(r as isize - p as isize, h) * w..][..w];
-            let row = &mut base.img[r * s..][..s];
-            widen(&src[inner0 - p..inner1 - p], &mut row[inner0..inner1]);
-            for c in (c0..inner0).chain(inner1..c1) {
-                row[c] = src[reflect101(c as isize - p as isize, w)] as f32;
-            }
-        }
+        let (s, p, h) = (base.stride(), base.pad, base.height);
+        let tile = Tile {
+            pad: p,
+            rows: [ty * TILE, ((ty + 1) * TILE).min(h + 2 * p)],
+            cols: [tx * TILE, ((tx + 1) * TILE).min(s)],
+        };
+        fill(&self.gray, base.width, tile, &mut base.img);
     }
 
     /// Frame point → level point.
@@ -342,26 +338,50 @@ unsafe fn rgb_to_gray_avx2(rgb: &[u8], out: &mut [u8]) -> usize {
     i
 }
 
-/// Grey levels `src` as floats into `dst`.
-fn widen(src: &[u8], dst: &mut [f32]) {
+/// A block of a level's padded plane: its rows and columns (padded-plane indices, ends
+/// exclusive) and the padding's width.
+#[derive(Clone, Copy)]
+struct Tile {
+    pad: usize,
+    rows: [usize; 2],
+    cols: [usize; 2],
+}
+
+/// The `tile` of a `plane` padded around `gray` (rows of `w`) filled with its grey levels as
+/// floats, mirrored into the padding.
+fn fill(gray: &[u8], w: usize, tile: Tile, plane: &mut [f32]) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: AVX2 is present.
-        return unsafe { widen_avx2(src, dst) };
+        return unsafe { fill_avx2(gray, w, tile, plane) };
     }
-    widen_body(src, dst)
+    fill_body(gray, w, tile, plane)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn widen_avx2(src: &[u8], dst: &mut [f32]) {
-    widen_body(src, dst)
+unsafe fn fill_avx2(gray: &[u8], w: usize, tile: Tile, plane: &mut [f32]) {
+    fill_body(gray, w, tile, plane)
 }
 
 #[inline(always)]
-fn widen_body(src: &[u8], dst: &mut [f32]) {
-    for (d, &g) in dst.iter_mut().zip(src) {
-        *d = g as f32;
+fn fill_body(gray: &[u8], w: usize, tile: Tile, plane: &mut [f32]) {
+    let (p, h) = (tile.pad, gray.len() / w);
+    let s = w + 2 * p;
+    let [c0, c1] = tile.cols;
+    let (inner0, inner1) = (c0.clamp(p, p + w), c1.clamp(p, p + w));
+    for r in tile.rows[0]..tile.rows[1] {
+        let src = &gray[reflect101(r as isize - p as isize, h) * w..][..w];
+        let row = &mut plane[r * s..][..s];
+        for (d, &g) in row[inner0..inner1]
+            .iter_mut()
+            .zip(&src[inner0 - p..inner1 - p])
+        {
+            *d = g as f32;
+        }
+        for c in (c0..inner0).chain(inner1..c1) {
+            row[c] = src[reflect101(c as isize - p as isize, w)] as f32;
+        }
     }
 }
 
