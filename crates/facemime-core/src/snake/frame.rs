@@ -88,8 +88,8 @@ pub struct Knots<'a> {
 }
 
 /// One frame's knots from `knots`' start: the field of `frame` (and `prev`, see
-/// [`frame_field`]) smoothed by `smoothing` pixels in the `bands` around the start (see
-/// [`band_field`]: the solver reads only there), written
+/// [`super::frame_field`]) smoothed by `smoothing` pixels in the `bands` around the start (the
+/// solver reads only there), written
 /// into `buffer` (grown as needed and reused), a pass of the solver over every curve, then
 /// `more`'s passes. Returns the solution (iterations added up; each curve's response from the
 /// last pass that solved it) and the time of each stage.
