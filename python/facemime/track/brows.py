@@ -36,9 +36,9 @@ class BrowSearch:
         self.active = min(self._template.shape) >= 8 and self._template.std() >= 1.0
 
     def find(self, image: np.ndarray, scale: float, expected: np.ndarray) -> np.ndarray | None:
-        """The brow's knots in ``image`` (grey or RGB; (K, 2) px: the first frame's, scaled by ``scale`` about the
-        match), or None when nothing matched. ``scale``: the head's scale since the first frame;
-        ``expected``: (K, 2) px, where the head motion put the knots."""
+        """The brow's knots in ``image`` (grey or RGB; (K, 2) px: the first frame's, scaled by
+        ``scale`` about the match), or None when nothing matched. ``scale``: the head's scale since
+        the first frame; ``expected``: (K, 2) px, where the head motion put the knots."""
         if not self.active:
             return None
         templ = self._template

@@ -117,8 +117,8 @@ class HeadMotion:
         self._brows = tuple(n for n in contours if n.startswith("brow"))
         zones = zone_polygons(contours)
         self._head = _core.HeadFollower(
-            frame, self.brow_points(contours), np.stack(zones), self._detect(frame, zones), WINDOW, LEVELS, GUIDED_LEVELS, FB_LIMIT, MIN_POINTS, FIT_ROUNDS, ITERATIONS,
-            EPSILON, MIN_EIGEN)
+            frame, self.brow_points(contours), np.stack(zones), self._detect(frame, zones), WINDOW, LEVELS,
+            GUIDED_LEVELS, FB_LIMIT, MIN_POINTS, FIT_ROUNDS, ITERATIONS, EPSILON, MIN_EIGEN)
 
     @property
     def points(self) -> np.ndarray:

@@ -58,10 +58,9 @@ GAIN = 0.5
 
 def mouth_shift(prev_image: np.ndarray, image: np.ndarray, prev: np.ndarray, carried: np.ndarray) -> np.ndarray | None:
     """How far the mouth moved from ``prev_image`` to ``image`` ((H, W) grey or (H, W, 3) RGB
-    uint8) beyond the head:
-    the (2,) px from ``carried`` ((K, 2) px, the mouth's knots ``prev`` of the previous frame
-    moved by the head motion) to where the previous frame's mouth region matched best; None when
-    it matched nowhere."""
+    uint8) beyond the head: the (2,) px from ``carried`` ((K, 2) px, the mouth's knots ``prev``
+    of the previous frame moved by the head motion) to where the previous frame's mouth region
+    matched best; None when it matched nowhere."""
     height, width = image.shape[:2]
     size = float(np.ptp(prev[:, 0]))
     lo, hi = crop_box(prev, MARGIN * size, width, height)

@@ -22,9 +22,9 @@ const TILE: usize = 32;
 
 /// One level's image, padded by `pad` mirrored pixels on every side.
 #[derive(Default)]
-pub(super) struct Level {
-    pub(super) width: usize,
-    pub(super) height: usize,
+struct Level {
+    width: usize,
+    height: usize,
     pad: usize,
     img: Vec<f32>,
 }
@@ -119,6 +119,7 @@ pub struct Pyramid {
     filled: Vec<bool>,
     tiles_across: usize,
     levels: Vec<Level>,
+    /// Scratch rows of the reductions: level 1's integer column sums, the others' float ones.
     sums: Vec<u16>,
     scratch: Vec<f32>,
 }
