@@ -43,7 +43,7 @@ class FlowFrames:
     facemime.track.flow)."""
 
     def __init__(self, max_level: int, window: int) -> None: ...
-    def push(self, gray: npt.NDArray[np.uint8], crop: tuple[int, int, int, int]) -> None: ...
+    def push(self, frame: npt.NDArray[np.uint8], crop: tuple[int, int, int, int]) -> None: ...
     def track(
         self,
         points: npt.NDArray[np.float64],
@@ -61,7 +61,6 @@ class HeadFollower:
         frame: npt.NDArray[np.uint8],
         brows: npt.NDArray[np.float64],
         zones: npt.NDArray[np.float64],
-        points: npt.NDArray[np.float32],
         window: int,
         max_level: int,
         extra_levels: int,
@@ -76,6 +75,15 @@ class HeadFollower:
         self, frame: npt.NDArray[np.uint8], brows: npt.NDArray[np.float64], extra: npt.NDArray[np.float64]
     ) -> tuple[npt.NDArray[np.float64] | None, npt.NDArray[np.float64]]: ...
     def advance(self, step: npt.NDArray[np.float64]) -> bool: ...
+    def corners(
+        self,
+        area: tuple[int, int, int, int],
+        mask: npt.NDArray[np.uint8],
+        max_corners: int,
+        quality: float,
+        min_distance: float,
+        block: int,
+    ) -> npt.NDArray[np.float32]: ...
     def detected(self, points: npt.NDArray[np.float32]) -> None: ...
     def drop_points(self) -> None: ...
     zones: npt.NDArray[np.float64]
@@ -110,15 +118,6 @@ class LipPlacer:
 
 def compose(a: npt.NDArray[np.float64], b: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
 def grown_box(points: npt.NDArray[np.float64], margin: int, width: int, height: int) -> tuple[int, int, int, int]: ...
-def good_features(
-    gray: npt.NDArray[np.uint8],
-    area: tuple[int, int, int, int],
-    mask: npt.NDArray[np.uint8],
-    max_corners: int,
-    quality: float,
-    min_distance: float,
-    block: int,
-) -> npt.NDArray[np.float32]: ...
 def robust_similarity(
     src: npt.NDArray[np.float64],
     dst: npt.NDArray[np.float64],

@@ -127,6 +127,6 @@ def test_the_corners_found_in_the_rigid_zones_are_opencvs(shared):
             cv2.fillConvexPoly(mask, np.round(poly - [x0, y0]).astype(np.int32), 255)
         theirs = cv2.goodFeaturesToTrack(frames[t][y0:y1, x0:x1], head._max_points, QUALITY,  # noqa: SLF001
                                          head._min_distance, mask=mask, blockSize=CORNER_BLOCK)  # noqa: SLF001
-        ours = head._detect(frames[t], zones)  # noqa: SLF001
+        ours = head._detect(zones)  # noqa: SLF001
         assert ours.dtype == np.float32 and len(ours) > 20
         np.testing.assert_array_equal(ours, theirs.reshape(-1, 2) + [x0, y0])

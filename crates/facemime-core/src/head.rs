@@ -2,13 +2,15 @@
 //! forehead), tracked by the Lucas-Kanade flow forwards and back and fitted by a robust
 //! similarity ([`follow_rigid`]). The zones are quadrilaterals placed each frame by the
 //! similarity that carries the first frame's brows onto the brows tracked in the previous one,
-//! then moved by the head's step; points that leave them are dropped. Finding new points (a
-//! corner detector) is the caller's: [`HeadFollower::advance`] says when too few are left.
+//! then moved by the head's step; points that leave them are dropped. [`HeadFollower::advance`]
+//! says when too few are left; [`HeadFollower::corners`] finds corners in the frame's grey
+//! levels (in a mask of the zones the caller draws) and [`HeadFollower::detected`] takes them.
 //!
 //! Points are (x, y) pixels of the whole frame, pixel centres on integers; transforms are 2×3
 //! matrices mapping one frame's pixels to another's. Rigid points are kept in single precision,
 //! as the corner detector gives them.
 
+use crate::corners::{good_features, CornerSettings};
 use crate::error::Result;
 use crate::extent::extent;
 use crate::flow::{LkParams, Pyramid};
@@ -67,7 +69,8 @@ pub struct HeadFollower {
     ids: Vec<i64>,
     followed: (Vec<[f32; 2]>, Vec<i64>),
     next_id: i64,
-    wanted: usize,
+    /// Fewer points than this call for new ones; set by the first frame's corners.
+    wanted: Option<usize>,
 }
 
 fn widen(p: &[f32; 2]) -> [f64; 2] {
@@ -75,15 +78,13 @@ fn widen(p: &[f32; 2]) -> [f64; 2] {
 }
 
 impl HeadFollower {
-    /// Starts on the first frame, a grey or RGB image: `brows0` are its
-    /// brow points (later frames' brows are matched to them point by point), `zones0` its
-    /// rigid zones, `points` the corners found in them (they get identities 0, 1, ...; from
-    /// then on, fewer than half as many, or than `min_points`, call for new ones).
+    /// Starts on the first frame, a grey or RGB image: `brows0` are its brow points (later
+    /// frames' brows are matched to them point by point), `zones0` its rigid zones. The
+    /// first frame's corners, found in them, are given next to [`HeadFollower::detected`].
     pub fn new(
         frame: &ImageRef,
         brows0: Vec<[f64; 2]>,
         zones0: Vec<Quad>,
-        points: Vec<[f32; 2]>,
         settings: FollowSettings,
     ) -> Result<Self> {
         if brows0.is_empty() {
@@ -100,11 +101,8 @@ impl HeadFollower {
             ids: Vec::new(),
             followed: (Vec::new(), Vec::new()),
             next_id: 0,
-            wanted: 0,
+            wanted: None,
         };
-        head.detected(points);
-        head.followed = (head.points.clone(), head.ids.clone());
-        head.wanted = settings.min_points.max(head.points.len() / 2);
         head.push(frame, &[])?;
         Ok(head)
     }
@@ -124,11 +122,57 @@ impl HeadFollower {
         (&self.followed.0, &self.followed.1)
     }
 
-    /// Replaces the rigid points by new ones, with new identities.
+    /// Replaces the rigid points by new ones, with new identities (0, 1, ... for the first
+    /// frame's, which are also its followed points; from then on, fewer than half as many as
+    /// those, or than `min_points`, call for new ones).
     pub fn detected(&mut self, points: Vec<[f32; 2]>) {
         self.ids = (self.next_id..).take(points.len()).collect();
         self.next_id += points.len() as i64;
         self.points = points;
+        if self.wanted.is_none() {
+            self.wanted = Some(self.settings.min_points.max(self.points.len() / 2));
+            self.followed = (self.points.clone(), self.ids.clone());
+        }
+    }
+
+    /// The corners of the current frame (frame pixels) in `area` = [x0, y0, x1, y1) (frame
+    /// pixels, exclusive ends) where `mask` (row-major over the area; nonzero: allowed) allows
+    /// them, as [`good_features`] finds them on the frame's grey levels. Only the part of the
+    /// area that the frame's pyramid covers is searched: all of it, unless the zones moved
+    /// further in one step than the pyramid's margin around them (the coarsest level's window).
+    pub fn corners(
+        &self,
+        area: [usize; 4],
+        mask: &[u8],
+        settings: &CornerSettings,
+    ) -> Result<Vec<[f32; 2]>> {
+        let [x0, y0, x1, y1] = area;
+        let (w, h) = (x1.saturating_sub(x0), y1.saturating_sub(y0));
+        if mask.len() != w * h {
+            return invalid!("the mask has {} pixels, not the area's {w}×{h}", mask.len());
+        }
+        let (grey, [cx0, cy0, cx1, cy1]) = self.cur.grey_levels();
+        let [ix0, iy0, ix1, iy1] = [x0.max(cx0), y0.max(cy0), x1.min(cx1), y1.min(cy1)];
+        if ix0 >= ix1 || iy0 >= iy1 {
+            return Ok(Vec::new());
+        }
+        let inside: Vec<u8>;
+        let mask = if [ix0, iy0, ix1, iy1] == area {
+            mask
+        } else {
+            inside = (iy0..iy1)
+                .flat_map(|y| &mask[(y - y0) * w + ix0 - x0..][..ix1 - ix0])
+                .copied()
+                .collect();
+            &inside
+        };
+        let local = [ix0 - cx0, iy0 - cy0, ix1 - cx0, iy1 - cy0];
+        let found = good_features(grey, cx1 - cx0, cy1 - cy0, local, mask, settings)?;
+        let shift = [cx0 as f32, cy0 as f32];
+        Ok(found
+            .into_iter()
+            .map(|p| [p[0] + shift[0], p[1] + shift[1]])
+            .collect())
     }
 
     /// Drops every rigid point (the step was measured some other way).
@@ -205,7 +249,7 @@ impl HeadFollower {
             self.ids.retain(|_| *k.next().expect("one flag per point"));
         }
         self.followed = (self.points.clone(), self.ids.clone());
-        self.points.len() < self.wanted
+        self.wanted.is_none_or(|w| self.points.len() < w)
     }
 
     fn moved_zones(&self, zones: &[Quad], m: &[[f64; 3]; 2]) -> Vec<Quad> {
@@ -271,15 +315,15 @@ mod tests {
         let (w, h) = (192, 160);
         let zone: Quad = [[60.0, 50.0], [120.0, 50.0], [120.0, 110.0], [60.0, 110.0]];
         let first = texture(w, h, 0.0, 0.0);
-        let mut head = HeadFollower::new(
-            &gray(&first, w, h),
-            brows(),
-            vec![zone],
-            grid_points(),
-            SETTINGS,
-        )
-        .unwrap();
+        let mut head =
+            HeadFollower::new(&gray(&first, w, h), brows(), vec![zone], SETTINGS).unwrap();
+        head.detected(grid_points());
         assert_eq!(head.points().1, (0..16).collect::<Vec<i64>>());
+        assert_eq!(
+            head.followed().1.len(),
+            16,
+            "the first frame's points are its followed"
+        );
         // The image moves 2 px right: the brows with it, so the zone does too.
         let next = texture(w, h, 2.0, 0.0);
         let moved: Vec<[f64; 2]> = brows().iter().map(|p| [p[0] + 2.0, p[1]]).collect();
@@ -314,21 +358,54 @@ mod tests {
     }
 
     #[test]
+    fn corners_are_those_of_the_frames_grey_levels_where_its_pyramid_reaches() {
+        let (w, h) = (400, 320);
+        let zone: Quad = [
+            [200.0, 150.0],
+            [260.0, 150.0],
+            [260.0, 210.0],
+            [200.0, 210.0],
+        ];
+        let img = texture(w, h, 0.0, 0.0);
+        let head = HeadFollower::new(&gray(&img, w, h), brows(), vec![zone], SETTINGS).unwrap();
+        let s = CornerSettings {
+            max_corners: 30,
+            quality: 0.01,
+            min_distance: 5.0,
+            block: 5,
+        };
+        // Inside the pyramid's crop: the corners of the whole image's grey levels.
+        let area = [190, 140, 270, 220];
+        let mask: Vec<u8> = (0..80 * 80)
+            .map(|i| if i % 80 < 70 { 255 } else { 0 })
+            .collect();
+        let want = good_features(&img, w, h, area, &mask, &s).unwrap();
+        assert!(want.len() > 5, "{want:?}");
+        assert_eq!(head.corners(area, &mask, &s).unwrap(), want);
+        // Reaching left of the crop (the zone's left, 200, less 8·21/2 + 8, down to a multiple
+        // of 8: 104): the part inside it.
+        let wide = [90, 140, 170, 220];
+        let inside: Vec<u8> = mask.chunks(80).flat_map(|r| &r[14..]).copied().collect();
+        let want = good_features(&img, w, h, [104, 140, 170, 220], &inside, &s).unwrap();
+        assert!(!want.is_empty());
+        assert_eq!(head.corners(wide, &mask, &s).unwrap(), want);
+        assert!(head.corners(area, &mask[1..], &s).is_err());
+    }
+
+    #[test]
     fn too_few_points_give_no_similarity_and_wrong_brows_are_refused() {
         let (w, h) = (192, 160);
         let zone: Quad = [[60.0, 50.0], [120.0, 50.0], [120.0, 110.0], [60.0, 110.0]];
         let img = texture(w, h, 0.0, 0.0);
         let few = grid_points()[..4].to_vec();
-        let mut head =
-            HeadFollower::new(&gray(&img, w, h), brows(), vec![zone], few, SETTINGS).unwrap();
+        let mut head = HeadFollower::new(&gray(&img, w, h), brows(), vec![zone], SETTINGS).unwrap();
+        head.detected(few);
         let got = head
             .follow(&gray(&img, w, h), &brows(), &[[90.0, 80.0]])
             .unwrap();
         assert_eq!(got.similarity, None);
         assert_eq!(got.extra, [None]);
         assert!(head.follow(&gray(&img, w, h), &brows()[..2], &[]).is_err());
-        assert!(
-            HeadFollower::new(&gray(&img, w, h), vec![], vec![zone], vec![], SETTINGS).is_err()
-        );
+        assert!(HeadFollower::new(&gray(&img, w, h), vec![], vec![zone], SETTINGS).is_err());
     }
 }

@@ -2,13 +2,12 @@
 //! (each built once, their memory reused) and the Lucas-Kanade flow between them.
 
 use facemime_core::flow::{self, LkParams, Pyramid};
-use facemime_core::raster::ImageRef;
-use numpy::{IntoPyArray, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyReadonlyArray2, PyReadonlyArrayDyn};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
-use crate::points::{gray_view, point_rows, rows, MaskedPoints};
+use crate::points::{frame_view, point_rows, rows, MaskedPoints};
 
 /// See `facemime.track.flow` for the documented API.
 #[pyclass(module = "facemime._core")]
@@ -43,16 +42,15 @@ impl FlowFrames {
         })
     }
 
-    /// gray: (H, W) C-contiguous uint8, the next frame; crop: (x0, y0, x1, y1) pixels,
-    /// exclusive ends, the part of it the flow may use.
+    /// frame: (H, W) grey or (H, W, 3) RGB C-contiguous uint8, the next frame; crop: (x0, y0,
+    /// x1, y1) pixels, exclusive ends, the part of it the flow may use.
     fn push(
         &mut self,
         py: Python<'_>,
-        gray: PyReadonlyArray2<u8>,
+        frame: PyReadonlyArrayDyn<u8>,
         crop: [usize; 4],
     ) -> PyResult<()> {
-        let (data, width, height) = gray_view(&gray)?;
-        let frame = ImageRef::named("gray", data, width, height, 1).map_err(CoreErr)?;
+        let frame = frame_view("frame", &frame)?;
         std::mem::swap(&mut self.prev, &mut self.cur);
         let (cur, max_level) = (&mut self.cur, self.max_level);
         py.detach(|| cur.rebuild(&frame, crop, max_level))

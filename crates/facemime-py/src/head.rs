@@ -1,7 +1,7 @@
 //! Bindings of `facemime_core::head`: `HeadFollower`, the head's rigid points followed from
 //! frame to frame.
 
-use facemime_core::corners::{self, CornerSettings};
+use facemime_core::corners::CornerSettings;
 use facemime_core::flow::LkParams;
 use facemime_core::head::{self, FollowSettings, Quad};
 use numpy::{
@@ -12,7 +12,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
-use crate::points::{array, frame_view, gray_view, matrix, point_rows, rows};
+use crate::points::{array, frame_view, matrix, point_rows, rows};
 
 /// The head's similarity step or None, and the extra points' positions.
 type Step<'py> = (Option<Bound<'py, PyArray2<f64>>>, Bound<'py, PyArray2<f64>>);
@@ -41,18 +41,17 @@ pub struct HeadFollower {
 
 #[pymethods]
 impl HeadFollower {
-    /// frame: the first frame, (H, W) grey or (H, W, 3) RGB uint8; brows: (N, 2) its brow points; zones: (Z, 4, 2)
-    /// its rigid zones; points: (M, 2) float32 corners found in them; window, max_level,
-    /// extra_levels, limit, min_points, rounds, iterations, epsilon, min_eigen: see
+    /// frame: the first frame, (H, W) grey or (H, W, 3) RGB uint8; brows: (N, 2) its brow
+    /// points; zones: (Z, 4, 2) its rigid zones; window, max_level, extra_levels, limit,
+    /// min_points, rounds, iterations, epsilon, min_eigen: see
     /// `facemime_core::head::FollowSettings` and `facemime_core::flow::LkParams`.
     #[new]
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (frame, brows, zones, points, window, max_level, extra_levels, limit, min_points, rounds, iterations, epsilon, min_eigen))]
+    #[pyo3(signature = (frame, brows, zones, window, max_level, extra_levels, limit, min_points, rounds, iterations, epsilon, min_eigen))]
     fn new(
         frame: PyReadonlyArrayDyn<u8>,
         brows: PyReadonlyArray2<f64>,
         zones: PyReadonlyArray3<f64>,
-        points: PyReadonlyArray2<f32>,
         window: usize,
         max_level: usize,
         extra_levels: usize,
@@ -89,9 +88,7 @@ impl HeadFollower {
             },
         };
         let brows = rows::<2, _>("brows", &brows)?;
-        let points = rows::<2, _>("points", &points)?;
-        let head =
-            head::HeadFollower::new(&frame, brows, zones, points, settings).map_err(CoreErr)?;
+        let head = head::HeadFollower::new(&frame, brows, zones, settings).map_err(CoreErr)?;
         Ok(Self { head })
     }
 
@@ -126,7 +123,40 @@ impl HeadFollower {
         Ok(self.head.advance(&matrix::<3>("step", &step)?))
     }
 
-    /// points: (M, 2) float32, new corners replacing the rigid points (new identities).
+    /// (M, 2) float32 corners (frame pixels) of the current frame in the box `area` = (x0, y0,
+    /// x1, y1), exclusive ends, where the (y1 − y0, x1 − x0) uint8 `mask` is nonzero, as
+    /// OpenCV's goodFeaturesToTrack finds them on its grey levels; see
+    /// `facemime_core::head::HeadFollower::corners`.
+    #[pyo3(signature = (area, mask, max_corners, quality, min_distance, block))]
+    #[allow(clippy::too_many_arguments)]
+    fn corners<'py>(
+        &self,
+        py: Python<'py>,
+        area: [usize; 4],
+        mask: PyReadonlyArray2<'py, u8>,
+        max_corners: usize,
+        quality: f64,
+        min_distance: f64,
+        block: usize,
+    ) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        let m = mask
+            .as_slice()
+            .map_err(|_| PyValueError::new_err("mask must be a C-contiguous uint8 array"))?;
+        let settings = CornerSettings {
+            max_corners,
+            quality,
+            min_distance,
+            block,
+        };
+        let head = &self.head;
+        let found = py
+            .detach(|| head.corners(area, m, &settings))
+            .map_err(CoreErr)?;
+        Ok(f32_rows(py, &found))
+    }
+
+    /// points: (M, 2) float32, new corners replacing the rigid points (new identities; the
+    /// first frame's set how few call for new ones).
     fn detected(&mut self, points: PyReadonlyArray2<f32>) -> PyResult<()> {
         self.head.detected(rows::<2, _>("points", &points)?);
         Ok(())
@@ -160,39 +190,7 @@ impl HeadFollower {
     }
 }
 
-/// (M, 2) float32 corners (frame pixels) of the (H, W) uint8 `gray` in the box `area` = (x0,
-/// y0, x1, y1), exclusive ends, where the (y1 − y0, x1 − x0) uint8 `mask` is nonzero, as
-/// OpenCV's goodFeaturesToTrack finds them; see `facemime_core::corners::good_features`.
-#[pyfunction]
-#[allow(clippy::too_many_arguments)]
-fn good_features<'py>(
-    py: Python<'py>,
-    gray: PyReadonlyArray2<'py, u8>,
-    area: [usize; 4],
-    mask: PyReadonlyArray2<'py, u8>,
-    max_corners: usize,
-    quality: f64,
-    min_distance: f64,
-    block: usize,
-) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    let (data, width, height) = gray_view(&gray)?;
-    let m = mask
-        .as_slice()
-        .map_err(|_| PyValueError::new_err("mask must be a C-contiguous uint8 array"))?;
-    let settings = CornerSettings {
-        max_corners,
-        quality,
-        min_distance,
-        block,
-    };
-    let found = py
-        .detach(|| corners::good_features(data, width, height, area, m, &settings))
-        .map_err(CoreErr)?;
-    Ok(f32_rows(py, &found))
-}
-
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(good_features, m)?)?;
     m.add_class::<HeadFollower>()?;
     Ok(())
 }

@@ -83,15 +83,6 @@ pub fn point_rows<'py>(py: Python<'py>, pts: &[Option<[f64; 2]>]) -> Bound<'py, 
     array(py, &rows)
 }
 
-/// A (H, W) C-contiguous uint8 gray image: its pixels, width and height.
-pub fn gray_view<'a>(gray: &'a PyReadonlyArray2<'_, u8>) -> PyResult<(&'a [u8], usize, usize)> {
-    let shape = gray.shape().to_vec();
-    let data = gray
-        .as_slice()
-        .map_err(|_| PyValueError::new_err("gray must be a C-contiguous uint8 array"))?;
-    Ok((data, shape[1], shape[0]))
-}
-
 /// A (H, W) grey or (H, W, C) C-contiguous uint8 image as a core image view.
 pub fn frame_view<'a>(name: &str, img: &'a PyReadonlyArrayDyn<'_, u8>) -> PyResult<ImageRef<'a>> {
     let shape = img.shape().to_vec();

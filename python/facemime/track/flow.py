@@ -25,16 +25,17 @@ def as_points(points: object) -> np.ndarray:
 
 
 class FrameFlow:
-    """Feed gray frames with :meth:`push`; :meth:`track` follows points from the previous frame
+    """Feed frames with :meth:`push`; :meth:`track` follows points from the previous frame
     into the current one, or back."""
 
     def __init__(self) -> None:
         self._frames = _core.FlowFrames(LEVELS, WINDOW)
 
-    def push(self, gray: np.ndarray, crop: tuple[int, int, int, int]) -> None:
-        """The next (H, W) uint8 frame; only ``crop`` = (x0, y0, x1, y1) px, exclusive ends,
-        is used: points outside it are not followed."""
-        self._frames.push(np.ascontiguousarray(gray, np.uint8), tuple(int(v) for v in crop))
+    def push(self, frame: np.ndarray, crop: tuple[int, int, int, int]) -> None:
+        """The next frame, (H, W) grey or (H, W, 3) RGB uint8 (read as OpenCV's ``RGB2GRAY``
+        grey levels); only ``crop`` = (x0, y0, x1, y1) px, exclusive ends, is used: points
+        outside it are not followed."""
+        self._frames.push(np.ascontiguousarray(frame, np.uint8), tuple(int(v) for v in crop))
 
     def track(self, points: np.ndarray, backward: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """Positions in the current frame of (N, 2) points of the previous one (the reverse

@@ -99,8 +99,9 @@ class HeadMotion:
     in the previous frame (:meth:`brow_points` of its contours): they place the rigid zones, so
     the points stay on the face even when the accumulated motion drifts. The flow, the fit and
     the zones run in the core (``facemime._core.HeadFollower``, which converts only the part of
-    an RGB frame the flow reads), and so does finding corners (``facemime._core.good_features``,
-    OpenCV's ``goodFeaturesToTrack``); the coarse fallback is OpenCV's, here.
+    an RGB frame the flow reads), and so does finding corners on those grey levels
+    (``HeadFollower.corners``, OpenCV's ``goodFeaturesToTrack``); the coarse fallback is
+    OpenCV's, here.
 
     ``total`` is the accumulated transform from the first frame to the current one. ``points``
     (M, 2) float32 are the rigid points followed into the current frame and ``ids`` (M,) int64
@@ -114,11 +115,13 @@ class HeadMotion:
         self._max_points = max_points
         self.total = IDENTITY.copy()
         self._prev = frame = np.ascontiguousarray(frame, np.uint8)
+        self._shape = frame.shape[:2]
         self._brows = tuple(n for n in contours if n.startswith("brow"))
         zones = zone_polygons(contours)
         self._head = _core.HeadFollower(
-            frame, self.brow_points(contours), np.stack(zones), self._detect(frame, zones), WINDOW, LEVELS,
-            GUIDED_LEVELS, FB_LIMIT, MIN_POINTS, FIT_ROUNDS, ITERATIONS, EPSILON, MIN_EIGEN)
+            frame, self.brow_points(contours), np.stack(zones), WINDOW, LEVELS, GUIDED_LEVELS, FB_LIMIT, MIN_POINTS,
+            FIT_ROUNDS, ITERATIONS, EPSILON, MIN_EIGEN)
+        self._head.detected(self._detect(zones))
 
     @property
     def points(self) -> np.ndarray:
@@ -148,21 +151,20 @@ class HeadMotion:
         the frame."""
         return _core.grown_box(as_points(zones), margin, shape[1], shape[0])
 
-    def _detect(self, frame: np.ndarray, zones: np.ndarray | list[np.ndarray]) -> np.ndarray:
-        """(M, 2) float32 corners in the ``zones`` (OpenCV's ``goodFeaturesToTrack``, computed
-        by ``facemime._core.good_features``). The corner measure reads a few pixels around
-        each pixel, so it runs on the zones' box grown by :data:`DETECT_MARGIN` px only: the
-        same corners as on the whole frame, for a fraction of the work."""
-        x0, y0, x1, y1 = self._zones_box(zones, frame.shape, DETECT_MARGIN)
+    def _detect(self, zones: np.ndarray | list[np.ndarray]) -> np.ndarray:
+        """(M, 2) float32 corners in the ``zones`` of the frame last followed (OpenCV's
+        ``goodFeaturesToTrack`` on its grey levels, computed by ``HeadFollower.corners``). The
+        corner measure reads a few pixels around each pixel, so it runs on the zones' box grown
+        by :data:`DETECT_MARGIN` px only: the same corners as on the whole frame, for a
+        fraction of the work."""
+        x0, y0, x1, y1 = self._zones_box(zones, self._shape, DETECT_MARGIN)
         if x1 - x0 <= 2 * DETECT_MARGIN or y1 - y0 <= 2 * DETECT_MARGIN:
             return np.zeros((0, 2), np.float32)
         mask = np.zeros((y1 - y0, x1 - x0), np.uint8)
         for poly in zones:
             cv2.fillConvexPoly(mask, np.round(poly - [x0, y0]).astype(np.int32), 255)
-        gray = np.ascontiguousarray(gray_crop(frame, (x0, y0), (x1, y1)))
-        found = _core.good_features(gray, (0, 0, x1 - x0, y1 - y0), mask, self._max_points, QUALITY,
-                                    self._min_distance, CORNER_BLOCK)
-        return found + np.array([x0, y0], np.float32)
+        return self._head.corners((x0, y0, x1, y1), mask, self._max_points, QUALITY, self._min_distance,
+                                  CORNER_BLOCK)
 
     def _coarse_shift(self, frame: np.ndarray) -> tuple[np.ndarray, bool]:
         """Fallback for motion too fast or blurred for the flow: the translation that best
@@ -207,6 +209,6 @@ class HeadMotion:
         step, ok = (fit, True) if fit is not None else self._coarse_shift(frame)
         self.total = compose(step, self.total)
         if self._head.advance(step):
-            self._head.detected(self._detect(frame, self._head.zones))
+            self._head.detected(self._detect(self._head.zones))
         self._prev = frame
         return step, ok, None if extra is None else moved

@@ -218,6 +218,14 @@ impl Pyramid {
         Ok(())
     }
 
+    /// The crop's grey levels (row-major) and the crop [x0, y0, x1, y1) (frame pixels,
+    /// exclusive ends); empty before the first build.
+    pub fn grey_levels(&self) -> (&[u8], [usize; 4]) {
+        let (w, h) = self.levels.first().map_or((0, 0), |l| (l.width, l.height));
+        let [x0, y0] = self.origin.map(|v| v as usize);
+        (&self.gray, [x0, y0, x0 + w, y0 + h])
+    }
+
     /// Number of levels above the crop itself (0 also before the first build).
     pub fn max_level(&self) -> usize {
         self.depth.saturating_sub(1)
