@@ -80,7 +80,8 @@ fn widen(p: &[f32; 2]) -> [f64; 2] {
 impl HeadFollower {
     /// Starts on the first frame, a grey or RGB image: `brows0` are its brow points (later
     /// frames' brows are matched to them point by point), `zones0` its rigid zones. The
-    /// first frame's corners, found in them, are given next to [`HeadFollower::detected`].
+    /// first frame's corners in them ([`HeadFollower::corners`]) are then given to
+    /// [`HeadFollower::detected`].
     pub fn new(
         frame: &ImageRef,
         brows0: Vec<[f64; 2]>,
