@@ -134,21 +134,8 @@ def fit_pose(
     iterations: int,
 ) -> tuple[float, float, float, float, float, float]: ...
 
-def affine_rest(
-    carried: npt.NDArray[np.float64],
-    start: npt.NDArray[np.float64],
-    groups: list[list[int]],
-    amount: float,
-) -> npt.NDArray[np.float64]: ...
-
 FIELD_CHANNELS: int
 
-def chords_within(
-    knots: npt.NDArray[np.float64],
-    rest: npt.NDArray[np.float64],
-    ends: npt.NDArray[np.uintp],
-    least: npt.NDArray[np.float64],
-) -> list[bool]: ...
 def reported_knots(
     knots: npt.NDArray[np.float64],
     offset: npt.NDArray[np.float64],
@@ -157,14 +144,6 @@ def reported_knots(
     upper: npt.NDArray[np.uintp],
     lower: npt.NDArray[np.uintp],
 ) -> npt.NDArray[np.float64]: ...
-def centre_group(
-    knots: npt.NDArray[np.float64],
-    rest: npt.NDArray[np.float64],
-    inner: npt.NDArray[np.uintp],
-    outer: npt.NDArray[np.uintp],
-    along: tuple[float, float],
-    amount: float,
-) -> None: ...
 def field_regions(
     knots: npt.NDArray[np.float64], bands: list[tuple[npt.NDArray[np.uintp], float]], width: int, height: int
 ) -> tuple[tuple[int, int, int, int], list[tuple[int, int, int, int]]]: ...
@@ -206,6 +185,11 @@ class FramePlan:
     def settle(
         self, start: npt.NDArray[np.float64], total: npt.NDArray[np.float64], scale: float
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+    def rest(self, carried: npt.NDArray[np.float64], start: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+    def centre(
+        self, knots: npt.NDArray[np.float64], rest: npt.NDArray[np.float64], down: tuple[float, float]
+    ) -> None: ...
+    def shapes(self, knots: npt.NDArray[np.float64], rest: npt.NDArray[np.float64]) -> list[bool]: ...
     def confidences(self, response: npt.NDArray[np.float64]) -> tuple[npt.NDArray[np.float64], list[float]]: ...
     def assess(
         self,

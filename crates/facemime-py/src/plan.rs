@@ -40,6 +40,25 @@ pub struct FramePlan {
     plan: snake::FramePlan,
 }
 
+impl FramePlan {
+    /// The rows of a (K, 2) array of the plan's K knots; a clear error for another shape.
+    fn knots(&self, name: &str, a: &PyReadonlyArray2<f64>) -> PyResult<Vec<[f64; 2]>> {
+        let pts = rows::<2, _>(name, a)?;
+        same_length(&[(name, pts.len()), ("knots0", self.plan.knots0.len())])?;
+        Ok(pts)
+    }
+
+    /// A (C,) array of one edge response per curve of the plan.
+    fn responses(&self, a: &PyReadonlyArray1<f64>) -> PyResult<Vec<f64>> {
+        let r = a.as_array().to_vec();
+        same_length(&[
+            ("response", r.len()),
+            ("response0", self.plan.response0.len()),
+        ])?;
+        Ok(r)
+    }
+}
+
 #[pymethods]
 impl FramePlan {
     #[new]
@@ -95,8 +114,7 @@ impl FramePlan {
         flow: Option<PyReadonlyArray2<f64>>,
     ) -> PyResult<Begun<'py>> {
         let (step, total) = (matrix::<3>("step", &step)?, matrix::<3>("total", &total)?);
-        let knots = rows::<2, _>("knots", &knots)?;
-        same_length(&[("knots", knots.len()), ("knots0", self.plan.knots0.len())])?;
+        let knots = self.knots("knots", &knots)?;
         let flow = flow.map(|f| rows::<2, _>("flow", &f)).transpose()?;
         if let Some(f) = &flow {
             same_length(&[("knots", knots.len()), ("flow", f.len())])?;
@@ -121,8 +139,7 @@ impl FramePlan {
         scale: f64,
     ) -> PyResult<Settled<'py>> {
         let total = matrix::<3>("total", &total)?;
-        let mut pts = rows::<2, _>("start", &start)?;
-        same_length(&[("start", pts.len()), ("knots0", self.plan.knots0.len())])?;
+        let mut pts = self.knots("start", &start)?;
         let s = self.plan.settle(&mut pts, &total, scale);
         write_rows(&mut start, &pts);
         Ok((
@@ -132,6 +149,45 @@ impl FramePlan {
         ))
     }
 
+    /// carried, start: (K, 2). Returns the (K, 2) rest shape (`FramePlan::rest`).
+    fn rest<'py>(
+        &self,
+        py: Python<'py>,
+        carried: PyReadonlyArray2<f64>,
+        start: PyReadonlyArray2<f64>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let (carried, start) = (
+            self.knots("carried", &carried)?,
+            self.knots("start", &start)?,
+        );
+        Ok(array(py, &self.plan.rest(&carried, &start)))
+    }
+
+    /// knots: (K, 2), the inner mouth slid in place; rest: (K, 2); down: unit vector
+    /// (`FramePlan::centre`).
+    fn centre(
+        &self,
+        mut knots: PyReadwriteArray2<f64>,
+        rest: PyReadonlyArray2<f64>,
+        down: (f64, f64),
+    ) -> PyResult<()> {
+        let mut pts = self.knots("knots", &knots)?;
+        let rest = self.knots("rest", &rest)?;
+        self.plan.centre(&mut pts, &rest, [down.0, down.1]);
+        write_rows(&mut knots, &pts);
+        Ok(())
+    }
+
+    /// knots, rest: (K, 2). Returns each feature's shape check (`FramePlan::shapes`).
+    fn shapes(
+        &self,
+        knots: PyReadonlyArray2<f64>,
+        rest: PyReadonlyArray2<f64>,
+    ) -> PyResult<Vec<bool>> {
+        let (knots, rest) = (self.knots("knots", &knots)?, self.knots("rest", &rest)?);
+        Ok(self.plan.shapes(&knots, &rest))
+    }
+
     /// response: (C,) each curve's edge response. Returns (each curve's confidence (C,), each
     /// feature's).
     fn confidences<'py>(
@@ -139,11 +195,7 @@ impl FramePlan {
         py: Python<'py>,
         response: PyReadonlyArray1<f64>,
     ) -> PyResult<Confidences<'py>> {
-        let response = response.as_array().to_vec();
-        same_length(&[
-            ("response", response.len()),
-            ("response0", self.plan.response0.len()),
-        ])?;
+        let response = self.responses(&response)?;
         let (ratio, confidence) = self.plan.confidences(&response);
         Ok((ratio.into_pyarray(py), confidence))
     }
@@ -160,23 +212,9 @@ impl FramePlan {
         response: PyReadonlyArray1<f64>,
         carried: PyReadonlyArray2<f64>,
     ) -> PyResult<Assessed<'py>> {
-        let mut pts = rows::<2, _>("knots", &knots)?;
-        let (rest, carried) = (
-            rows::<2, _>("rest", &rest)?,
-            rows::<2, _>("carried", &carried)?,
-        );
-        let response = response.as_array().to_vec();
-        let k = self.plan.knots0.len();
-        same_length(&[
-            ("knots", pts.len()),
-            ("rest", rest.len()),
-            ("carried", carried.len()),
-            ("knots0", k),
-        ])?;
-        same_length(&[
-            ("response", response.len()),
-            ("response0", self.plan.response0.len()),
-        ])?;
+        let mut pts = self.knots("knots", &knots)?;
+        let (rest, carried) = (self.knots("rest", &rest)?, self.knots("carried", &carried)?);
+        let response = self.responses(&response)?;
         let a = self
             .plan
             .assess(&mut pts, &rest, [down.0, down.1], &response, &carried);

@@ -7,7 +7,7 @@ use facemime_core::snake::{
 };
 use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
-    PyReadonlyArray3, PyReadwriteArray2, PyUntypedArrayMethods,
+    PyReadonlyArray3, PyUntypedArrayMethods,
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -455,29 +455,6 @@ fn frame_field<'py>(
     Ok(out)
 }
 
-/// carried, start: (K, 2) pixels; groups: lists of knot indices; amount: 0..1. Returns the
-/// (K, 2) rest knots: `carried` with each group moved `amount` of the way to its affine
-/// least-squares fit to `start`.
-#[pyfunction]
-fn affine_rest<'py>(
-    py: Python<'py>,
-    carried: PyReadonlyArray2<f64>,
-    start: PyReadonlyArray2<f64>,
-    groups: Vec<Vec<usize>>,
-    amount: f64,
-) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let (a, b) = (
-        rows::<2, _>("carried", &carried)?,
-        rows::<2, _>("start", &start)?,
-    );
-    same_length(&[("carried", a.len()), ("start", b.len())])?;
-    if let Some(&k) = groups.iter().flatten().find(|&&k| k >= a.len()) {
-        return Err(err(format!("knot index {k} is past the {} knots", a.len())));
-    }
-    let slices: Vec<&[usize]> = groups.iter().map(Vec::as_slice).collect();
-    Ok(array(py, &snake::affine_rest(&a, &b, &slices, amount)))
-}
-
 /// knots: (K, 2) pixels; bands: (knot indices (uintp), margin px) pairs; width, height: the
 /// frame's. Returns (the box holding every band's region, each band's region): the integer
 /// boxes (x0, y0, x1, y1), exclusive ends, around the band's knots grown by its margin, inside
@@ -493,61 +470,6 @@ fn field_regions(
     let bands = bands_of(&bands, knots.len())?;
     frame_size(width, height)?;
     Ok(snake::band_regions(&knots, &bands, width, height))
-}
-
-/// knots: (K, 2) pixels, changed in place; rest: (K, 2) their rest shape; inner, outer:
-/// knot indices (uintp) of two groups; along: a unit vector; amount: 0..1. Slides the inner
-/// knots along `along` by `amount` of their drift along it from where they sat relative to the
-/// outer ones in the rest shape.
-#[pyfunction]
-fn centre_group(
-    mut knots: PyReadwriteArray2<f64>,
-    rest: PyReadonlyArray2<f64>,
-    inner: PyReadonlyArray1<usize>,
-    outer: PyReadonlyArray1<usize>,
-    along: (f64, f64),
-    amount: f64,
-) -> PyResult<()> {
-    let (mut pts, rest) = (rows::<2, _>("knots", &knots)?, rows::<2, _>("rest", &rest)?);
-    same_length(&[("knots", pts.len()), ("rest", rest.len())])?;
-    let indices = |a: &PyReadonlyArray1<usize>, name: &str| -> PyResult<Vec<usize>> {
-        let v = a.as_array().to_vec();
-        within(name, &v, pts.len())?;
-        if v.is_empty() {
-            return Err(err(format!("{name} needs at least one knot")));
-        }
-        Ok(v)
-    };
-    let (inner, outer) = (indices(&inner, "inner")?, indices(&outer, "outer")?);
-    snake::centre_group(&mut pts, &rest, &inner, &outer, [along.0, along.1], amount);
-    let mut out = knots.as_array_mut();
-    for &i in &inner {
-        out[[i, 0]] = pts[i][0];
-        out[[i, 1]] = pts[i][1];
-    }
-    Ok(())
-}
-
-/// knots, rest: (K, 2) pixels; ends: (F, 2) knot index pairs (uintp); least: (F,) factors.
-/// Returns, per pair, whether its chord in `knots` is within `least` to 2 times its chord in
-/// `rest`.
-#[pyfunction]
-fn chords_within(
-    knots: PyReadonlyArray2<f64>,
-    rest: PyReadonlyArray2<f64>,
-    ends: PyReadonlyArray2<usize>,
-    least: PyReadonlyArray1<f64>,
-) -> PyResult<Vec<bool>> {
-    let (knots, rest) = (rows::<2, _>("knots", &knots)?, rows::<2, _>("rest", &rest)?);
-    let ends = rows::<2, _>("ends", &ends)?;
-    same_length(&[("ends", ends.len()), ("least", least.len())])?;
-    within("ends", ends.as_flattened(), knots.len().min(rest.len()))?;
-    Ok(snake::chords_within(
-        &knots,
-        &rest,
-        &ends,
-        &least.as_array().to_vec(),
-    ))
 }
 
 /// knots, offset: (K, 2) pixels; linear: the head's 2×2 linear part; down: unit vector;
@@ -582,11 +504,8 @@ fn reported_knots<'py>(
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<SnakeSolver>()?;
-    m.add_function(wrap_pyfunction!(chords_within, m)?)?;
     m.add_function(wrap_pyfunction!(reported_knots, m)?)?;
-    m.add_function(wrap_pyfunction!(centre_group, m)?)?;
     m.add_function(wrap_pyfunction!(field_regions, m)?)?;
-    m.add_function(wrap_pyfunction!(affine_rest, m)?)?;
     m.add_function(wrap_pyfunction!(frame_field, m)?)?;
     m.add("FIELD_CHANNELS", FIELD_CHANNELS)?;
     Ok(())

@@ -601,20 +601,20 @@ class Tracker:
     def _centre_inner(self, knots: np.ndarray, rest: np.ndarray, down: np.ndarray) -> None:
         """Slide the inner mouth along the mouth line by :data:`CENTRING` of its drift from
         where it sat in the outer mouth in the rest shape (a closed mouth's dark line gives the
-        inner curves nothing to hold them sideways; ``facemime._core.centre_group``, in place)."""
-        _core.centre_group(knots, rest, self._inner_uintp, self._outer_uintp, (down[1], -down[0]), CENTRING)
+        inner curves nothing to hold them sideways; ``FramePlan.centre``, in place)."""
+        self._plan.centre(knots, rest, tuple(down))
 
     def _mouth_rest(self, carried: np.ndarray, start: np.ndarray) -> np.ndarray:
         """The rest knots: ``carried`` (the first frame's, moved by the head) with each mouth
         feature moved ``mouth_affine`` of the way to its affine least-squares fit to ``start``
-        (``facemime._core.affine_rest``)."""
-        return _core.affine_rest(carried, start, self._affine_groups, self.params.mouth_affine)
+        (``FramePlan.rest``)."""
+        return self._plan.rest(carried, start)
 
     def _shapes_ok(self, knots: np.ndarray, rest: np.ndarray) -> dict[str, bool]:
         """Per feature, whether its upper curve's chord stays within a factor 2 of its chord in
         ``rest`` (the inner mouth's may shrink to :data:`NARROWEST` of it: a mouth rounding into
-        an "O" opens only in the middle of the line where the lips met)."""
-        return dict(zip(FEATURES, _core.chords_within(knots, rest, self._chord_ends, self._least_chord)))
+        an "O" opens only in the middle of the line where the lips met; ``FramePlan.shapes``)."""
+        return dict(zip(FEATURES, self._plan.shapes(knots, rest)))
 
     def _shape_ok(self, knots: np.ndarray, rest: np.ndarray, feature: str) -> bool:
         """:meth:`_shapes_ok` of one feature."""

@@ -164,7 +164,7 @@ pub fn solve_frame(
 /// Slides the `inner` knots along `along` (a unit vector) by `amount` of their drift along it
 /// from where they sat relative to the `outer` knots in the `rest` shape: the difference of
 /// the two groups' mean knots, less that of their mean rest knots (in place; pixels).
-pub fn centre_group(
+pub(crate) fn centre_group(
     knots: &mut [[f64; 2]],
     rest: &[[f64; 2]],
     inner: &[usize],
@@ -190,7 +190,7 @@ pub fn centre_group(
 /// The knots' starting positions in a frame: where the head's `step` (a 2×3 similarity)
 /// carries `knots`, or where the optical flow put them (`flow`, NaN where it failed). Returns
 /// them and which came from the flow.
-pub fn start_knots(
+pub(crate) fn start_knots(
     step: &[[f64; 3]; 2],
     knots: &[[f64; 2]],
     flow: &[[f64; 2]],
@@ -210,7 +210,7 @@ pub fn start_knots(
 
 /// Per (first, last) knot pair of `ends`: whether the chord between them in `knots` is at
 /// least `least` times and at most twice its length in `rest`.
-pub fn chords_within(
+pub(crate) fn chords_within(
     knots: &[[f64; 2]],
     rest: &[[f64; 2]],
     ends: &[[usize; 2]],

@@ -19,10 +19,8 @@ mod solver;
 pub use energy::{CurveParams, Operator, PairKind, PairSpec};
 pub use field::{Field, FIELD_CHANNELS};
 pub use frame::{
-    band_regions, centre_group, chords_within, region, reported_knots, solve_frame, start_knots,
-    Band, FrameTimes, Knots, MorePasses,
+    band_regions, region, reported_knots, solve_frame, Band, FrameTimes, Knots, MorePasses,
 };
 pub use frame_field::{field_shape, frame_field, MAX_SIGMA};
 pub use plan::{Assessed, Begun, FramePlan, Settled};
-pub use rest::affine_rest;
 pub use solver::{FrameInput, Problem, Settings, Solution};

@@ -161,14 +161,34 @@ impl FramePlan {
             }
         }
         let carried = transformed(total, &self.knots0);
-        let groups: Vec<&[usize]> = self.affine_groups.iter().map(Vec::as_slice).collect();
-        let rest = affine_rest(&carried, start, &groups, self.mouth_affine);
+        let rest = self.rest(&carried, start);
         let targets = self.targets0.iter().map(|t| t * scale).collect();
         Settled {
             carried,
             rest,
             targets,
         }
+    }
+
+    /// The rest shape: `carried` (the first frame's knots moved by the head) with each of the
+    /// plan's affine groups moved its fraction of the way to its affine least-squares fit to
+    /// `start`.
+    pub fn rest(&self, carried: &[P2], start: &[P2]) -> Vec<P2> {
+        let groups: Vec<&[usize]> = self.affine_groups.iter().map(Vec::as_slice).collect();
+        affine_rest(carried, start, &groups, self.mouth_affine)
+    }
+
+    /// The inner mouth slid (in place in `knots`) by the plan's fraction of its drift from
+    /// where it sat in the outer mouth in `rest`, along the mouth line (`down` turned).
+    pub fn centre(&self, knots: &mut [P2], rest: &[P2], down: P2) {
+        let along = [down[1], -down[0]];
+        centre_group(knots, rest, &self.inner, &self.outer, along, self.centring);
+    }
+
+    /// Per feature, whether its upper curve's chord in `knots` is within its least fraction to
+    /// 2 times its chord in `rest`.
+    pub fn shapes(&self, knots: &[P2], rest: &[P2]) -> Vec<bool> {
+        chords_within(knots, rest, &self.chord_ends, &self.least_chord)
     }
 
     /// Each curve's edge `response` over its first frame's, clipped to 0..1, and each
@@ -188,10 +208,9 @@ impl FramePlan {
         (ratio, confidence)
     }
 
-    /// After the solver: the inner mouth slid back (in place in `knots`) by the plan's
-    /// fraction of its sideways drift from where it sat in the outer mouth in `rest` (along
-    /// the mouth line, `down` turned), and the confidences of `response` and the shape checks
-    /// of `knots` against `carried`.
+    /// After the solver: the inner mouth slid back in `knots` ([`FramePlan::centre`]), the
+    /// confidences of `response` and the shape checks of `knots` against `carried`
+    /// ([`FramePlan::shapes`]).
     pub fn assess(
         &self,
         knots: &mut [P2],
@@ -200,16 +219,9 @@ impl FramePlan {
         response: &[f64],
         carried: &[P2],
     ) -> Assessed {
-        centre_group(
-            knots,
-            rest,
-            &self.inner,
-            &self.outer,
-            [down[1], -down[0]],
-            self.centring,
-        );
+        self.centre(knots, rest, down);
         let (ratio, confidence) = self.confidences(response);
-        let shape_ok = chords_within(knots, carried, &self.chord_ends, &self.least_chord);
+        let shape_ok = self.shapes(knots, carried);
         Assessed {
             ratio,
             confidence,

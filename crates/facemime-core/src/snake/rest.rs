@@ -17,7 +17,7 @@ pub(crate) fn mean_of(pts: &[[f64; 2]], idx: &[usize]) -> [f64; 2] {
 /// linear part from the centred points by the normal equations, or, where the group is
 /// (nearly) collinear, from the pseudo-inverse of its rank-one scatter; the translation maps
 /// the centroids onto each other. Indices must be inside both arrays (same length).
-pub fn affine_rest(
+pub(crate) fn affine_rest(
     carried: &[[f64; 2]],
     start: &[[f64; 2]],
     groups: &[&[usize]],
