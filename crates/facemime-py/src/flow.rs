@@ -7,7 +7,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
-use crate::points::{frame_view, point_rows, rows, MaskedPoints};
+use crate::points::{image_view, point_rows, rows, MaskedPoints};
 
 /// See `facemime.track.flow` for the documented API.
 #[pyclass(module = "facemime._core")]
@@ -50,7 +50,7 @@ impl FlowFrames {
         frame: PyReadonlyArrayDyn<u8>,
         crop: [usize; 4],
     ) -> PyResult<()> {
-        let frame = frame_view("frame", &frame)?;
+        let frame = image_view("frame", &frame)?;
         std::mem::swap(&mut self.prev, &mut self.cur);
         let (cur, max_level) = (&mut self.cur, self.max_level);
         py.detach(|| cur.rebuild(&frame, crop, max_level))

@@ -12,7 +12,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
-use crate::points::{array, frame_view, matrix, point_rows, rows};
+use crate::points::{array, image_view, matrix, point_rows, rows};
 
 /// The head's similarity step or None, and the extra points' positions.
 type Step<'py> = (Option<Bound<'py, PyArray2<f64>>>, Bound<'py, PyArray2<f64>>);
@@ -62,7 +62,7 @@ impl HeadFollower {
         epsilon: f64,
         min_eigen: f64,
     ) -> PyResult<Self> {
-        let frame = frame_view("frame", &frame)?;
+        let frame = image_view("frame", &frame)?;
         let z = zones.as_array();
         if z.shape()[1..] != [4, 2] {
             return Err(PyValueError::new_err(format!(
@@ -102,7 +102,7 @@ impl HeadFollower {
         brows: PyReadonlyArray2<f64>,
         extra: PyReadonlyArray2<f64>,
     ) -> PyResult<Step<'py>> {
-        let frame = frame_view("frame", &frame)?;
+        let frame = image_view("frame", &frame)?;
         let (brows, extra) = (
             rows::<2, _>("brows", &brows)?,
             rows::<2, _>("extra", &extra)?,

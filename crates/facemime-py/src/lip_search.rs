@@ -9,8 +9,8 @@ use numpy::{
 use pyo3::prelude::*;
 
 use crate::error::CoreErr;
+use crate::points::image_view;
 use crate::points::{rows, write_rows};
-use crate::snake::rgb_view;
 
 /// The core's lip colour from (w_r, w_g, bias).
 fn lip_colour(c: [f64; 3]) -> LipColour {
@@ -29,7 +29,7 @@ fn lip_score_map<'py>(
     colour: [f64; 3],
     bounds: (usize, usize, usize, usize),
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    let img = rgb_view("frame", &frame)?;
+    let img = image_view("frame", &frame)?;
     let colour = lip_colour(colour);
     let (x0, y0, x1, y1) = bounds;
     let map = lip_search::score_map(&img, &colour, [x0, y0, x1, y1]).map_err(CoreErr)?;
@@ -62,7 +62,7 @@ impl LipPlacer {
         signs: [f64; 4],
         edges: PyReadonlyArray2<f64>,
     ) -> PyResult<Self> {
-        let img = rgb_view("frame", &frame)?;
+        let img = image_view("frame", &frame)?;
         let edges = rows::<2, _>("edges", &edges)?;
         let colour = lip_colour(colour);
         let placer = py
@@ -84,7 +84,7 @@ impl LipPlacer {
         unfollowed: PyReadonlyArray1<bool>,
         scale: f64,
     ) -> PyResult<()> {
-        let img = rgb_view("frame", &frame)?;
+        let img = image_view("frame", &frame)?;
         let mut pts = rows::<2, _>("knots", &knots)?;
         let unfollowed = unfollowed.as_array().to_vec();
         py.detach(|| self.placer.place(&img, &mut pts, &unfollowed, scale))

@@ -2,9 +2,10 @@
 //! grey or colour images as core views.
 
 use facemime_core::raster::ImageRef;
+use numpy::ndarray::Dimension;
 use numpy::{
-    Element, IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyReadonlyArrayDyn,
-    PyReadwriteArray2, PyUntypedArrayMethods,
+    Element, IntoPyArray, PyArray1, PyArray2, PyReadonlyArray, PyReadonlyArray2, PyReadwriteArray2,
+    PyUntypedArrayMethods,
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -83,8 +84,12 @@ pub fn point_rows<'py>(py: Python<'py>, pts: &[Option<[f64; 2]>]) -> Bound<'py, 
     array(py, &rows)
 }
 
-/// A (H, W) grey or (H, W, C) C-contiguous uint8 image as a core image view.
-pub fn frame_view<'a>(name: &str, img: &'a PyReadonlyArrayDyn<'_, u8>) -> PyResult<ImageRef<'a>> {
+/// A (H, W) grey or (H, W, C) C-contiguous uint8 image as a core image view (the core checks
+/// the channels each use takes); a clear error naming `name` otherwise.
+pub fn image_view<'a, D: Dimension>(
+    name: &str,
+    img: &'a PyReadonlyArray<'_, u8, D>,
+) -> PyResult<ImageRef<'a>> {
     let shape = img.shape().to_vec();
     let data = img
         .as_slice()

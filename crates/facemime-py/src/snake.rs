@@ -1,6 +1,5 @@
 //! Bindings of `facemime_core::snake`: a `SnakeSolver` built once per tracker, solved per frame.
 
-use facemime_core::raster::ImageRef;
 use facemime_core::snake::{
     self, Band, CurveParams, Field, FrameInput, FrameTimes, Knots, MorePasses, Operator, PairKind,
     PairSpec, Problem, Settings, FIELD_CHANNELS,
@@ -14,7 +13,7 @@ use pyo3::prelude::*;
 use std::sync::Mutex;
 
 use crate::error::CoreErr;
-use crate::points::{array, matrix, rows, same_length};
+use crate::points::{array, image_view, matrix, rows, same_length};
 
 fn err(msg: String) -> PyErr {
     PyValueError::new_err(msg)
@@ -246,9 +245,9 @@ impl SnakeSolver {
         passes: usize,
         fast: f64,
     ) -> PyResult<Tracked<'py>> {
-        let img = rgb_view("frame", &frame)?;
+        let img = image_view("frame", &frame)?;
         frame_size(bounds.0, bounds.1)?;
-        let before = prev.as_ref().map(|p| rgb_view("prev", p)).transpose()?;
+        let before = prev.as_ref().map(|p| image_view("prev", p)).transpose()?;
         let (start, rest) = (rows::<2, _>("start", &start)?, rows::<2, _>("rest", &rest)?);
         let n = self.problem.n_knots();
         if start.len() != n || rest.len() != n {
@@ -395,18 +394,6 @@ impl<'a> FrameArgs<'a> {
     }
 }
 
-/// A (H, W, 3) C-contiguous uint8 frame as a core image view.
-pub(crate) fn rgb_view<'a>(
-    name: &str,
-    img: &'a PyReadonlyArray3<'_, u8>,
-) -> PyResult<ImageRef<'a>> {
-    let shape = img.as_array().shape().to_vec();
-    let data = img
-        .as_slice()
-        .map_err(|_| err(format!("{name} must be a C-contiguous uint8 array")))?;
-    Ok(ImageRef::named(name, data, shape[1], shape[0], shape[2]).map_err(CoreErr)?)
-}
-
 /// The (y1 − y0, x1 − x0, FIELD_CHANNELS) float32 field of `frame` over `region`
 /// (x0, y0, x1, y1), only inside `bands` ((x0, y0, x1, y1) frame rectangles) when given; see
 /// `facemime.track.field`. Written into `out` (a C-contiguous array of that shape, returned)
@@ -422,8 +409,8 @@ fn frame_field<'py>(
     bands: Option<Vec<[usize; 4]>>,
     out: Option<Bound<'py, PyArray3<f32>>>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
-    let img = rgb_view("frame", &frame)?;
-    let before = prev.as_ref().map(|p| rgb_view("prev", p)).transpose()?;
+    let img = image_view("frame", &frame)?;
+    let before = prev.as_ref().map(|p| image_view("prev", p)).transpose()?;
     let shape = snake::field_shape(&img, before.as_ref(), region, sigma).map_err(CoreErr)?;
     let out = match out {
         Some(o) if o.shape() != shape => {
