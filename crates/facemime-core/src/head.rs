@@ -183,9 +183,10 @@ impl HeadFollower {
     }
 
     /// The next `frame` (grey or RGB, the first frame's size): the zones placed by the previous
-    /// frame's `brows` (as many as the first frame's), the frame's pyramid built, the rigid points followed into it and fitted, and
-    /// the `extra` points (pixels of the previous frame) followed alike. With a similarity the
-    /// rigid points that fit it are kept at their new positions; without one, they stay.
+    /// frame's `brows` (as many as the first frame's), the frame's pyramid built, the rigid
+    /// points followed into it and fitted, and the `extra` points (pixels of the previous
+    /// frame) followed alike. With a similarity the rigid points that fit it are kept at their
+    /// new positions; without one, they stay.
     pub fn follow(
         &mut self,
         frame: &ImageRef,

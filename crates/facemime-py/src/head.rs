@@ -92,9 +92,10 @@ impl HeadFollower {
         Ok(Self { head })
     }
 
-    /// frame: the next frame, (H, W) grey or (H, W, 3) RGB uint8; brows: (N, 2) the previous frame's brow points;
-    /// extra: (E, 2) other points of the previous frame. Returns (the head's 2×3 similarity
-    /// step or None, the extra points' (E, 2) positions, NaN where the flow failed).
+    /// frame: the next frame, (H, W) grey or (H, W, 3) RGB uint8; brows: (N, 2) the previous
+    /// frame's brow points; extra: (E, 2) other points of the previous frame. Returns (the
+    /// head's 2×3 similarity step or None, the extra points' (E, 2) positions, NaN where the
+    /// flow failed).
     fn follow<'py>(
         &mut self,
         py: Python<'py>,

@@ -89,10 +89,9 @@ pub struct Knots<'a> {
 
 /// One frame's knots from `knots`' start: the field of `frame` (and `prev`, see
 /// [`super::frame_field`]) smoothed by `smoothing` pixels in the `bands` around the start (the
-/// solver reads only there), written
-/// into `buffer` (grown as needed and reused), a pass of the solver over every curve, then
-/// `more`'s passes. Returns the solution (iterations added up; each curve's response from the
-/// last pass that solved it) and the time of each stage.
+/// solver reads only there), written into `buffer` (grown as needed and reused), a pass of the
+/// solver over every curve, then `more`'s passes. Returns the solution (iterations added up;
+/// each curve's response from the last pass that solved it) and the time of each stage.
 #[allow(clippy::too_many_arguments)]
 pub fn solve_frame(
     problem: &Problem,
