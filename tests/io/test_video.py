@@ -1,8 +1,10 @@
+import threading
+
 import av
 import numpy as np
 import pytest
 
-from facemime.errors import InvalidInputError, OutputFileError
+from facemime.errors import InputFileError, InvalidInputError, OutputFileError
 from facemime.io import VideoWriter, check_outputs
 from facemime.io.outputs import OutputExistsError
 from facemime.io.video import VideoReader
@@ -87,3 +89,61 @@ def test_existing_outputs_are_not_overwritten_without_force(tmp_path):
         check_outputs([tmp_path / "a.png", tmp_path / "b.png"], force=False)
     check_outputs([tmp_path / "a.png"], force=True)
     assert (tmp_path / "a.png").read_bytes() == b"mine"
+
+
+def _decoders() -> list[str]:
+    return [t.name for t in threading.enumerate() if t.name.startswith("decoder ")]
+
+
+def _levels_clip(path, count: int) -> None:
+    with VideoWriter(path, fps=25) as w:
+        for i in range(count):
+            w.write(np.full((16, 32, 3), 10 + 9 * i, np.uint8))
+
+
+def test_frames_decoded_ahead_come_in_order_and_the_decoder_ends(tmp_path):
+    count = 3 * VideoReader.AHEAD  # more than the decoder queues
+    _levels_clip(tmp_path / "c.mp4", count)
+    with VideoReader(tmp_path / "c.mp4") as r:
+        levels = [int(f.mean().round()) for f in r]
+        assert _decoders() == []
+    assert np.allclose(levels, [10 + 9 * i for i in range(count)], atol=3), levels
+
+
+def test_stopping_early_stops_the_decoder(tmp_path):
+    _levels_clip(tmp_path / "c.mp4", 3 * VideoReader.AHEAD)
+    with VideoReader(tmp_path / "c.mp4") as r:
+        for index, _ in enumerate(r):
+            if index == 1:
+                break
+        assert _decoders() == []
+    with VideoReader(tmp_path / "c.mp4") as r:
+        frames = iter(r)
+        next(frames)
+        r.close()  # while the caller still holds the iteration
+        assert _decoders() == []
+        assert list(frames) == []
+
+
+class _FailingConverter:
+    """Converts frames as PyAV does until the ``fail_at``-th, which raises an FFmpeg error."""
+
+    def __init__(self, fail_at: int):
+        self.calls, self.fail_at = 0, fail_at
+
+    def reformat(self, frame, **kwargs):
+        self.calls += 1
+        if self.calls == self.fail_at:
+            raise av.InvalidDataError(1094995529, "Invalid data found when processing input")
+        return frame.reformat(**kwargs)
+
+
+def test_a_decoding_error_reaches_the_caller_as_one_line_where_it_happened(tmp_path):
+    _levels_clip(tmp_path / "c.mp4", 12)
+    with VideoReader(tmp_path / "c.mp4") as r:
+        r._to_rgb = _FailingConverter(fail_at=5)
+        got = []
+        with pytest.raises(InputFileError, match=r"^cannot decode video .*c\.mp4: Invalid data found"):
+            for frame in r:
+                got.append(frame)
+        assert len(got) == 4 and _decoders() == []

@@ -139,7 +139,15 @@ class VideoReader:
     ``width``, ``height`` (pixels), ``fps`` and ``frames`` (the container's frame count, 0 when
     unknown) are known after opening. A missing or unreadable file, or a file with no video
     stream, raises :class:`InputFileError` with one line naming it.
+
+    Frames are decoded on a thread of the reader's own, at most :data:`AHEAD` ahead of the
+    caller, so that decoding runs beside the caller's work on the frames already given; a
+    decoding error is raised, as :class:`InputFileError`, where the caller's iteration reaches
+    it. Stopping early (``break``, or :meth:`close`) stops the decoding.
     """
+
+    #: Frames decoded and waiting for the caller at most.
+    AHEAD = 8
 
     def __init__(self, path: str | Path):
         self.path = Path(path)
@@ -162,19 +170,62 @@ class VideoReader:
         self.frames = int(self._stream.frames or 0)
         # One converter for all frames: ``VideoFrame.to_ndarray`` sets up a new one per frame.
         self._to_rgb = VideoReformatter()
+        self._decoding: tuple[threading.Thread, threading.Event, queue.Queue] | None = None
         if self.width <= 0 or self.height <= 0:
             self._container.close()
             raise InputFileError(f"cannot read video {self.path}: no frame size in its stream")
 
     def __iter__(self) -> Iterator[np.ndarray]:
+        self._stop_decoding()
+        frames: queue.Queue[np.ndarray | BaseException | None] = queue.Queue(self.AHEAD)
+        stop = threading.Event()
+        decoder = threading.Thread(target=self._decode, args=(frames, stop), name=f"decoder {self.path.name}",
+                                   daemon=True)
+        self._decoding = (decoder, stop, frames)
+        decoder.start()
+        try:
+            while (item := frames.get()) is not None:
+                if isinstance(item, BaseException):
+                    raise item
+                yield item
+        finally:
+            self._stop_decoding()
+
+    def _decode(self, frames: queue.Queue, stop: threading.Event) -> None:
+        """The decoder thread: queues each frame, then None at the end or the error that ended
+        it; returns once ``stop`` is set."""
         try:
             for frame in self._container.decode(self._stream):
                 # One thread: FFmpeg's threaded conversion costs twice the time on a small frame.
-                yield self._to_rgb.reformat(frame, format="rgb24", threads=1).to_ndarray()
+                frames.put(self._to_rgb.reformat(frame, format="rgb24", threads=1).to_ndarray())
+                if stop.is_set():
+                    return
+            end: BaseException | None = None
         except (av.FFmpegError, OSError) as e:
-            raise InputFileError(f"cannot decode video {self.path}: {_reason(e)}") from None
+            end = InputFileError(f"cannot decode video {self.path}: {_reason(e)}")
+        except BaseException as e:  # noqa: BLE001 (an unexpected error, raised as it is in the caller's thread)
+            end = e
+        frames.put(end)
+
+    def _stop_decoding(self) -> None:
+        """Stops the decoder thread, if any, taking the frames it still queues."""
+        if self._decoding is None:
+            return
+        decoder, stop, frames = self._decoding
+        stop.set()
+        while decoder.is_alive():
+            try:
+                frames.get(timeout=0.01)
+            except queue.Empty:
+                pass
+        decoder.join()
+        while not frames.empty():  # what it queued last
+            frames.get_nowait()
+        frames.put_nowait(None)  # an iteration resumed after this ends
+        self._decoding = None
 
     def close(self) -> None:
+        self._stop_decoding()
         self._container.close()
 
     def __enter__(self) -> "VideoReader":
