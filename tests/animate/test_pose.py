@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from facemime.animate.pose import fit_pose, lift
+from facemime.animate.pose import fit_pose, lift, moved
 from facemime.model import generic_head
 from facemime.render.projection import Pose, project
 
@@ -41,3 +41,17 @@ def test_fit_pose_recovers_a_known_pose_from_noisy_points():
     pts[:10] += 25
     pose = fit_pose(head.vertices, pts, Pose(scale=2.0, tx=250, ty=250), towards=(18, -7))
     assert abs(pose.roll - 5) < 0.5 and abs(pose.tx - 260) < 1.5
+
+
+@pytest.mark.parametrize(("turn", "zoom", "shift"), [(0.0, 1.0, (14.0, -9.0)), (-6.0, 1.04, (5.0, 3.0)), (4.0, 0.97, (0.0, 0.0))])
+def test_a_pose_moved_by_an_image_step_projects_where_the_step_puts_its_projection(turn, zoom, shift):
+    """A frame whose pose the rigid points could not measure moves it by the head's step in the
+    image (turn in degrees, y down: clockwise as seen)."""
+    head = generic_head()
+    pose = Pose(yaw=15, pitch=-6, roll=7, scale=1.8, tx=230, ty=250)
+    c, s = zoom * np.cos(np.radians(turn)), zoom * np.sin(np.radians(turn))
+    step = np.array([[c, -s, shift[0]], [s, c, shift[1]]])
+    before = project(head.vertices, pose)[0]
+    after = project(head.vertices, moved(pose, step))[0]
+    assert np.abs(after - (before @ step[:, :2].T + step[:, 2])).max() < 1e-9
+    assert moved(pose, step).yaw == pose.yaw and moved(pose, step).pitch == pose.pitch

@@ -73,6 +73,26 @@ def test_a_large_face_tracks_as_well_as_at_the_size_the_settings_were_tuned_on(e
     assert np.abs(tracker.edges["mouth_outer_upper"] - refs[0]["mouth_outer_upper"]).max() < 10.0
 
 
+def test_the_heads_step_is_reported_in_the_frames_pixels(enlarged):
+    """The rigid points followed on the shrunk frames land, in the frame's pixels, where the
+    head's reported step carries them from the previous frame."""
+    frames, refs, _ = enlarged
+    tracker = Tracker(frames[0], refs[0])
+    residuals = []
+    for frame in frames[1:30]:
+        before = dict(zip(tracker.motion.ids.tolist(), tracker.motion.points))
+        tracker.update(frame)
+        points, ids = tracker.motion.followed
+        step = tracker.motion.step
+        pairs = [(before[i], p) for i, p in zip(ids.tolist(), points) if i in before]
+        if len(pairs) >= 6:
+            a, b = (np.array(x, np.float64) for x in zip(*pairs))
+            residuals.append(np.median(np.hypot(*(a @ step[:, :2].T + step[:, 2] - b).T)))
+    # The fit's inliers are within 1 working pixel (about 2.2 frame pixels); a step left in
+    # working pixels misses by half the head's position, hundreds of pixels.
+    assert len(residuals) > 20 and max(residuals) < 1.5
+
+
 def test_without_shrinking_the_same_face_tracks_worse(enlarged):
     errors, _, _ = track_errors(enlarged, TrackerParams(face_width=None))
     assert errors.mean() > 0.03  # measured: 0.041

@@ -2,9 +2,12 @@
 brow contours tracked, the head pose followed, and the local motion (knot offsets in the head's
 own frame, see :mod:`facemime.animate.deform`) measured.
 
-When the face is lost (it leaves the frame or turns away: the rigid points can no longer be
-followed), frames are marked and every later frame is searched for the face again; once found,
-tracking restarts from points found on it, and offsets stay relative to the first frame.
+When the face is lost (it leaves the frame or turns away: the head's step can no longer be
+measured, or every feature collapsed), frames are marked and every later frame is searched for
+the face again; once found, tracking restarts from points found on it, and offsets stay relative
+to the first frame. A frame whose step came from the head motion's coarse fallback (a fast,
+blurred shake: the rigid points are dropped and found anew) keeps the face: its pose moves by
+that step (:meth:`facemime.animate.pose.PoseTracker.update`).
 """
 
 from __future__ import annotations
@@ -84,8 +87,9 @@ class Analysis:
         t0 = time.perf_counter()
         result = self.tracker.update(frame)
         t1 = time.perf_counter()
-        measured = self.pose.update(self.tracker.motion)
-        face = result.motion_ok and measured and len(result.lost) < len(FEATURES)
+        # The pose is measured on the rigid points, or moved by the head's step without them.
+        self.pose.update(self.tracker.motion)
+        face = result.motion_ok and len(result.lost) < len(FEATURES)
         if face:
             offsets = self.deformer.knot_positions(result.contours, self.pose.pose) - self._knots0
             self.last = FrameMotion(result.contours, result.confidence, result.lost, True, self.pose.pose, offsets)

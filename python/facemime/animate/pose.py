@@ -10,6 +10,8 @@ by Gauss-Newton with Huber weights, started from the previous pose.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from facemime import _core
@@ -87,6 +89,17 @@ def fit_pose(model_points: np.ndarray, image_points: np.ndarray, start: Pose,
     return _pose(p)
 
 
+def moved(pose: Pose, step: np.ndarray) -> Pose:
+    """``pose`` followed by the image's 2×3 similarity ``step`` (pixels to pixels): the step's
+    turn added to the roll (counter-clockwise on the image, y down), its scale to the scale and
+    the model origin's image position moved by it; yaw and pitch stay."""
+    m = np.asarray(step, np.float64)
+    turn = np.degrees(np.arctan2(m[1, 0] - m[0, 1], m[0, 0] + m[1, 1]))
+    origin = m[:, :2] @ (pose.tx, pose.ty) + m[:, 2]
+    return replace(pose, roll=pose.roll - float(turn), scale=pose.scale * float(np.sqrt(abs(np.linalg.det(m[:, :2])))),
+                   tx=float(origin[0]), ty=float(origin[1]))
+
+
 class PoseTracker:
     """Follows the head pose of one actor model through a video, on the rigid points of a
     :class:`facemime.track.motion.HeadMotion`.
@@ -120,8 +133,10 @@ class PoseTracker:
 
     def update(self, motion: HeadMotion) -> bool:
         """Fit the pose to the points ``motion`` followed into the current frame; returns whether
-        it could be measured (at least :data:`MIN_POINTS` known points). An unmeasured frame keeps
-        the last pose. Yaw and pitch relax towards the first frame's by :data:`RELAX` per frame."""
+        it could be measured (at least :data:`MIN_POINTS` known points). An unmeasured frame
+        moves the last pose by the head's step in the image (``motion.step``; the step's
+        fallback, when the flow lost the points in a fast motion, drops them all). Yaw and pitch
+        relax towards the first frame's by :data:`RELAX` per frame."""
         points, ids = motion.followed
         known = np.array([i in self._known for i in ids.tolist()], bool)
         ok = int(known.sum()) >= MIN_POINTS
@@ -129,6 +144,8 @@ class PoseTracker:
             xyz = np.array([self._known[i] for i in ids[known].tolist()])
             self.pose = fit_pose(xyz, np.asarray(points, np.float64)[known], self.pose,
                                  towards=(self._frontal.yaw, self._frontal.pitch))
+        else:
+            self.pose = moved(self.pose, motion.step)
         current = set(motion.ids.tolist())
         self._known = {i: p for i, p in self._known.items() if i in current}
         self._lift(np.asarray(motion.points, np.float64), motion.ids)

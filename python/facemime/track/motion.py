@@ -103,7 +103,8 @@ class HeadMotion:
     (``HeadFollower.corners``, OpenCV's ``goodFeaturesToTrack``); the coarse fallback is
     OpenCV's, here.
 
-    ``total`` is the accumulated transform from the first frame to the current one. ``points``
+    ``total`` is the accumulated transform from the first frame to the current one, ``step``
+    the last frame's (identity before the first update and where it was not measured). ``points``
     (M, 2) float32 are the rigid points followed into the current frame and ``ids`` (M,) int64
     their identities: a point keeps its id for as long as it is followed, new detections get
     new ids (the head-pose estimator keeps each point's 3D position by id). ``followed`` is the
@@ -114,6 +115,7 @@ class HeadMotion:
         self._min_distance = max(3.0, face_frame(contours)[3] / 30.0)
         self._max_points = max_points
         self.total = IDENTITY.copy()
+        self.step = IDENTITY.copy()
         self._prev = frame = np.ascontiguousarray(frame, np.uint8)
         self._shape = frame.shape[:2]
         self._brows = tuple(n for n in contours if n.startswith("brow"))
@@ -207,6 +209,7 @@ class HeadMotion:
         extra_pts = as_points(np.zeros((0, 2)) if extra is None else extra)
         fit, moved = self._head.follow(frame, as_points(brows), extra_pts)
         step, ok = (fit, True) if fit is not None else self._coarse_shift(frame)
+        self.step = step
         self.total = compose(step, self.total)
         if self._head.advance(step):
             self._head.detected(self._detect(self._head.zones))

@@ -50,6 +50,15 @@ class FrameScale:
         """(N, 2) frame pixels -> working pixels (a new array)."""
         return (np.asarray(pts, np.float64) + 0.5) * self._f - 0.5 if self.active else np.array(pts, np.float64)
 
+    def frame_step(self, step: np.ndarray) -> np.ndarray:
+        """A 2×3 transform ``step`` of working pixels as the transform of frame pixels it is."""
+        out = np.array(step, np.float64)
+        if self.active:
+            f, c = self._f, 0.5 * self._f - 0.5  # working = f·frame + c, per axis
+            out[:, :2] = out[:, :2] * f[None, :] / f[:, None]
+            out[:, 2] = (step[:, :2] @ c + step[:, 2] - c) / f
+        return out
+
     def to_frame(self, pts: np.ndarray) -> np.ndarray:
         """(N, 2) working pixels -> frame pixels (a new array)."""
         return (np.asarray(pts, np.float64) + 0.5) / self._f - 0.5 if self.active else np.array(pts, np.float64)
@@ -57,8 +66,8 @@ class FrameScale:
 
 class ScaledMotion:
     """The rigid points of a :class:`facemime.track.motion.HeadMotion` that runs on working
-    frames, in the frame's pixels: ``points`` (M, 2) float32, ``ids`` (M,) int64 and
-    ``followed``, as the head motion's own."""
+    frames, in the frame's pixels: ``points`` (M, 2) float32, ``ids`` (M,) int64,
+    ``followed`` and the last frame's 2×3 ``step``, as the head motion's own."""
 
     def __init__(self, motion: HeadMotion, scale: FrameScale):
         self._motion, self._scale = motion, scale
@@ -78,3 +87,7 @@ class ScaledMotion:
     def followed(self) -> tuple[np.ndarray, np.ndarray]:
         pts, ids = self._motion.followed
         return self._frame_points(pts), ids
+
+    @property
+    def step(self) -> np.ndarray:
+        return self._scale.frame_step(self._motion.step)
