@@ -130,36 +130,37 @@ fn sample_portable(s: &Shape, g: &Grid, rows: usize, out: &mut [f32]) {
 
 /// Scharr derivatives of the window whose samples, grown by one pixel on every side, are
 /// `ext` (see [`sample`]): window (r, c) is `ext` (r + 1, c + 1). Writes `gx`, `gy` (`s.win`
-/// rows of `s.cols`) scaled by `live` per column (1/32 in the window, which makes them grey
-/// levels per pixel, as the Scharr weights sum to 32; 0 past it) and returns the gradient
-/// matrix and the window's image against its derivatives:
-/// (Σgx², Σgx·gy, Σgy², ΣI·gx, ΣI·gy), I the window's samples. `ext` must be finite.
-pub fn gradients(s: &Shape, ext: &[f32], live: &[f32], gx: &mut [f32], gy: &mut [f32]) -> [f64; 5] {
-    assert!(s.cols.is_multiple_of(LANES) && s.ecols >= s.cols + 2 && live.len() == s.cols);
+/// rows of `s.cols`) divided by 32, which makes them grey levels per pixel (the Scharr weights
+/// sum to 32), and 0 past the window's side; returns the gradient matrix and the window's image
+/// against its derivatives: (Σgx², Σgx·gy, Σgy², ΣI·gx, ΣI·gy), I the window's samples. `ext`
+/// must be finite.
+///
+/// Dividing by 32 is exact, so it is applied to the weights: (10/32)·a + (3/32)·b rounds as
+/// (10·a + 3·b)/32 does.
+pub fn gradients(s: &Shape, ext: &[f32], gx: &mut [f32], gy: &mut [f32]) -> [f64; 5] {
+    assert!(s.cols.is_multiple_of(LANES) && s.ecols >= s.cols + 2);
     assert!(ext.len() >= (s.win + 2) * s.ecols);
     assert!(gy.len() == gx.len() && gx.len() == s.win * s.cols);
     #[cfg(target_arch = "x86_64")]
     if has_avx2() {
         // SAFETY: AVX2 is present and the sizes are checked above.
-        return unsafe { gradients_avx2(s, ext, live, gx, gy) };
+        return unsafe { gradients_avx2(s, ext, gx, gy) };
     }
-    gradients_portable(s, ext, live, gx, gy)
+    gradients_portable(s, ext, gx, gy)
 }
 
-fn gradients_portable(
-    s: &Shape,
-    ext: &[f32],
-    live: &[f32],
-    gx: &mut [f32],
-    gy: &mut [f32],
-) -> [f64; 5] {
+/// The Scharr weights over 32.
+const TEN: f32 = 10.0 / 32.0;
+const THREE: f32 = 3.0 / 32.0;
+
+fn gradients_portable(s: &Shape, ext: &[f32], gx: &mut [f32], gy: &mut [f32]) -> [f64; 5] {
     let mut acc = [[0.0f32; LANES]; 5];
-    // Per column of ext row e: (row difference n − p, row smoothing 3·(p + n) + 10·m, m).
+    // Per column of ext row e: (row difference n − p, row smoothing (3·(p + n) + 10·m)/32, m).
     let along = |e: usize, k: usize| -> [[f32; LANES]; 3] {
         let v = &ext[e * s.ecols + k..][..LANES + 2];
         [
             std::array::from_fn(|l| v[l + 2] - v[l]),
-            std::array::from_fn(|l| 10.0f32.mul_add(v[l + 1], 3.0 * (v[l] + v[l + 2]))),
+            std::array::from_fn(|l| TEN.mul_add(v[l + 1], THREE * (v[l] + v[l + 2]))),
             std::array::from_fn(|l| v[l + 1]),
         ]
     };
@@ -168,9 +169,13 @@ fn gradients_portable(
         for r in 0..s.win {
             let r2 = along(r + 2, k);
             for l in 0..LANES {
-                let m = live[k + l];
-                let x = m * 10.0f32.mul_add(r1[0][l], 3.0 * (r0[0][l] + r2[0][l]));
-                let y = m * (r2[1][l] - r0[1][l]);
+                let live = k + l < s.win;
+                let x = TEN.mul_add(r1[0][l], THREE * (r0[0][l] + r2[0][l]));
+                let (x, y) = if live {
+                    (x, r2[1][l] - r0[1][l])
+                } else {
+                    (0.0, 0.0)
+                };
                 let i = r1[2][l];
                 gx[r * s.cols + k + l] = x;
                 gy[r * s.cols + k + l] = y;
@@ -280,44 +285,48 @@ unsafe fn sample_avx2(s: &Shape, g: &Grid, rows: usize, out: &mut [f32]) {
 /// AVX2 must be present and the sizes those [`gradients`] checks.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn gradients_avx2(
-    s: &Shape,
-    ext: &[f32],
-    live: &[f32],
-    gx: &mut [f32],
-    gy: &mut [f32],
-) -> [f64; 5] {
-    let (three, ten) = (_mm256_set1_ps(3.0), _mm256_set1_ps(10.0));
+unsafe fn gradients_avx2(s: &Shape, ext: &[f32], gx: &mut [f32], gy: &mut [f32]) -> [f64; 5] {
+    let (three, ten) = (_mm256_set1_ps(THREE), _mm256_set1_ps(TEN));
+    let lane = _mm256_setr_ps(0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0);
     let mut acc = [_mm256_setzero_ps(); 5];
-    let e = ext.as_ptr();
-    let along = |row: usize, k: usize| {
-        let v = e.add(row * s.ecols + k);
-        let (p, m, n) = (
-            _mm256_loadu_ps(v),
-            _mm256_loadu_ps(v.add(1)),
-            _mm256_loadu_ps(v.add(2)),
-        );
-        let smooth = _mm256_fmadd_ps(ten, m, _mm256_mul_ps(three, _mm256_add_ps(p, n)));
-        (_mm256_sub_ps(n, p), smooth, m)
-    };
     for k in (0..s.cols).step_by(LANES) {
-        let live = _mm256_loadu_ps(live.as_ptr().add(k));
-        let (mut r0, mut r1) = (along(0, k), along(1, k));
-        for r in 0..s.win {
-            let r2 = along(r + 2, k);
-            let x = _mm256_mul_ps(
-                live,
-                _mm256_fmadd_ps(ten, r1.0, _mm256_mul_ps(three, _mm256_add_ps(r0.0, r2.0))),
+        // All ones in the window's columns, zero past its side.
+        let live = _mm256_cmp_ps::<_CMP_LT_OQ>(
+            _mm256_add_ps(lane, _mm256_set1_ps(k as f32)),
+            _mm256_set1_ps(s.win as f32),
+        );
+        // Row e's difference n − p, smoothing (3·(p + n) + 10·m)/32 and middle m.
+        let along = |e: usize| {
+            let v = ext.as_ptr().add(e * s.ecols + k);
+            let (p, m, n) = (
+                _mm256_loadu_ps(v),
+                _mm256_loadu_ps(v.add(1)),
+                _mm256_loadu_ps(v.add(2)),
             );
-            let y = _mm256_mul_ps(live, _mm256_sub_ps(r2.1, r0.1));
-            let i = r1.2;
+            let smooth = _mm256_fmadd_ps(ten, m, _mm256_mul_ps(three, _mm256_add_ps(p, n)));
+            (_mm256_sub_ps(n, p), smooth, m)
+        };
+        // Rows r and r + 1 of ext held in registers, named rather than in arrays (which the
+        // compiler shuffles and spills).
+        let (mut d0, mut s0, _) = along(0);
+        let (mut d1, mut s1, mut m1) = along(1);
+        let [mut xx, mut xy, mut yy, mut ix, mut iy] = acc;
+        for r in 0..s.win {
+            let (d2, s2, m2) = along(r + 2);
+            let x = _mm256_fmadd_ps(ten, d1, _mm256_mul_ps(three, _mm256_add_ps(d0, d2)));
+            let x = _mm256_and_ps(live, x);
+            let y = _mm256_and_ps(live, _mm256_sub_ps(s2, s0));
             _mm256_storeu_ps(gx.as_mut_ptr().add(r * s.cols + k), x);
             _mm256_storeu_ps(gy.as_mut_ptr().add(r * s.cols + k), y);
-            for (a, (u, v)) in acc.iter_mut().zip([(x, x), (x, y), (y, y), (i, x), (i, y)]) {
-                *a = _mm256_fmadd_ps(u, v, *a);
-            }
-            (r0, r1) = (r1, r2);
+            xx = _mm256_fmadd_ps(x, x, xx);
+            xy = _mm256_fmadd_ps(x, y, xy);
+            yy = _mm256_fmadd_ps(y, y, yy);
+            ix = _mm256_fmadd_ps(m1, x, ix);
+            iy = _mm256_fmadd_ps(m1, y, iy);
+            (d0, s0) = (d1, s1);
+            (d1, s1, m1) = (d2, s2, m2);
         }
+        acc = [xx, xy, yy, ix, iy];
     }
     acc.map(|a| sum(avx2::lanes(a)))
 }
@@ -383,8 +392,6 @@ mod tests {
             let s = Shape::new(win);
             let stride = 90;
             let plane = values(stride * 40, 1);
-            let mut live = vec![1.0f32 / 32.0; s.cols];
-            live[win..].fill(0.0);
             for (seed, wx, wy) in [(2, [0.3, 0.7], [0.6, 0.4]), (3, [0.95, 0.05], [0.02, 0.98])] {
                 let g = Grid {
                     plane: &plane,
@@ -402,8 +409,8 @@ mod tests {
                 let n = win * s.cols;
                 let (mut gx, mut gy, mut hx, mut hy) =
                     (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-                let m = gradients(&s, &a, &live, &mut gx, &mut gy);
-                assert_eq!(m, gradients_portable(&s, &a, &live, &mut hx, &mut hy));
+                let m = gradients(&s, &a, &mut gx, &mut gy);
+                assert_eq!(m, gradients_portable(&s, &a, &mut hx, &mut hy));
                 assert_eq!((&gx, &gy), (&hx, &hy));
                 assert!(gx
                     .chunks(s.cols)

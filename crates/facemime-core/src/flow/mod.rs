@@ -48,7 +48,6 @@ pub struct LkParams {
 /// win rows, zero past the side.
 struct Windows {
     shape: Shape,
-    live: Vec<f32>,
     ext: Vec<f32>,
     gx: Vec<f32>,
     gy: Vec<f32>,
@@ -57,11 +56,8 @@ struct Windows {
 impl Windows {
     fn new(win: usize) -> Self {
         let shape = Shape::new(win);
-        let mut live = vec![1.0 / 32.0; shape.cols];
-        live[win..].fill(0.0);
         Self {
             shape,
-            live,
             ext: vec![0.0; (win + 2) * shape.ecols],
             gx: vec![0.0; win * shape.cols],
             gy: vec![0.0; win * shape.cols],
@@ -151,8 +147,7 @@ fn track_level(
     // against its derivatives.
     let grown = prev.grid(level, c0[0] - 1.0, c0[1] - 1.0, s.sampled_block(win + 2));
     kernels::sample(&s, &grown, win + 2, &mut bufs.ext);
-    let [a11, a12, a22, i1, i2] =
-        kernels::gradients(&s, &bufs.ext, &bufs.live, &mut bufs.gx, &mut bufs.gy);
+    let [a11, a12, a22, i1, i2] = kernels::gradients(&s, &bufs.ext, &mut bufs.gx, &mut bufs.gy);
     let det = a11 * a22 - a12 * a12;
     let min_eigen =
         (a11 + a22 - ((a11 - a22).powi(2) + 4.0 * a12 * a12).sqrt()) / (2.0 * (win * win) as f64);
