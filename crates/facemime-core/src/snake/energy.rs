@@ -77,6 +77,7 @@ fn add_to(g: &mut P2, v: P2, s: f64) {
 /// Internal energies E1 + E2 + Et of one curve; adds their gradient to `grad` (indexed like
 /// `knots`, through `idx`). `chord2` is Δ², `n` the points per segment.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 pub(crate) fn internal(
     idx: &[usize],
     knots: &[P2],
@@ -123,6 +124,7 @@ pub(crate) fn internal(
 
 /// Image energies −(Ec + Ev) of one curve; adds their gradient to `grad`. Returns
 /// (energy, mean H over the curve points).
+#[inline(always)]
 pub(crate) fn image(
     idx: &[usize],
     knots: &[P2],
@@ -162,7 +164,7 @@ pub(crate) fn image(
 }
 
 /// H and (L − L')² at one point with their (x, y) gradients.
-#[inline]
+#[inline(always)]
 fn point_terms(field: &Field<'_>, x: f64, y: f64, nrm: P2, p: &CurveParams) -> (f64, P2, f64, P2) {
     // The derivative channels come first; the lumas only feed the temporal term.
     let s = if p.gamma == 0.0 {
@@ -209,6 +211,7 @@ fn point_terms(field: &Field<'_>, x: f64, y: f64, nrm: P2, p: &CurveParams) -> (
 }
 
 /// Energy of one pair with target gap `target` (pixels); adds its gradient to `grad`.
+#[inline(always)]
 pub(crate) fn pair(spec: &PairSpec, target: f64, knots: &[P2], down: P2, grad: &mut [P2]) -> f64 {
     let d = sub(knots[spec.b], knots[spec.a]);
     let gap = down[0] * d[0] + down[1] * d[1];

@@ -60,7 +60,7 @@ impl<'a> Field<'a> {
 
     /// Samples at frame point (x, y) the first `N` channels (the others are 0). Outside the
     /// block the border value is used and the derivative across the border is zero.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn sample<const N: usize>(&self, x: f64, y: f64) -> Sample {
         let (fx, cx, x0) = axis(x - self.origin[0], self.width);
         let (fy, cy, y0) = axis(y - self.origin[1], self.height);
@@ -98,7 +98,7 @@ impl<'a> Field<'a> {
 
 /// Splits a local coordinate into (fraction, inside, cell index) with the cell clamped to the
 /// block; `inside` is false when the coordinate was clamped.
-#[inline]
+#[inline(always)]
 fn axis(t: f64, size: usize) -> (f64, bool, usize) {
     let max = (size - 1) as f64;
     if t.is_nan() || t <= 0.0 {

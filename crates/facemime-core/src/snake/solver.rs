@@ -272,6 +272,37 @@ impl Problem {
         active: &[bool],
         ws: &mut Workspace,
     ) -> f64 {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+        {
+            // SAFETY: AVX2 and FMA are present.
+            return unsafe { self.evaluate_avx2(knots, input, active, ws) };
+        }
+        self.evaluate_body(knots, input, active, ws)
+    }
+
+    /// [`Problem::evaluate`] compiled for AVX2 and FMA: the same operations (Rust never fuses
+    /// a product and a sum on its own), in fewer instructions.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn evaluate_avx2(
+        &self,
+        knots: &[P2],
+        input: &FrameInput<'_>,
+        active: &[bool],
+        ws: &mut Workspace,
+    ) -> f64 {
+        self.evaluate_body(knots, input, active, ws)
+    }
+
+    #[inline(always)]
+    fn evaluate_body(
+        &self,
+        knots: &[P2],
+        input: &FrameInput<'_>,
+        active: &[bool],
+        ws: &mut Workspace,
+    ) -> f64 {
         ws.grad.iter_mut().for_each(|g| *g = [0.0; 2]);
         ws.group_energy.iter_mut().for_each(|e| *e = 0.0);
         let n = self.settings.points_per_segment;
