@@ -13,6 +13,8 @@ use crate::error::Result;
 use crate::invalid;
 
 type P2 = [f64; 2];
+/// Per knot, whether it stays where it starts (see [`Problem::solve_some`]).
+type Held<'a> = Option<&'a [bool]>;
 
 /// Solver settings shared by all curves of a problem.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -184,6 +186,26 @@ impl Problem {
         curves: &[bool],
         held: Option<&[bool]>,
     ) -> Result<Solution> {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+        {
+            // SAFETY: AVX2 and FMA are present.
+            return unsafe { self.solve_avx2(input, curves, held) };
+        }
+        self.solve_body(input, curves, held)
+    }
+
+    /// [`Problem::solve_some`] compiled for AVX2 and FMA: the same operations (Rust never fuses
+    /// a product and a sum on its own), in fewer instructions.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn solve_avx2(&self, at: &FrameInput, curves: &[bool], held: Held) -> Result<Solution> {
+        self.solve_body(at, curves, held)
+    }
+
+    /// [`Problem::solve_some`]'s work.
+    #[inline(always)]
+    fn solve_body(&self, input: &FrameInput, curves: &[bool], held: Held) -> Result<Solution> {
         if curves.len() != self.curves.len() {
             return invalid!(
                 "the curve mask must have {} values, got {}",
@@ -265,38 +287,8 @@ impl Problem {
 
     /// Total energy at `knots` of the `active` groups; writes its gradient and each of their
     /// curves' mean H into `ws` (NaN for the other curves).
-    fn evaluate(
-        &self,
-        knots: &[P2],
-        input: &FrameInput<'_>,
-        active: &[bool],
-        ws: &mut Workspace,
-    ) -> f64 {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-        {
-            // SAFETY: AVX2 and FMA are present.
-            return unsafe { self.evaluate_avx2(knots, input, active, ws) };
-        }
-        self.evaluate_body(knots, input, active, ws)
-    }
-
-    /// [`Problem::evaluate`] compiled for AVX2 and FMA: the same operations (Rust never fuses
-    /// a product and a sum on its own), in fewer instructions.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn evaluate_avx2(
-        &self,
-        knots: &[P2],
-        input: &FrameInput<'_>,
-        active: &[bool],
-        ws: &mut Workspace,
-    ) -> f64 {
-        self.evaluate_body(knots, input, active, ws)
-    }
-
     #[inline(always)]
-    fn evaluate_body(
+    fn evaluate(
         &self,
         knots: &[P2],
         input: &FrameInput<'_>,
