@@ -9,6 +9,7 @@
 pub mod adjust;
 mod border;
 pub mod corners;
+mod cpu;
 pub mod error;
 pub mod extent;
 pub mod flow;

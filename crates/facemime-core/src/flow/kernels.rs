@@ -15,6 +15,8 @@
 //! side rounded up to [`LANES`]; columns past the side are dead (derivatives 0) and add nothing.
 
 #[cfg(target_arch = "x86_64")]
+use crate::cpu::has_avx2_fma;
+#[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
 
 /// Width of the partial sums.
@@ -87,11 +89,6 @@ impl Grid<'_> {
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-fn has_avx2() -> bool {
-    std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-}
-
 /// The lanes' total, in f64: lanes l and l + 4, then those sums two apart, then the two.
 fn sum(a: [f32; LANES]) -> f64 {
     let h: [f64; 4] = std::array::from_fn(|l| a[l] as f64 + a[l + 4] as f64);
@@ -104,7 +101,7 @@ pub fn sample(s: &Shape, g: &Grid, rows: usize, out: &mut [f32]) {
     assert!(out.len() >= rows * s.ecols && s.ecols >= s.sampled());
     g.row(rows, s.sampled() - LANES, LANES); // the last value read is in the plane
     #[cfg(target_arch = "x86_64")]
-    if has_avx2() {
+    if has_avx2_fma() {
         // SAFETY: AVX2 is present and the sizes are checked above.
         return unsafe { sample_avx2(s, g, rows, out) };
     }
@@ -142,7 +139,7 @@ pub fn gradients(s: &Shape, ext: &[f32], gx: &mut [f32], gy: &mut [f32]) -> [f64
     assert!(ext.len() >= (s.win + 2) * s.ecols);
     assert!(gy.len() == gx.len() && gx.len() == s.win * s.cols);
     #[cfg(target_arch = "x86_64")]
-    if has_avx2() {
+    if has_avx2_fma() {
         // SAFETY: AVX2 is present and the sizes are checked above.
         return unsafe { gradients_avx2(s, ext, gx, gy) };
     }
@@ -196,7 +193,7 @@ pub fn correlate(s: &Shape, next: &Grid, gx: &[f32], gy: &[f32]) -> [f64; 2] {
     assert!(gy.len() == gx.len() && gx.len() == s.win * s.cols);
     next.row(s.win, s.cols - LANES, LANES); // the last value read is in the plane
     #[cfg(target_arch = "x86_64")]
-    if has_avx2() {
+    if has_avx2_fma() {
         // SAFETY: AVX2 is present and the sizes are checked above.
         return unsafe { correlate_avx2(s, next, gx, gy) };
     }
@@ -385,7 +382,7 @@ mod tests {
 
     #[test]
     fn avx2_kernels_equal_the_portable_ones_bit_for_bit() {
-        if !has_avx2() {
+        if !has_avx2_fma() {
             return;
         }
         for win in [5, 15, 21] {

@@ -187,8 +187,7 @@ impl Problem {
         held: Option<&[bool]>,
     ) -> Result<Solution> {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-        {
+        if crate::cpu::has_avx2_fma() {
             // SAFETY: AVX2 and FMA are present.
             return unsafe { self.solve_avx2(input, curves, held) };
         }
@@ -199,8 +198,13 @@ impl Problem {
     /// a product and a sum on its own), in fewer instructions.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    unsafe fn solve_avx2(&self, at: &FrameInput, curves: &[bool], held: Held) -> Result<Solution> {
-        self.solve_body(at, curves, held)
+    unsafe fn solve_avx2(
+        &self,
+        input: &FrameInput,
+        curves: &[bool],
+        held: Held,
+    ) -> Result<Solution> {
+        self.solve_body(input, curves, held)
     }
 
     /// [`Problem::solve_some`]'s work.
