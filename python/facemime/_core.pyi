@@ -145,7 +145,11 @@ def reported_knots(
     lower: npt.NDArray[np.uintp],
 ) -> npt.NDArray[np.float64]: ...
 def field_regions(
-    knots: npt.NDArray[np.float64], bands: list[tuple[npt.NDArray[np.uintp], float]], width: int, height: int
+    knots: npt.NDArray[np.float64],
+    bands: list[tuple[npt.NDArray[np.uintp], float]],
+    width: int,
+    height: int,
+    sigma: float,
 ) -> tuple[tuple[int, int, int, int], list[tuple[int, int, int, int]]]: ...
 def frame_field(
     frame: npt.NDArray[np.uint8],

@@ -46,11 +46,29 @@ def test_without_a_previous_frame_the_last_channel_repeats_the_luma(frames):
 def test_the_regions_cover_their_knots_with_their_margin_inside_the_image():
     knots = np.array([[10.2, 50.0], [90.7, 60.5], [99.0, 79.0]])
     bands = [(np.array([0, 1], np.uintp), 5.0), (np.array([2], np.uintp), 0.0)]
-    box, boxes = regions(knots, bands, 100, 80)
+    # σ = 0.5: a 5-tap Gaussian, radius 2, by which the box grows (inside the image).
+    box, boxes = regions(knots, bands, 100, 80, 0.5)
     assert boxes == [(5, 45, 97, 67), (96, 76, 100, 80)]
-    assert box == (5, 45, 100, 80)
+    assert box == (3, 43, 100, 80)
     with pytest.raises(ValueError, match="past the 3 knots"):
-        regions(knots, [(np.array([3], np.uintp), 1.0)], 100, 80)
+        regions(knots, [(np.array([3], np.uintp), 1.0)], 100, 80, 0.5)
+    with pytest.raises(ValueError, match="sigma"):
+        regions(knots, bands, 100, 80, 0.0)
+
+
+def test_a_field_read_inside_its_bands_is_that_of_a_box_grown_far_beyond_them(frames):
+    """The pixels of a band hold the values of a field over a much larger box (no mirrored
+    edge reaches them), so the snakes read the same field however tight the box."""
+    knots = np.array([[200.0, 300.0], [260.0, 310.0]])
+    bands = [(np.array([0, 1], np.uintp), 6.0)]
+    box, (band,) = regions(knots, bands, 700, 700, 1.5)
+    tight = build_field(frames[1], frames[0], box, 1.5, [band])
+    wide_box = (box[0] - 40, box[1] - 40, box[2] + 40, box[3] + 40)
+    wide = build_field(frames[1], frames[0], wide_box, 1.5)
+    (x0, y0, x1, y1), (ox, oy) = band, (box[0] - wide_box[0], box[1] - wide_box[1])
+    read = (slice(y0 - box[1] + 1, y1 - box[1] - 1), slice(x0 - box[0] + 1, x1 - box[0] - 1))
+    wide_read = (slice(read[0].start + oy, read[0].stop + oy), slice(read[1].start + ox, read[1].stop + ox))
+    np.testing.assert_array_equal(tight[read], wide[wide_read])
 
 
 def test_a_reused_buffer_gets_the_same_field_whatever_it_held(frames):

@@ -443,20 +443,23 @@ fn frame_field<'py>(
 }
 
 /// knots: (K, 2) pixels; bands: (knot indices (uintp), margin px) pairs; width, height: the
-/// frame's. Returns (the box holding every band's region, each band's region): the integer
-/// boxes (x0, y0, x1, y1), exclusive ends, around the band's knots grown by its margin, inside
-/// the frame, at least 4×4.
+/// frame's; sigma: the field's smoothing (px). Returns (the field's box, each band's region):
+/// integer boxes (x0, y0, x1, y1), exclusive ends, inside the frame, at least 4×4; a band's
+/// region is around its knots grown by its margin, the box holds them all grown by the
+/// smoothing's radius.
 #[pyfunction]
 fn field_regions(
     knots: PyReadonlyArray2<f64>,
     bands: Vec<(PyReadonlyArray1<usize>, f64)>,
     width: usize,
     height: usize,
+    sigma: f64,
 ) -> PyResult<([usize; 4], Vec<[usize; 4]>)> {
     let knots = rows::<2, _>("knots", &knots)?;
     let bands = bands_of(&bands, knots.len())?;
     frame_size(width, height)?;
-    Ok(snake::band_regions(&knots, &bands, width, height))
+    snake::check_sigma(sigma).map_err(CoreErr)?;
+    Ok(snake::band_regions(&knots, &bands, width, height, sigma))
 }
 
 /// knots, offset: (K, 2) pixels; linear: the head's 2×2 linear part; down: unit vector;

@@ -14,13 +14,15 @@ import numpy as np
 from facemime import _core
 
 
-def regions(knots: np.ndarray, bands: list[tuple[np.ndarray, float]], width: int,
-            height: int) -> tuple[tuple[int, int, int, int], list[tuple[int, int, int, int]]]:
-    """The field's regions for ``knots`` (K, 2) px in a ``width`` × ``height`` frame: each of
-    ``bands``, (knot indices as np.uintp, margin px), gives the integer box (x0, y0, x1, y1),
-    exclusive ends, around its knots grown by its margin, inside the frame, at least 4×4;
-    returns (the box holding them all, those boxes)."""
-    box, boxes = _core.field_regions(np.ascontiguousarray(knots, np.float64), bands, width, height)
+def regions(knots: np.ndarray, bands: list[tuple[np.ndarray, float]], width: int, height: int,
+            sigma: float) -> tuple[tuple[int, int, int, int], list[tuple[int, int, int, int]]]:
+    """The field's regions for ``knots`` (K, 2) px in a ``width`` × ``height`` frame, smoothed
+    by ``sigma`` px: each of ``bands``, (knot indices as np.uintp, margin px: how far around
+    them the field is read), gives the integer box (x0, y0, x1, y1), exclusive ends, around its
+    knots grown by its margin, inside the frame, at least 4×4, where the field is computed;
+    returns (the field's box, those boxes). The box holds them all grown by the smoothing's
+    radius, so that every pixel read holds the values it would in a field of the whole frame."""
+    box, boxes = _core.field_regions(np.ascontiguousarray(knots, np.float64), bands, width, height, sigma)
     return tuple(box), [tuple(b) for b in boxes]
 
 

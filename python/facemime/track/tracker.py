@@ -383,11 +383,12 @@ class Tracker:
 
     def _band_args(self, bands: tuple[tuple[np.ndarray, int], ...]) -> list[tuple[np.ndarray, float]]:
         """(knot indices as np.uintp, margin px) of each of ``bands``, (knot indices, solver
-        passes): the margin that so many passes from the knots, each reaching δ0/(1−σ) px, and
-        the smoothing can read."""
+        passes): the margin that so many passes from the knots, each reaching δ0/(1−σ) px, can
+        read (and the bilinear cell of a point read); the field's box grows beyond it by the
+        smoothing's radius (:func:`facemime.track.field.regions`)."""
         p = self.params
         reach = p.delta0 / (1.0 - p.sigma)
-        return [(np.asarray(idx, np.uintp), passes * reach + 4.0 * p.smoothing + 2.0) for idx, passes in bands]
+        return [(np.asarray(idx, np.uintp), passes * reach + 2.0) for idx, passes in bands]
 
     def _previous(self) -> np.ndarray | None:
         """The previous frame when the temporal brightness term reads it, else None."""
@@ -403,7 +404,7 @@ class Tracker:
         # The snakes read the image only near the knots: around the brows and around the mouth,
         # not the eyes and nose between them.
         band_args = self._band_args(bands) if bands is not None else self._frame_bands
-        box, boxes = regions(knots, band_args, self.width, self.height)
+        box, boxes = regions(knots, band_args, self.width, self.height, self.params.smoothing)
         # One buffer reused frame after frame: a fresh megabyte-sized array each frame cost
         # more in page faults than filling it.
         size = (box[3] - box[1]) * (box[2] - box[0]) * _core.FIELD_CHANNELS

@@ -7,7 +7,7 @@
 use std::time::{Duration, Instant};
 
 use super::field::{Field, FIELD_CHANNELS};
-use super::frame_field::band_field;
+use super::frame_field::{band_field, smoothing_radius};
 use super::rest::mean_of;
 use super::solver::{FrameInput, Problem, Solution};
 use crate::error::Result;
@@ -15,7 +15,8 @@ use crate::extent::extent;
 use crate::motion::{dot_after, dot_before, transformed};
 use crate::raster::ImageRef;
 
-/// Knots whose field is read `margin` pixels around them at most.
+/// Knots whose field is read `margin` pixels around them at most (their reach, and one pixel
+/// more for the bilinear cell of a point read).
 pub struct Band<'a> {
     pub knots: &'a [usize],
     pub margin: f64,
@@ -51,22 +52,26 @@ pub fn region(points: &[[f64; 2]], margin: f64, width: usize, height: usize) -> 
     [x0, y0, x1, y1].map(|v| v as usize)
 }
 
-/// Each band's [`region`] around its knots, and the box holding them all.
+/// Each band's [`region`] around its knots, where the field is computed, and the field's box:
+/// the one holding those regions each grown by the radius of a smoothing of `sigma` pixels
+/// ([`smoothing_radius`]), so that the smoothing of every pixel read stops short of the box's
+/// mirrored edges (a field pixel then holds the same value whatever the box, see
+/// [`super::frame_field`]).
 pub fn band_regions(
     knots: &[[f64; 2]],
     bands: &[Band<'_>],
     width: usize,
     height: usize,
+    sigma: f64,
 ) -> ([usize; 4], Vec<[usize; 4]>) {
-    let boxes: Vec<[usize; 4]> = bands
-        .iter()
-        .map(|b| {
-            let pts: Vec<[f64; 2]> = b.knots.iter().map(|&i| knots[i]).collect();
-            region(&pts, b.margin, width, height)
-        })
-        .collect();
+    let grown = smoothing_radius(sigma) as f64;
+    let around = |b: &Band, grow: f64| {
+        let pts: Vec<[f64; 2]> = b.knots.iter().map(|&i| knots[i]).collect();
+        region(&pts, b.margin + grow, width, height)
+    };
+    let boxes: Vec<[usize; 4]> = bands.iter().map(|b| around(b, 0.0)).collect();
     let mut all = [usize::MAX, usize::MAX, 0, 0];
-    for b in &boxes {
+    for b in bands.iter().map(|b| around(b, grown)) {
         all = [
             all[0].min(b[0]),
             all[1].min(b[1]),
@@ -105,7 +110,7 @@ pub fn solve_frame(
 ) -> Result<(Solution, FrameTimes)> {
     let t0 = Instant::now();
     let [width, height] = knots.bounds;
-    let (b, boxes) = band_regions(knots.start, bands, width, height);
+    let (b, boxes) = band_regions(knots.start, bands, width, height, smoothing);
     let (w, h) = (b[2] - b[0], b[3] - b[1]);
     let size = w * h * FIELD_CHANNELS;
     if buffer.len() < size {
@@ -302,8 +307,8 @@ mod tests {
         let (brow, lip): (Vec<usize>, Vec<usize>) = ((0..5).collect(), (5..10).collect());
         let curves = vec![(brow.clone(), params), (lip.clone(), params)];
         let problem = Problem::new(curves, vec![], 10, settings).unwrap();
-        // The tracker's margins: its passes' reach, the smoothing's and the cell's.
-        let margin = |passes: f64| passes * 8.0 + 4.0 * 1.5 + 2.0;
+        // The tracker's margins: its passes' reach and the cell's.
+        let margin = |passes: f64| passes * 8.0 + 2.0;
         let bands = [
             Band {
                 knots: &brow,
@@ -370,9 +375,10 @@ mod tests {
                 margin: 1.0,
             },
         ];
-        let (all, boxes) = band_regions(&knots, &bands, 100, 80);
+        // σ = 0.25: a 3-tap Gaussian, radius 1.
+        let (all, boxes) = band_regions(&knots, &bands, 100, 80, 0.25);
         assert_eq!(boxes, [[8, 8, 23, 15], [59, 39, 63, 43]], "at least 4×4");
-        assert_eq!(all, [8, 8, 63, 43]);
+        assert_eq!(all, [7, 7, 63, 43], "grown by the radius, inside the image");
     }
 
     #[test]

@@ -199,15 +199,28 @@ pub fn field_shape(
             frame.height
         );
     }
+    check_sigma(sigma)?;
+    Ok([y1 - y0, x1 - x0, FIELD_CHANNELS])
+}
+
+/// An error unless `sigma` (pixels) is a smoothing the field takes: in (0, [`MAX_SIGMA`]].
+pub fn check_sigma(sigma: f64) -> Result<()> {
     if !(sigma > 0.0 && sigma <= MAX_SIGMA) {
         return invalid!("sigma must be in (0, {MAX_SIGMA}] pixels, got {sigma}");
     }
-    Ok([y1 - y0, x1 - x0, FIELD_CHANNELS])
+    Ok(())
+}
+
+/// The radius (pixels) of the Gaussian of `sigma` pixels (see [`gaussian`]): a field pixel
+/// whose derivatives read no mirrored pixel lies more than this plus one inside its region's
+/// edges (those not on the frame's), and holds the same value in any such region.
+pub fn smoothing_radius(sigma: f64) -> usize {
+    (((sigma * 8.0 + 1.0).round() as usize) | 1) / 2
 }
 
 /// OpenCV's Gaussian taps for a float image: side round(8σ + 1) | 1, computed in f64.
 fn gaussian(sigma: f64) -> Vec<f32> {
-    let side = ((sigma * 8.0 + 1.0).round() as usize) | 1;
+    let side = 2 * smoothing_radius(sigma) + 1;
     let r = (side / 2) as f64;
     let taps: Vec<f64> = (0..side)
         .map(|i| (-(i as f64 - r).powi(2) / (2.0 * sigma * sigma)).exp())

@@ -21,6 +21,6 @@ pub use field::{Field, FIELD_CHANNELS};
 pub use frame::{
     band_regions, region, reported_knots, solve_frame, Band, FrameTimes, Knots, MorePasses,
 };
-pub use frame_field::{field_shape, frame_field, MAX_SIGMA};
+pub use frame_field::{check_sigma, field_shape, frame_field, MAX_SIGMA};
 pub use plan::{Assessed, Begun, FramePlan, Settled};
 pub use solver::{FrameInput, Problem, Settings, Solution};
