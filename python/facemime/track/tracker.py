@@ -302,7 +302,7 @@ class Tracker:
         self._order = np.concatenate([self._index[n] for n in CONTOUR_NAMES])
         ends = np.cumsum([0] + [len(self._index[n]) for n in CONTOUR_NAMES]).tolist()
         self._spans = list(zip(CONTOUR_NAMES, ends[:-1], ends[1:]))
-        self._feature_rows = {f: np.array([CONTOUR_NAMES.index(n) for n in names]) for f, names in FEATURES.items()}
+        self._feature_rows = {f: tuple(CONTOUR_NAMES.index(n) for n in names) for f, names in FEATURES.items()}
         # Curve masks of the features solved on their own: the mouth's second pass, a brow found again.
         self._feature_curves = {f: np.isin(np.arange(len(CONTOUR_NAMES)), rows) for f, rows in self._feature_rows.items()}
         self._mouth_curves = np.array([n.startswith("mouth") for n in CONTOUR_NAMES])
@@ -467,33 +467,22 @@ class Tracker:
                                                 self._mouth_uintp, self._mouth_curves, p.mouth_passes, FAST * reach)
         # The inner mouth centred (:meth:`_centre_inner`), the confidences and shape checks.
         ratio, confs, shapes = self._plan.assess(knots, rest, tuple(down), resp, carried)
-        confidences, shapes_ok = dict(zip(FEATURES, confs)), dict(zip(FEATURES, shapes))
-        confidence, lost = {}, []
-        for feature in FEATURES:
-            rows, idx = self._feature_rows[feature], self._features[feature]
-            conf = confidences[feature]
-            fallback = carried
-            shape_ok = shapes_ok[feature]
+        ratio, confidence, lost = ratio.tolist(), dict(zip(FEATURES, confs)), []
+        for feature, shape_ok in zip(FEATURES, shapes):
+            conf, fallback = confidence[feature], carried
             search = self._brow_search.get(feature)
-            if search is not None and (ratio[rows].min() < p.brow_search or not shape_ok):
-                found = search.find(frame, scale, start[idx])
-                if found is not None:
-                    fallback = knots.copy()
-                    fallback[idx] = found
-                    if np.abs(found - knots[idx]).max() >= AGREE * reach:
-                        again, more, again_resp = self._solve(self._field(frame, fallback, ((idx, 1),)), fallback,
-                                                              rest, down, targets, self._feature_curves[feature])
-                        iters += more
-                        conf_again = self._confidences(again_resp)[feature]
-                        if conf_again > conf or not shape_ok:
-                            knots[idx], conf = again[idx], conf_again
-                            shape_ok = self._shape_ok(knots, carried, feature)
-            confidence[feature] = conf
+            if search is not None and (min(ratio[r] for r in self._feature_rows[feature]) < p.brow_search
+                                       or not shape_ok):
+                conf, shape_ok, fallback, more = self._search_brow(frame, feature, search, knots, start, rest, down,
+                                                                   targets, carried, scale, conf, shape_ok)
+                iters += more
+                confidence[feature] = conf
             if conf < p.lost_response or not shape_ok:
                 lost.append(feature)
                 if feature.startswith("brow"):
-                    knots[idx] = fallback[idx]
-        self._mouth_lost_for = self._mouth_lost_for + 1 if any(f.startswith("mouth") for f in lost) else 0
+                    knots[self._features[feature]] = fallback[self._features[feature]]
+        mouth_lost = bool(lost) and any(f.startswith("mouth") for f in lost)
+        self._mouth_lost_for = self._mouth_lost_for + 1 if mouth_lost else 0
         if 0 < p.mouth_relocate <= self._mouth_lost_for and self._lips is not None and self._lips.active:
             found, more = self._relocate_mouth(frame, knots, carried, down, targets)
             iters += more
@@ -501,7 +490,8 @@ class Tracker:
                 confidence.update(found)
                 lost = [f for f in lost if not f.startswith("mouth")]
         if p.inner_search > 0 and "mouth_inner" in lost:
-            found, more = self._search_inner(frame, knots, rest, down, targets, carried, confidences["mouth_inner"])
+            found, more = self._search_inner(frame, knots, rest, down, targets, carried,
+                                             confs[list(FEATURES).index("mouth_inner")])
             iters += more
             if found is not None:
                 confidence["mouth_inner"] = found
@@ -516,6 +506,31 @@ class Tracker:
         self._reported = self._reported_knots()
         return FrameResult(self.frame_index, self._named(self._scale.to_frame(self._reported)), confidence, lost,
                            iters, ok)
+
+    def _search_brow(self, frame: np.ndarray, feature: str, search: BrowSearch, knots: np.ndarray, start: np.ndarray,
+                     rest: np.ndarray, down: np.ndarray, targets: np.ndarray, carried: np.ndarray, scale: float,
+                     conf: float, shape_ok: bool) -> tuple[float, bool, np.ndarray, int]:
+        """Look for a brow whose edge or shape was lost (``brow_search``) around where the head
+        motion put it (``start``): when the match moves its knots at least :data:`AGREE` solver
+        reaches, the brow is settled there by a solver pass and kept (in ``knots``, in place)
+        when its confidence rose or its shape (``shape_ok`` against ``carried``) was unsound.
+        Returns the brow's confidence and shape check then, where it goes should it be lost (the
+        match, else ``carried``), and the solver's iterations."""
+        p, idx = self.params, self._features[feature]
+        found = search.find(frame, scale, start[idx])
+        if found is None:
+            return conf, shape_ok, carried, 0
+        fallback = knots.copy()
+        fallback[idx] = found
+        if np.abs(found - knots[idx]).max() < AGREE * p.delta0 / (1.0 - p.sigma):
+            return conf, shape_ok, fallback, 0
+        again, iters, again_resp = self._solve(self._field(frame, fallback, ((idx, 1),)), fallback, rest, down, targets,
+                                               self._feature_curves[feature])
+        conf_again = self._confidences(again_resp)[feature]
+        if conf_again > conf or not shape_ok:
+            knots[idx], conf = again[idx], conf_again
+            shape_ok = self._shape_ok(knots, carried, feature)
+        return conf, shape_ok, fallback, iters
 
     def _mouth_sideways(self, frame: np.ndarray, start: np.ndarray, followed: np.ndarray, step: np.ndarray,
                         down: np.ndarray, reach: float) -> None:
