@@ -288,9 +288,11 @@ class Tracker:
         self._features = {f: np.unique(np.concatenate([self._index[n] for n in names])) for f, names in FEATURES.items()}
         self._mouth_knots = np.unique(np.concatenate([self._features["mouth_outer"], self._features["mouth_inner"]]))
         self._affine_groups = [[int(i) for i in self._features[f]] for f in ("mouth_outer", "mouth_inner")]
-        # The field's bands: the mouth's knots with its solver passes, the brows' with one.
-        brows = np.unique(np.concatenate([self._features["brow_left"], self._features["brow_right"]]))
-        self._frame_bands = self._band_args(((self._mouth_knots, p.mouth_passes), (brows, 1)))
+        # The field's bands: the mouth's knots with its solver passes, each brow's with one (a
+        # band apiece, so that where a tilted head puts one brow above the other, the rows of
+        # one brow alone are computed only around it).
+        self._frame_bands = self._band_args(((self._mouth_knots, p.mouth_passes), (self._features["brow_left"], 1),
+                                             (self._features["brow_right"], 1)))
         self._mouth_uintp = self._mouth_knots.astype(np.uintp)
         self._inner_uintp, self._outer_uintp = (self._features[f].astype(np.uintp) for f in ("mouth_inner", "mouth_outer"))
         # Each feature's upper curve's end knots and how far its chord may shrink.
