@@ -124,6 +124,35 @@ impl Level {
     }
 }
 
+/// Level 1's column sums at their even and at their odd positions apart (scratch of
+/// [`down_gray`]), so that the 5-tap sums at even positions read their taps contiguously, which
+/// vectorises where the strided reads did not.
+#[derive(Default)]
+struct Halves {
+    even: Vec<u16>,
+    odd: Vec<u16>,
+}
+
+impl Halves {
+    /// The taps of the 5-tap sums at positions 0, 2, .., 2(n − 1) of `row` (2n + 4 values):
+    /// for output x, `row[2x ..= 2x + 4]` is (e0[x], o0[x], e1[x], o1[x], e2[x]).
+    #[inline(always)]
+    fn taps(&mut self, row: &[u16], n: usize) -> [&[u16]; 5] {
+        self.even.resize(n + 2, 0);
+        self.odd.resize(n + 2, 0);
+        for ((e, o), pair) in self
+            .even
+            .iter_mut()
+            .zip(&mut self.odd)
+            .zip(row.chunks_exact(2))
+        {
+            (*e, *o) = (pair[0], pair[1]);
+        }
+        let (e, o) = (&self.even[..n + 2], &self.odd[..n + 2]);
+        [&e[..n], &e[1..n + 1], &e[2..], &o[..n], &o[1..n + 1]]
+    }
+}
+
 /// The Gaussian pyramid of one frame's crop, for a fixed window size. Rebuilding it for
 /// another frame reuses its memory.
 pub struct Pyramid {
@@ -136,8 +165,10 @@ pub struct Pyramid {
     filled: Vec<bool>,
     tiles_across: usize,
     levels: Vec<Level>,
-    /// Scratch rows of the reductions: level 1's integer column sums, the others' float ones.
+    /// Scratch rows of the reductions: level 1's integer column sums (and their even and odd
+    /// columns apart), the others' float ones.
     sums: Vec<u16>,
+    halves: Halves,
     scratch: Vec<f32>,
 }
 
@@ -156,6 +187,7 @@ impl Pyramid {
             tiles_across: 0,
             levels: Vec::new(),
             sums: Vec::new(),
+            halves: Halves::default(),
             scratch: Vec::new(),
         })
     }
@@ -222,7 +254,12 @@ impl Pyramid {
         self.filled
             .resize(self.tiles_across * (h + 2 * pad).div_ceil(TILE), false);
         if sizes.len() > 1 {
-            down_gray(&self.gray, w, &mut self.levels[1], &mut self.sums);
+            down_gray(
+                &self.gray,
+                w,
+                &mut self.levels[1],
+                (&mut self.sums, &mut self.halves),
+            );
             self.levels[1].mirror();
         }
         for l in 2..sizes.len() {
@@ -428,27 +465,39 @@ fn fill_body(gray: &[u8], w: usize, tile: Tile, plane: &mut [f32]) {
 
 /// Level 1 into `next` (shaped, its padding not filled) from the crop's grey levels `gray`
 /// (rows of `w`): [`Level::down`] of level 0, summed in integers, which is exact (a sum is at
-/// most 255·256) and so gives the same values. `sums` is scratch.
-fn down_gray(gray: &[u8], w: usize, next: &mut Level, sums: &mut Vec<u16>) {
+/// most 255·256) and so gives the same values. `scratch` is the column sums and their halves.
+fn down_gray(gray: &[u8], w: usize, next: &mut Level, scratch: (&mut Vec<u16>, &mut Halves)) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: AVX2 is present.
-        return unsafe { down_gray_avx2(gray, w, next, sums) };
+        return unsafe { down_gray_avx2(gray, w, next, scratch) };
     }
-    down_gray_body(gray, w, next, sums)
+    down_gray_body(gray, w, next, scratch)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn down_gray_avx2(gray: &[u8], w: usize, next: &mut Level, sums: &mut Vec<u16>) {
-    down_gray_body(gray, w, next, sums)
+unsafe fn down_gray_avx2(
+    gray: &[u8],
+    w: usize,
+    next: &mut Level,
+    scratch: (&mut Vec<u16>, &mut Halves),
+) {
+    down_gray_body(gray, w, next, scratch)
 }
 
 #[inline(always)]
-fn down_gray_body(gray: &[u8], w: usize, next: &mut Level, sums: &mut Vec<u16>) {
+fn down_gray_body(
+    gray: &[u8],
+    w: usize,
+    next: &mut Level,
+    (sums, halves): (&mut Vec<u16>, &mut Halves),
+) {
     let h = gray.len() / w;
-    // Column sums with two mirrored columns on either side.
-    sums.resize(w + 4, 0);
+    let n = next.width;
+    // Column sums with two mirrored columns on either side (and, for an odd width, one more
+    // that no output reads).
+    sums.resize(2 * n + 4, 0);
     for y in 0..next.height {
         let rows: [&[u8]; 5] =
             std::array::from_fn(|j| &gray[reflect101((2 * y + j) as isize - 2, h) * w..][..w]);
@@ -460,10 +509,11 @@ fn down_gray_body(gray: &[u8], w: usize, next: &mut Level, sums: &mut Vec<u16>) 
             sums[i] = sums[2 + reflect101(i as isize - 2, w)];
             sums[w + 2 + i] = sums[2 + reflect101((w + i) as isize, w)];
         }
-        for (x, o) in next.interior_row(y).iter_mut().enumerate() {
-            let t = &sums[2 * x..][..5];
-            let v = t[0] + t[4] + 4 * (t[1] + t[3]) + 6 * t[2];
-            *o = v as f32 / 256.0;
+        let row = next.interior_row(y);
+        let [e0, e1, e2, o0, o1] = halves.taps(sums, row.len());
+        for x in 0..row.len() {
+            let v = e0[x] + e2[x] + 4 * (o0[x] + o1[x]) + 6 * e1[x];
+            row[x] = v as f32 / 256.0;
         }
     }
 }
