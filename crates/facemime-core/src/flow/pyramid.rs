@@ -54,10 +54,18 @@ impl Level {
         for y in p..p + h {
             let row = &mut self.img[y * s..][..s];
             if p < w {
-                // One reflection reaches: the common case, without index arithmetic.
-                for x in 0..p {
-                    row[x] = row[2 * p - x];
-                    row[p + w + x] = row[p + w - 2 - x];
+                // One reflection reaches: the common case, each side a reversed copy of the
+                // interior beside it (apart, so that the copies vectorise).
+                let (left, rest) = row.split_at_mut(p);
+                let (interior, right) = rest.split_at_mut(w);
+                for (d, v) in left.iter_mut().zip(interior[1..=p].iter().rev()) {
+                    *d = *v;
+                }
+                for (d, v) in right
+                    .iter_mut()
+                    .zip(interior[w - 1 - p..w - 1].iter().rev())
+                {
+                    *d = *v;
                 }
                 continue;
             }
