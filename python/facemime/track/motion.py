@@ -163,8 +163,8 @@ class HeadMotion:
         if x1 - x0 <= 2 * DETECT_MARGIN or y1 - y0 <= 2 * DETECT_MARGIN:
             return np.zeros((0, 2), np.float32)
         mask = np.zeros((y1 - y0, x1 - x0), np.uint8)
-        for poly in zones:
-            cv2.fillConvexPoly(mask, np.round(poly - [x0, y0]).astype(np.int32), 255)
+        for poly in np.rint(np.asarray(zones) - (x0, y0)).astype(np.int32):
+            cv2.fillConvexPoly(mask, poly, 255)
         return self._head.corners((x0, y0, x1, y1), mask, self._max_points, QUALITY, self._min_distance,
                                   CORNER_BLOCK)
 
