@@ -102,7 +102,10 @@ pub fn lucas_kanade_from(
     if prev.depth == 0 || next.depth == 0 {
         return invalid!("the flow needs two built pyramids");
     }
-    let mut bufs = Windows::new(prev.window);
+    let mut bufs = WINDOWS
+        .take()
+        .filter(|b| b.shape.win == prev.window)
+        .unwrap_or_else(|| Windows::new(prev.window));
     let top = prev.max_level().min(next.max_level()).min(top);
     let mut out = Vec::with_capacity(points.len());
     for (&p, &g) in points.iter().zip(guesses) {
@@ -121,7 +124,14 @@ pub fn lucas_kanade_from(
         }
         out.push(ok.then_some(guess));
     }
+    WINDOWS.set(Some(bufs));
     Ok(out)
+}
+
+thread_local! {
+    /// [`lucas_kanade_from`]'s window buffers, kept from one call to the next (a frame makes
+    /// several); every value a window reads is written first, or is a dead column's 0.
+    static WINDOWS: std::cell::Cell<Option<Windows>> = const { std::cell::Cell::new(None) };
 }
 
 /// One level of the flow of frame point `p` from its current estimate `guess` (frame pixels).
