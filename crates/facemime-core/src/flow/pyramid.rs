@@ -102,10 +102,12 @@ impl Level {
     fn down_body(&self, next: &mut Level, col: &mut Vec<f32>) {
         let (s, p) = (self.stride(), self.pad);
         col.resize(s, 0.0);
+        // The columns the sums at even pixels read: p − 2 ..= p + 2·next.width.
+        let (c0, c1) = (p - 2, (p + 2 * next.width + 1).min(s));
         for y in 0..next.height {
             let rows: [&[f32]; 5] =
-                std::array::from_fn(|j| &self.img[(2 * y + j + p - 2) * s..][..s]);
-            for (x, c) in col.iter_mut().enumerate() {
+                std::array::from_fn(|j| &self.img[(2 * y + j + p - 2) * s..][c0..c1]);
+            for (x, c) in col[c0..c1].iter_mut().enumerate() {
                 *c = rows[0][x] + rows[4][x] + 4.0 * (rows[1][x] + rows[3][x]) + 6.0 * rows[2][x];
             }
             for (x, o) in next.interior_row(y).iter_mut().enumerate() {
