@@ -470,6 +470,7 @@ class Tracker:
         # The inner mouth centred (:meth:`_centre_inner`), the confidences and shape checks.
         ratio, confs, shapes = self._plan.assess(knots, rest, tuple(down), resp, carried)
         ratio, confidence, lost = ratio.tolist(), dict(zip(FEATURES, confs)), []
+        assessed_inner = confidence["mouth_inner"]  # before a relocated mouth replaces it
         for feature, shape_ok in zip(FEATURES, shapes):
             conf, fallback = confidence[feature], carried
             search = self._brow_search.get(feature)
@@ -483,8 +484,7 @@ class Tracker:
                 lost.append(feature)
                 if feature.startswith("brow"):
                     knots[self._features[feature]] = fallback[self._features[feature]]
-        mouth_lost = bool(lost) and any(f.startswith("mouth") for f in lost)
-        self._mouth_lost_for = self._mouth_lost_for + 1 if mouth_lost else 0
+        self._mouth_lost_for = self._mouth_lost_for + 1 if any(f.startswith("mouth") for f in lost) else 0
         if 0 < p.mouth_relocate <= self._mouth_lost_for and self._lips is not None and self._lips.active:
             found, more = self._relocate_mouth(frame, knots, carried, down, targets)
             iters += more
@@ -492,8 +492,7 @@ class Tracker:
                 confidence.update(found)
                 lost = [f for f in lost if not f.startswith("mouth")]
         if p.inner_search > 0 and "mouth_inner" in lost:
-            found, more = self._search_inner(frame, knots, rest, down, targets, carried,
-                                             confs[list(FEATURES).index("mouth_inner")])
+            found, more = self._search_inner(frame, knots, rest, down, targets, carried, assessed_inner)
             iters += more
             if found is not None:
                 confidence["mouth_inner"] = found

@@ -15,8 +15,8 @@ use crate::extent::extent;
 use crate::motion::{dot_after, dot_before, transformed};
 use crate::raster::ImageRef;
 
-/// Knots whose field is read `margin` pixels around them at most (their reach, and one pixel
-/// more for the bilinear cell of a point read).
+/// Knots whose field is read `margin` pixels around them at most (the tracker's: their reach,
+/// and two pixels for the bilinear cell of a point read and the rounding of the band's edges).
 pub struct Band<'a> {
     pub knots: &'a [usize],
     pub margin: f64,
@@ -65,13 +65,12 @@ pub fn band_regions(
     sigma: f64,
 ) -> ([usize; 4], Vec<[usize; 4]>) {
     let grown = smoothing_radius(sigma) as f64;
-    let around = |b: &Band, grow: f64| {
-        let pts: Vec<[f64; 2]> = b.knots.iter().map(|&i| knots[i]).collect();
-        region(&pts, b.margin + grow, width, height)
-    };
-    let boxes: Vec<[usize; 4]> = bands.iter().map(|b| around(b, 0.0)).collect();
+    let mut boxes = Vec::with_capacity(bands.len());
     let mut all = [usize::MAX, usize::MAX, 0, 0];
-    for b in bands.iter().map(|b| around(b, grown)) {
+    for band in bands {
+        let pts: Vec<[f64; 2]> = band.knots.iter().map(|&i| knots[i]).collect();
+        boxes.push(region(&pts, band.margin, width, height));
+        let b = region(&pts, band.margin + grown, width, height);
         all = [
             all[0].min(b[0]),
             all[1].min(b[1]),

@@ -184,7 +184,7 @@ impl Problem {
         &self,
         input: &FrameInput<'_>,
         curves: &[bool],
-        held: Option<&[bool]>,
+        held: Held,
     ) -> Result<Solution> {
         #[cfg(target_arch = "x86_64")]
         if crate::cpu::has_avx2_fma() {
