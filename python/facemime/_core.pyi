@@ -63,7 +63,7 @@ class HeadFollower:
         zones: npt.NDArray[np.float64],
         window: int,
         max_level: int,
-        extra_levels: int,
+        guided_levels: int,
         limit: float,
         min_points: int,
         rounds: int,

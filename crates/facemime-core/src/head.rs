@@ -35,9 +35,9 @@ pub struct FollowSettings {
     pub window: usize,
     /// Pyramid levels above the frame at most.
     pub max_level: usize,
-    /// Levels above the frame at most for the extra points' flow, which starts where the head's
-    /// step carries them (see [`follow_rigid`]).
-    pub extra_levels: usize,
+    /// Levels above the frame at most for the flows that start where the head's step carries
+    /// the points: the extra points' both ways, the rigid points' way back (see [`follow_rigid`]).
+    pub guided_levels: usize,
     /// Forward-backward and fit tolerance (pixels).
     pub limit: f64,
     /// Fewest points for a similarity; also the fewest that are ever wanted.
@@ -217,7 +217,7 @@ impl HeadFollower {
             &mut self.cur,
             &points,
             extra,
-            s.extra_levels,
+            s.guided_levels,
             &s.lk,
             s.limit,
             s.min_points,
@@ -295,7 +295,7 @@ mod tests {
     const SETTINGS: FollowSettings = FollowSettings {
         window: 21,
         max_level: 3,
-        extra_levels: 2,
+        guided_levels: 2,
         limit: 1.0,
         min_points: 6,
         rounds: 10,

@@ -250,12 +250,27 @@ fn forward_backward(
 ) -> Result<Vec<Option<[f64; 2]>>> {
     let guess: Vec<[f64; 2]> = start.iter().map(|&p| apply(m, p)).collect();
     let there = lucas_kanade_from(prev, next, start, &guess, levels, lk)?;
+    back_checked(prev, next, start, &there, (&invert(m), levels), lk, limit)
+}
+
+/// The forward-backward check of the flow of `start` (pixels of `prev`'s frame) to `there`
+/// (`next`'s frame; None where it failed): each of `there` followed back into `prev`'s frame,
+/// from where the transform `back` carries it and through `levels` levels above the frame at
+/// most. Returns `there` where the flow came back within `limit` px of `start`, else None.
+fn back_checked(
+    prev: &mut Pyramid,
+    next: &mut Pyramid,
+    start: &[[f64; 2]],
+    there: &[Option<[f64; 2]>],
+    (back, levels): (&[[f64; 3]; 2], usize),
+    lk: &LkParams,
+    limit: f64,
+) -> Result<Vec<Option<[f64; 2]>>> {
     let ahead: Vec<[f64; 2]> = there.iter().map(|q| q.unwrap_or([f64::NAN; 2])).collect();
-    let inv = invert(m);
-    let guess: Vec<[f64; 2]> = ahead.iter().map(|&q| apply(&inv, q)).collect();
-    let back = lucas_kanade_from(next, prev, &ahead, &guess, levels, lk)?;
+    let guess: Vec<[f64; 2]> = ahead.iter().map(|&q| apply(back, q)).collect();
+    let returned = lucas_kanade_from(next, prev, &ahead, &guess, levels, lk)?;
     Ok((0..start.len())
-        .map(|i| match (there[i], back[i]) {
+        .map(|i| match (there[i], returned[i]) {
             (Some(q), Some(b)) => {
                 let d = [b[0] - start[i][0], b[1] - start[i][1]];
                 (d[0] * d[0] + d[1] * d[1] < limit * limit).then_some(q)
@@ -266,53 +281,78 @@ fn forward_backward(
 }
 
 /// The head's motion from `prev`'s frame to `next`'s: the rigid `points` (pixels of the
-/// previous frame) followed by the Lucas-Kanade flow forwards and back; those that come back
-/// within `limit` px of where they started are fitted by [`robust_similarity`] (inliers within
-/// `limit` px, at most `rounds` rounds), which counts when at least `min_points` passed the
-/// check and fit it. The `extra` points are followed and checked alike (not fitted). With a
-/// similarity, their flow starts where it carries them and runs through `extra_levels` levels
-/// above the frame at most (each level costs as much as the frame's own); those that fail the
-/// check then, or all of them without a similarity, are followed like the rigid points.
+/// previous frame) followed by the Lucas-Kanade flow forwards, from where they were through
+/// every level, and back; those that come back within `limit` px of where they started are
+/// fitted by [`robust_similarity`] (inliers within `limit` px, at most `rounds` rounds), which
+/// counts when at least `min_points` passed the check and fit it. The way back starts where
+/// the inverse of the similarity fitted to the forward flow alone carries each point and runs
+/// through `guided_levels` levels above the frame at most (each level costs as much as the
+/// frame's own); a point that fails the check then is followed back again from where it is,
+/// through every level. The `extra` points are followed and checked alike (not fitted), both
+/// ways from where the similarity carries them through `guided_levels` levels; those that fail
+/// the check then, or all of them without a similarity, are followed like the rigid points
+/// from where they were, both ways through every level.
 #[allow(clippy::too_many_arguments)]
 pub fn follow_rigid(
     prev: &mut Pyramid,
     next: &mut Pyramid,
     points: &[[f64; 2]],
     extra: &[[f64; 2]],
-    extra_levels: usize,
+    guided_levels: usize,
     lk: &LkParams,
     limit: f64,
     min_points: usize,
     rounds: usize,
 ) -> Result<RigidStep> {
-    // From where they were, through every level.
     let unguided = (&IDENTITY, usize::MAX);
-    let checked = forward_backward(prev, next, points, unguided, lk, limit)?;
-    let good: Vec<usize> = (0..points.len())
-        .filter(|&i| checked[i].is_some())
-        .collect();
     let mut step = RigidStep {
         similarity: None,
         kept: Vec::new(),
         moved: Vec::new(),
         extra: Vec::new(),
     };
-    if good.len() >= min_points {
-        let src: Vec<[f64; 2]> = good.iter().map(|&i| points[i]).collect();
-        let dst: Vec<[f64; 2]> = good.iter().map(|&i| checked[i].expect("checked")).collect();
-        let (m, inliers) = robust_similarity(&src, &dst, limit, rounds);
-        if inliers.iter().filter(|&&k| k).count() >= min_points {
-            step.similarity = Some(m);
-            for (j, _) in inliers.iter().enumerate().filter(|(_, &k)| k) {
-                step.kept.push(good[j]);
-                step.moved.push(dst[j]);
+    let there = lucas_kanade_from(prev, next, points, points, usize::MAX, lk)?;
+    let (src, dst) = followed_pairs(points, &there);
+    if src.len() >= min_points {
+        let (ahead, _) = robust_similarity(&src, &dst, limit, rounds);
+        let mut checked = back_checked(
+            prev,
+            next,
+            points,
+            &there,
+            (&invert(&ahead), guided_levels),
+            lk,
+            limit,
+        )?;
+        let missed: Vec<usize> = (0..points.len())
+            .filter(|&i| there[i].is_some() && checked[i].is_none())
+            .collect();
+        let from: Vec<[f64; 2]> = missed.iter().map(|&i| points[i]).collect();
+        let to: Vec<Option<[f64; 2]>> = missed.iter().map(|&i| there[i]).collect();
+        let wider = back_checked(prev, next, &from, &to, unguided, lk, limit)?;
+        for (&i, c) in missed.iter().zip(wider) {
+            checked[i] = c;
+        }
+        let good: Vec<usize> = (0..points.len())
+            .filter(|&i| checked[i].is_some())
+            .collect();
+        if good.len() >= min_points {
+            let src: Vec<[f64; 2]> = good.iter().map(|&i| points[i]).collect();
+            let dst: Vec<[f64; 2]> = good.iter().map(|&i| checked[i].expect("checked")).collect();
+            let (m, inliers) = robust_similarity(&src, &dst, limit, rounds);
+            if inliers.iter().filter(|&&k| k).count() >= min_points {
+                step.similarity = Some(m);
+                for (j, _) in inliers.iter().enumerate().filter(|(_, &k)| k) {
+                    step.kept.push(good[j]);
+                    step.moved.push(dst[j]);
+                }
             }
         }
     }
     step.extra = match &step.similarity {
         None => forward_backward(prev, next, extra, unguided, lk, limit)?,
         Some(m) => {
-            let mut found = forward_backward(prev, next, extra, (m, extra_levels), lk, limit)?;
+            let mut found = forward_backward(prev, next, extra, (m, guided_levels), lk, limit)?;
             let missed: Vec<usize> = (0..extra.len()).filter(|&i| found[i].is_none()).collect();
             let again: Vec<[f64; 2]> = missed.iter().map(|&i| extra[i]).collect();
             let wider = forward_backward(prev, next, &again, unguided, lk, limit)?;
@@ -323,6 +363,18 @@ pub fn follow_rigid(
         }
     };
     Ok(step)
+}
+
+/// The `points` the flow followed and where it took them (`there`, None where it failed).
+fn followed_pairs(
+    points: &[[f64; 2]],
+    there: &[Option<[f64; 2]>],
+) -> (Vec<[f64; 2]>, Vec<[f64; 2]>) {
+    points
+        .iter()
+        .zip(there)
+        .filter_map(|(&p, q)| q.map(|q| (p, q)))
+        .unzip()
 }
 
 /// Which of `points` lie inside (or on the border of) any of the convex quadrilaterals
@@ -469,6 +521,39 @@ mod tests {
         let guided =
             crate::flow::lucas_kanade_from(&mut pa, &mut pb, &extra[1..], &moved, 0, &PARAMS);
         assert!(off(guided.unwrap()[0], [40.0, 110.0]) > 1.0);
+    }
+
+    #[test]
+    fn rigid_points_come_back_from_where_the_head_moved_them() {
+        use crate::flow::tests::{pyramid, texture, PARAMS};
+        let (w, h) = (384, 256);
+        // The head moves by (30, -20), beyond the frame level's reach from where the points
+        // were: the way back, on the frame's level alone, finds them only from where the
+        // head's step carries them back.
+        let (a, b) = (texture(w, h, 0.0, 0.0), texture(w, h, 30.0, -20.0));
+        let (mut pa, mut pb) = (pyramid(&a, w, h), pyramid(&b, w, h));
+        let points: Vec<[f64; 2]> = (0..12)
+            .map(|k| [150.0 + 12.0 * (k % 4) as f64, 110.0 + 15.0 * (k / 4) as f64])
+            .collect();
+        let step = follow_rigid(&mut pa, &mut pb, &points, &[], 0, &PARAMS, 1.0, 6, 10).unwrap();
+        let m = step.similarity.expect("a similarity");
+        assert!(
+            (m[0][2] - 30.0).abs() < 0.1 && (m[1][2] + 20.0).abs() < 0.1,
+            "{m:?}"
+        );
+        assert_eq!(step.kept, (0..12).collect::<Vec<_>>());
+        // On the frame's level alone, the way back finds them all from where the head's
+        // step carries them back, not from where they are.
+        let there: Vec<Option<[f64; 2]>> = points
+            .iter()
+            .map(|p| Some([p[0] + 30.0, p[1] - 20.0]))
+            .collect();
+        let mut back = |guide: [[f64; 3]; 2]| {
+            let found = back_checked(&mut pa, &mut pb, &points, &there, (&guide, 0), &PARAMS, 1.0);
+            found.unwrap().iter().filter(|q| q.is_some()).count()
+        };
+        assert_eq!(back(invert(&m)), 12);
+        assert!(back(IDENTITY) < 6);
     }
 
     #[test]

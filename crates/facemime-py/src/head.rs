@@ -42,19 +42,19 @@ pub struct HeadFollower {
 #[pymethods]
 impl HeadFollower {
     /// frame: the first frame, (H, W) grey or (H, W, 3) RGB uint8; brows: (N, 2) its brow
-    /// points; zones: (Z, 4, 2) its rigid zones; window, max_level, extra_levels, limit,
+    /// points; zones: (Z, 4, 2) its rigid zones; window, max_level, guided_levels, limit,
     /// min_points, rounds, iterations, epsilon, min_eigen: see
     /// `facemime_core::head::FollowSettings` and `facemime_core::flow::LkParams`.
     #[new]
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (frame, brows, zones, window, max_level, extra_levels, limit, min_points, rounds, iterations, epsilon, min_eigen))]
+    #[pyo3(signature = (frame, brows, zones, window, max_level, guided_levels, limit, min_points, rounds, iterations, epsilon, min_eigen))]
     fn new(
         frame: PyReadonlyArrayDyn<u8>,
         brows: PyReadonlyArray2<f64>,
         zones: PyReadonlyArray3<f64>,
         window: usize,
         max_level: usize,
-        extra_levels: usize,
+        guided_levels: usize,
         limit: f64,
         min_points: usize,
         rounds: usize,
@@ -77,7 +77,7 @@ impl HeadFollower {
         let settings = FollowSettings {
             window,
             max_level,
-            extra_levels,
+            guided_levels,
             limit,
             min_points,
             rounds,
