@@ -13,6 +13,7 @@ mod cpu;
 pub mod error;
 pub mod extent;
 pub mod flow;
+mod grey;
 pub mod head;
 pub mod lip_placement;
 pub mod lip_search;
@@ -20,5 +21,6 @@ pub mod motion;
 pub mod pose;
 pub mod raster;
 pub mod snake;
+pub mod template;
 
 pub use error::CoreError;

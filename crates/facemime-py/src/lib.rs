@@ -14,6 +14,7 @@ mod points;
 mod pose;
 mod raster;
 mod snake;
+mod template;
 
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -27,5 +28,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     pose::register(m)?;
     raster::register(m)?;
     snake::register(m)?;
+    template::register(m)?;
     Ok(())
 }

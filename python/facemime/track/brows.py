@@ -31,7 +31,7 @@ class BrowSearch:
         self._knots0 = np.asarray(knots, np.float64)
         self._width = float(np.ptp(self._knots0[:, 0]))
         lo, hi = crop_box(self._knots0, MARGIN * self._width, image.shape[1], image.shape[0])
-        self._template = gray_crop(image, lo, hi).copy()
+        self._template = gray_crop(image, lo, hi)
         self._centre0 = (lo + hi - 1) / 2.0  # the template's centre, px of the first frame
         self.active = min(self._template.shape) >= 8 and self._template.std() >= 1.0
 

@@ -1,12 +1,13 @@
 """Finding a patch or a shape again near where it is expected.
 
-:func:`find`: the normalised cross-correlation (``cv2.matchTemplate``, TM_CCOEFF_NORMED) of a
-gray template over a window around the expected position; it finds a lost brow again
-(:mod:`facemime.track.brows`) and follows the whole mouth when the optical flow loses its knots
-(:mod:`facemime.track.mouth`). :func:`locate`: a feature's outline (an eye, a brow, the lips),
-expected to differ from a band of skin around it, slid and scaled over a search window to where
-the mean of a channel inside minus the mean in the band is largest; it places the features of a
-photo (:mod:`facemime.fit.auto`) and finds a mouth the tracker lost again. Coordinates are
+:func:`find`: the normalised cross-correlation (TM_CCOEFF_NORMED, searched coarse to fine by
+``facemime._core.best_match``) of a gray template over a window around the expected position;
+it finds a lost brow again (:mod:`facemime.track.brows`) and follows the whole mouth when the
+optical flow loses its knots (:mod:`facemime.track.mouth`). :func:`locate`: a feature's outline
+(an eye, a brow, the lips), expected to differ from a band of skin around it, slid and scaled
+over a search window to where the mean of a channel inside minus the mean in the band is
+largest; it places the features of a photo (:mod:`facemime.fit.auto`) and finds a mouth the
+tracker lost again. Coordinates are
 (x, y) pixels, origin at the centre of the top-left pixel, y down; polygons are (K, 2) float
 arrays.
 """
@@ -17,6 +18,8 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+
+from facemime import _core
 
 
 def crop_box(points: np.ndarray, margin: float, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
@@ -30,9 +33,8 @@ def crop_box(points: np.ndarray, margin: float, width: int, height: int) -> tupl
 def gray_crop(image: np.ndarray, lo: np.ndarray | tuple[int, int], hi: np.ndarray | tuple[int, int]) -> np.ndarray:
     """The (y1 − y0, x1 − x0) uint8 grey levels of ``image`` ((H, W) uint8 grey, or (H, W, 3)
     uint8 RGB converted as OpenCV's ``RGB2GRAY``) in the box from ``lo`` = (x0, y0) to ``hi`` =
-    (x1, y1) px, ``hi`` exclusive; a view of a grey ``image``."""
-    part = image[lo[1]:hi[1], lo[0]:hi[0]]
-    return part if part.ndim == 2 else cv2.cvtColor(part, cv2.COLOR_RGB2GRAY)
+    (x1, y1) px, ``hi`` exclusive, inside the image (``facemime._core.grey_area``)."""
+    return _core.grey_area(np.ascontiguousarray(image), (int(lo[0]), int(lo[1]), int(hi[0]), int(hi[1])))
 
 
 def find(image: np.ndarray, template: np.ndarray, centre: np.ndarray, reach: float, min_match: float) -> np.ndarray | None:
@@ -47,8 +49,7 @@ def find(image: np.ndarray, template: np.ndarray, centre: np.ndarray, reach: flo
     y1 = min(int(round(centre[1] + (th - 1) / 2.0 + reach)) + 1, image.shape[0])
     if x1 - x0 < tw or y1 - y0 < th:
         return None
-    scores = cv2.matchTemplate(gray_crop(image, (x0, y0), (x1, y1)), template, cv2.TM_CCOEFF_NORMED)
-    _, best, _, (bx, by) = cv2.minMaxLoc(scores)
+    (bx, by), best = _core.best_match(gray_crop(image, (x0, y0), (x1, y1)), template)
     if not best >= min_match:
         return None
     return np.array([x0 + bx + (tw - 1) / 2.0, y0 + by + (th - 1) / 2.0])

@@ -188,8 +188,7 @@ class HeadMotion:
         search = small(gray_crop(frame, (sx0, sy0), (sx1, sy1)))
         if templ.shape[0] > search.shape[0] or templ.shape[1] > search.shape[1] or templ.std() < 1.0:
             return IDENTITY.copy(), False
-        scores = cv2.matchTemplate(search, templ, cv2.TM_CCOEFF_NORMED)
-        _, best, _, (bx, by) = cv2.minMaxLoc(scores)
+        (bx, by), best = _core.best_match(search, templ)
         if best < 0.5:
             return IDENTITY.copy(), False
         shift = np.array([sx0 + 4.0 * bx - x0, sy0 + 4.0 * by - y0])
