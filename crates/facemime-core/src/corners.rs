@@ -5,6 +5,9 @@
 //!
 //! Pixels are (x, y) of the whole frame, centres on integers; intensities are grey levels.
 
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
 use crate::border::reflect101;
 use crate::error::Result;
 use crate::invalid;
@@ -179,8 +182,9 @@ fn corners(search: &Search) -> Vec<[f32; 2]> {
             }
         }
     }
-    found.sort_by(|a, b| b.0.total_cmp(&a.0).then((b.2, b.1).cmp(&(a.2, a.1))));
-    spaced(&found, [bw, bh], s)
+    // Strongest first, taken from a heap as far as `spaced` reads: most are never needed.
+    let mut heap: BinaryHeap<Peak> = found.into_iter().map(Peak).collect();
+    spaced(std::iter::from_fn(|| heap.pop().map(|p| p.0)), [bw, bh], s)
         .into_iter()
         .map(|[x, y]| [(x0 + x) as f32, (y0 + y) as f32])
         .collect()
@@ -250,24 +254,53 @@ fn mask_bands(mask: &[u8], w: usize, h: usize) -> Vec<[usize; 4]> {
     out
 }
 
+/// A local maximum (measure, x, y), ordered by its measure, then (ties) by its row-major
+/// position, the later the greater.
+struct Peak((f64, usize, usize));
+
+impl Ord for Peak {
+    fn cmp(&self, o: &Self) -> Ordering {
+        let (a, b) = (&self.0, &o.0);
+        a.0.total_cmp(&b.0).then((a.2, a.1).cmp(&(b.2, b.1)))
+    }
+}
+
+impl PartialOrd for Peak {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+
+impl PartialEq for Peak {
+    fn eq(&self, o: &Self) -> bool {
+        self.cmp(o) == Ordering::Equal
+    }
+}
+
+impl Eq for Peak {}
+
 /// The corners of `found` (measure, x, y; strongest first) kept greedily in that order when
 /// none kept before lies within `min_distance` (OpenCV's grid of cells of that side, rounded),
 /// at most `max_corners` of them.
-fn spaced(found: &[(f64, usize, usize)], size: [usize; 2], s: &CornerSettings) -> Vec<[usize; 2]> {
+fn spaced(
+    found: impl Iterator<Item = (f64, usize, usize)>,
+    size: [usize; 2],
+    s: &CornerSettings,
+) -> Vec<[usize; 2]> {
     let limit = if s.max_corners == 0 {
         usize::MAX
     } else {
         s.max_corners
     };
     if s.min_distance < 1.0 {
-        return found.iter().take(limit).map(|&(_, x, y)| [x, y]).collect();
+        return found.take(limit).map(|(_, x, y)| [x, y]).collect();
     }
     let cell = s.min_distance.round_ties_even() as usize;
     let (gw, gh) = (size[0].div_ceil(cell), size[1].div_ceil(cell));
     let mut grid: Vec<Vec<[usize; 2]>> = vec![Vec::new(); gw * gh];
     let near = s.min_distance * s.min_distance;
     let mut kept = Vec::new();
-    for &(_, x, y) in found {
+    for (_, x, y) in found {
         let (cx, cy) = (x / cell, y / cell);
         let close = (cy.saturating_sub(1)..=(cy + 1).min(gh - 1)).any(|gy| {
             (cx.saturating_sub(1)..=(cx + 1).min(gw - 1)).any(|gx| {
