@@ -305,47 +305,34 @@ pub fn follow_rigid(
     rounds: usize,
 ) -> Result<RigidStep> {
     let unguided = (&IDENTITY, usize::MAX);
+    let checked = rigid_checked(
+        prev,
+        next,
+        points,
+        guided_levels,
+        lk,
+        limit,
+        min_points,
+        rounds,
+    )?;
+    let good: Vec<usize> = (0..points.len())
+        .filter(|&i| checked[i].is_some())
+        .collect();
     let mut step = RigidStep {
         similarity: None,
         kept: Vec::new(),
         moved: Vec::new(),
         extra: Vec::new(),
     };
-    let there = lucas_kanade_from(prev, next, points, points, usize::MAX, lk)?;
-    let (src, dst) = followed_pairs(points, &there);
-    if src.len() >= min_points {
-        let (ahead, _) = robust_similarity(&src, &dst, limit, rounds);
-        let mut checked = back_checked(
-            prev,
-            next,
-            points,
-            &there,
-            (&invert(&ahead), guided_levels),
-            lk,
-            limit,
-        )?;
-        let missed: Vec<usize> = (0..points.len())
-            .filter(|&i| there[i].is_some() && checked[i].is_none())
-            .collect();
-        let from: Vec<[f64; 2]> = missed.iter().map(|&i| points[i]).collect();
-        let to: Vec<Option<[f64; 2]>> = missed.iter().map(|&i| there[i]).collect();
-        let wider = back_checked(prev, next, &from, &to, unguided, lk, limit)?;
-        for (&i, c) in missed.iter().zip(wider) {
-            checked[i] = c;
-        }
-        let good: Vec<usize> = (0..points.len())
-            .filter(|&i| checked[i].is_some())
-            .collect();
-        if good.len() >= min_points {
-            let src: Vec<[f64; 2]> = good.iter().map(|&i| points[i]).collect();
-            let dst: Vec<[f64; 2]> = good.iter().map(|&i| checked[i].expect("checked")).collect();
-            let (m, inliers) = robust_similarity(&src, &dst, limit, rounds);
-            if inliers.iter().filter(|&&k| k).count() >= min_points {
-                step.similarity = Some(m);
-                for (j, _) in inliers.iter().enumerate().filter(|(_, &k)| k) {
-                    step.kept.push(good[j]);
-                    step.moved.push(dst[j]);
-                }
+    if good.len() >= min_points {
+        let src: Vec<[f64; 2]> = good.iter().map(|&i| points[i]).collect();
+        let dst: Vec<[f64; 2]> = good.iter().map(|&i| checked[i].expect("checked")).collect();
+        let (m, inliers) = robust_similarity(&src, &dst, limit, rounds);
+        if inliers.iter().filter(|&&k| k).count() >= min_points {
+            step.similarity = Some(m);
+            for (j, _) in inliers.iter().enumerate().filter(|(_, &k)| k) {
+                step.kept.push(good[j]);
+                step.moved.push(dst[j]);
             }
         }
     }
@@ -363,6 +350,44 @@ pub fn follow_rigid(
         }
     };
     Ok(step)
+}
+
+/// The rigid `points` followed forwards from where they were, through every level, and checked
+/// back ([`back_checked`]) from where the inverse of the similarity fitted to the forward flow
+/// carries them, through `levels` levels; those that fail the check then, again from where they
+/// are through every level. All None when fewer than `min_points` were followed forwards.
+#[allow(clippy::too_many_arguments)]
+fn rigid_checked(
+    prev: &mut Pyramid,
+    next: &mut Pyramid,
+    points: &[[f64; 2]],
+    levels: usize,
+    lk: &LkParams,
+    limit: f64,
+    min_points: usize,
+    rounds: usize,
+) -> Result<Vec<Option<[f64; 2]>>> {
+    let there = lucas_kanade_from(prev, next, points, points, usize::MAX, lk)?;
+    let (src, dst) = followed_pairs(points, &there);
+    if src.len() < min_points {
+        return Ok(vec![None; points.len()]);
+    }
+    let (ahead, _) = robust_similarity(&src, &dst, limit, rounds);
+    let back = invert(&ahead);
+    let mut checked = back_checked(prev, next, points, &there, (&back, levels), lk, limit)?;
+    let missed: Vec<usize> = (0..points.len())
+        .filter(|&i| there[i].is_some() && checked[i].is_none())
+        .collect();
+    let from: Vec<[f64; 2]> = missed.iter().map(|&i| points[i]).collect();
+    let to: Vec<Option<[f64; 2]>> = missed.iter().map(|&i| there[i]).collect();
+    let unguided = (&IDENTITY, usize::MAX);
+    for (&i, c) in missed
+        .iter()
+        .zip(back_checked(prev, next, &from, &to, unguided, lk, limit)?)
+    {
+        checked[i] = c;
+    }
+    Ok(checked)
 }
 
 /// The `points` the flow followed and where it took them (`there`, None where it failed).
