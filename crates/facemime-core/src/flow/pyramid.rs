@@ -299,6 +299,8 @@ impl Pyramid {
     /// The bilinear samples of `level` on the unit grid whose top-left sample is the level
     /// point (x, y), with the `block` (columns, rows) of plane values from that sample's integer
     /// part on filled; the block must fit in the padded plane (see [`Pyramid::inside`]).
+    /// Inlined into the flow's iterations: about 1% of the tracker's time, measured.
+    #[inline(always)]
     pub(super) fn grid(&mut self, level: usize, x: f32, y: f32, block: [usize; 2]) -> Grid<'_> {
         if level == 0 {
             let p = self.levels[0].pad as isize;
