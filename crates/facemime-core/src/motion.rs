@@ -469,12 +469,17 @@ mod tests {
         assert_eq!(median(&mut [5.0, 1.0, 3.0]), 3.0);
     }
 
+    /// The pyramids of a w×h texture and of the same texture shifted by `by` pixels.
+    fn shifted(w: usize, h: usize, by: [f64; 2]) -> (Pyramid, Pyramid) {
+        use crate::flow::tests::{pyramid, texture};
+        let (a, b) = (texture(w, h, 0.0, 0.0), texture(w, h, by[0], by[1]));
+        (pyramid(&a, w, h), pyramid(&b, w, h))
+    }
+
     #[test]
     fn follow_rigid_finds_the_shift_and_checks_every_point() {
-        use crate::flow::tests::{pyramid, texture, PARAMS};
-        let (w, h) = (96, 96);
-        let (a, b) = (texture(w, h, 0.0, 0.0), texture(w, h, 1.5, -0.5));
-        let (mut pa, mut pb) = (pyramid(&a, w, h), pyramid(&b, w, h));
+        use crate::flow::tests::PARAMS;
+        let (mut pa, mut pb) = shifted(96, 96, [1.5, -0.5]);
         let points: Vec<[f64; 2]> = (0..9)
             .map(|k| [30.0 + 6.0 * (k % 3) as f64, 30.0 + 6.0 * (k / 3) as f64])
             .collect();
@@ -550,13 +555,11 @@ mod tests {
 
     #[test]
     fn rigid_points_come_back_from_where_the_head_moved_them() {
-        use crate::flow::tests::{pyramid, texture, PARAMS};
-        let (w, h) = (384, 256);
+        use crate::flow::tests::PARAMS;
         // The head moves by (30, -20), beyond the frame level's reach from where the points
         // were: the way back, on the frame's level alone, finds them only from where the
         // head's step carries them back.
-        let (a, b) = (texture(w, h, 0.0, 0.0), texture(w, h, 30.0, -20.0));
-        let (mut pa, mut pb) = (pyramid(&a, w, h), pyramid(&b, w, h));
+        let (mut pa, mut pb) = shifted(384, 256, [30.0, -20.0]);
         let points: Vec<[f64; 2]> = (0..12)
             .map(|k| [150.0 + 12.0 * (k % 4) as f64, 110.0 + 15.0 * (k / 4) as f64])
             .collect();

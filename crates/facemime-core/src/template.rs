@@ -63,24 +63,17 @@ impl Grey {
     /// Each 2×2 block's mean, rounded half up; an odd last row or column is dropped (the
     /// image must be at least 2×2).
     fn halved(&self) -> Grey {
-        let k = 2;
-        let (width, height) = (self.width / k, self.height / k);
-        let n = (k * k) as u32;
-        // Each block row's columns summed down its k rows, then each k columns across.
-        let mut columns = vec![0u32; width * k];
+        let (width, height) = (self.width / 2, self.height / 2);
         let mut data = Vec::with_capacity(width * height);
-        for by in 0..height {
-            columns.fill(0);
-            for y in by * k..(by + 1) * k {
-                for (c, &v) in columns.iter_mut().zip(self.row(y)) {
-                    *c += v as u32;
-                }
-            }
-            data.extend(
-                columns
-                    .chunks_exact(k)
-                    .map(|b| ((b.iter().sum::<u32>() + n / 2) / n) as u8),
-            );
+        for y in 0..height {
+            let (a, b) = (self.row(2 * y), self.row(2 * y + 1));
+            data.extend((0..width).map(|x| {
+                let sum: u32 = [a[2 * x], a[2 * x + 1], b[2 * x], b[2 * x + 1]]
+                    .iter()
+                    .map(|&v| v as u32)
+                    .sum();
+                ((sum + 2) / 4) as u8
+            }));
         }
         Grey {
             data,
