@@ -569,12 +569,14 @@ class Tracker:
         iterations."""
         p, idx = self.params, self._features[feature]
         reach = p.delta0 / (1.0 - p.sigma)
+        # One field for every trial: a trial is at most brow_raise reaches from the start and its
+        # pass reads one more.
+        image = self._field(frame, start, ((idx, p.brow_raise + 1),))
         best, iters = None, 0
         for k in range(1, p.brow_raise + 1):
             tried = knots.copy()
             tried[idx] = start[idx] - k * reach * down
-            moved, more, resp = self._solve(self._field(frame, tried, ((idx, 1),)), tried, rest, down, targets,
-                                            self._feature_curves[feature])
+            moved, more, resp = self._solve(image, tried, rest, down, targets, self._feature_curves[feature])
             iters += more
             c = self._confidences(resp)[feature]
             if c >= RAISED and c > conf and (best is None or c > best[0]):
