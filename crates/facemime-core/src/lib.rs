@@ -17,6 +17,7 @@ mod grey;
 pub mod head;
 pub mod lip_placement;
 pub mod lip_search;
+mod median;
 pub mod motion;
 pub mod pose;
 pub mod raster;

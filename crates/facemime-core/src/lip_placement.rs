@@ -12,6 +12,7 @@
 use crate::error::Result;
 use crate::invalid;
 use crate::lip_search::{find_edges, normal_gaps, scores_near, LipColour, Probe, SearchSettings};
+use crate::median::median;
 use crate::raster::ImageRef;
 
 /// Smoothing (px) of the lip score along a normal.
@@ -83,17 +84,10 @@ fn normals(pts: &[[f64; 2]]) -> Vec<[f64; 2]> {
         .collect()
 }
 
-/// The median of finite values (the mean of the middle two for an even count); None when
-/// there are none.
-fn median(values: impl Iterator<Item = f64>) -> Option<f64> {
+/// The [`median`] of the finite `values`; None when there are none.
+fn finite_median(values: impl Iterator<Item = f64>) -> Option<f64> {
     let mut v: Vec<f64> = values.filter(|x| x.is_finite()).collect();
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    match n {
-        0 => None,
-        _ if n % 2 == 1 => Some(v[n / 2]),
-        _ => Some((v[n / 2 - 1] + v[n / 2]) / 2.0),
-    }
+    (!v.is_empty()).then(|| median(&mut v))
 }
 
 /// One search of [`LipPlacer::search`]: which interior knots, a shorter range (px) than the
@@ -174,7 +168,7 @@ impl LipPlacer {
         }
         for curve in [Curve::OuterUpper, Curve::OuterLower] {
             let gap: Vec<f64> = placer.gaps(edges, curve).iter().map(|g| g.abs()).collect();
-            let fill = median(gap.iter().copied()).unwrap_or(0.0);
+            let fill = finite_median(gap.iter().copied()).unwrap_or(0.0);
             placer.lip0[curve as usize] = gap
                 .iter()
                 .map(|&g| if g.is_finite() { g } else { fill })
@@ -405,7 +399,7 @@ impl LipPlacer {
         let offsets = &self.offset0[c];
         let how = Search {
             expect: Some(&expect),
-            offset: median(offsets[1..offsets.len() - 1].iter().copied()),
+            offset: finite_median(offsets[1..offsets.len() - 1].iter().copied()),
             ..Search::default()
         };
         self.place_curve(image, knots, curve, &far, scale, &how)
@@ -427,9 +421,12 @@ mod tests {
     }
 
     #[test]
-    fn median_skips_non_finite_values() {
-        assert_eq!(median([3.0, f64::NAN, 1.0, 2.0].into_iter()), Some(2.0));
-        assert_eq!(median([4.0, 1.0].into_iter()), Some(2.5));
-        assert_eq!(median([f64::NAN].into_iter()), None);
+    fn the_median_skips_non_finite_values() {
+        assert_eq!(
+            finite_median([3.0, f64::NAN, 1.0, 2.0].into_iter()),
+            Some(2.0)
+        );
+        assert_eq!(finite_median([4.0, 1.0].into_iter()), Some(2.5));
+        assert_eq!(finite_median([f64::NAN].into_iter()), None);
     }
 }

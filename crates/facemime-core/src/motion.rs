@@ -7,6 +7,7 @@
 
 use crate::error::Result;
 use crate::flow::{lucas_kanade_from, LkParams, Pyramid};
+use crate::median::median;
 
 /// Tukey's biweight constant (95 % efficiency on Gaussian residuals).
 const TUKEY: f64 = 4.685;
@@ -51,20 +52,6 @@ impl Complex {
     }
     fn abs(self) -> f64 {
         self.re.hypot(self.im)
-    }
-}
-
-/// Median (the mean of the two middle values for an even count); NaN when empty.
-fn median(values: &mut [f64]) -> f64 {
-    let n = values.len();
-    if n == 0 {
-        return f64::NAN;
-    }
-    values.sort_unstable_by(f64::total_cmp);
-    if n % 2 == 1 {
-        values[n / 2]
-    } else {
-        0.5 * (values[n / 2 - 1] + values[n / 2])
     }
 }
 
