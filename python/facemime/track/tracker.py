@@ -201,6 +201,11 @@ class TrackerParams:
     mouth_relocate: int = 1
     face_width: float | None = 240.0
 
+    @property
+    def reach(self) -> float:
+        """The farthest a solver pass moves a knot coordinate, δ0/(1−σ) px."""
+        return self.delta0 / (1.0 - self.sigma)
+
     def with_(self, **changes: object) -> "TrackerParams":
         """A copy with some settings changed."""
         return replace(self, **changes)
@@ -408,8 +413,7 @@ class Tracker:
         passes): the margin that so many passes from the knots, each reaching δ0/(1−σ) px, can
         read (and the bilinear cell of a point read); the field's box grows beyond it by the
         smoothing's radius (:func:`facemime.track.field.regions`)."""
-        p = self.params
-        reach = p.delta0 / (1.0 - p.sigma)
+        reach = self.params.reach
         return [(np.asarray(idx, np.uintp), passes * reach + 2.0) for idx, passes in bands]
 
     def _previous(self) -> np.ndarray | None:
@@ -473,7 +477,7 @@ class Tracker:
         # Where the flow followed a knot, else where the head's step carries it; the head's
         # scale, and the mouth's downward normal turned with the head.
         start, followed, mouth_unfollowed, scale, down = self._plan.begin(step, total, self._knots, flow)
-        reach = p.delta0 / (1.0 - p.sigma)
+        reach = p.reach
         if followed is not None:
             if mouth_unfollowed:
                 self._mouth_sideways(frame, start, followed, step, down, reach)
@@ -544,7 +548,7 @@ class Tracker:
         if found is not None:
             fallback = knots.copy()
             fallback[idx] = found
-            if np.abs(found - knots[idx]).max() >= AGREE * p.delta0 / (1.0 - p.sigma):
+            if np.abs(found - knots[idx]).max() >= AGREE * p.reach:
                 again, iters, again_resp = self._solve(self._field(frame, fallback, ((idx, 1),)), fallback, rest,
                                                        down, targets, self._feature_curves[feature])
                 conf_again = self._confidences(again_resp)[feature]
@@ -568,7 +572,7 @@ class Tracker:
         Returns the brow's confidence and shape check (against ``carried``), and the solver's
         iterations."""
         p, idx = self.params, self._features[feature]
-        reach = p.delta0 / (1.0 - p.sigma)
+        reach = p.reach
         # One field for every trial: a trial is at most brow_raise reaches from the start and its
         # pass reads one more.
         image = self._field(frame, start, ((idx, p.brow_raise + 1),))
@@ -611,7 +615,7 @@ class Tracker:
         holds its edges (confidence at least ``lost_response``, shape sound against
         ``carried``). Returns its confidence then, else None; and the solver's iterations."""
         p = self.params
-        reach = p.delta0 / (1.0 - p.sigma)
+        reach = p.reach
         inner = self._features["mouth_inner"]
         # One field for every trial: a trial moves a knot at most inner_search reaches and its
         # pass one more.
