@@ -50,7 +50,8 @@ class Viewer:
 
     ``source``: a video file (analysed live) or a ``facemime.track/1`` file with motion (from
     ``facemime run``); ``actor``: the face to drive (default: for a video, the face fitted on its
-    first frame; for a track file, the generic head).
+    first frame; for a track file, the generic head). A video is decoded on a thread of its
+    reader's while the viewer plays it: :meth:`close` (or leaving a ``with`` block) stops it.
     """
 
     def __init__(self, source: str | Path, actor: Actor | None = None):
@@ -83,17 +84,19 @@ class Viewer:
                     yield None, Pose(**m["pose"]), m["offsets"], self._puppet
                 continue
             analysis = None
-            for frame in VideoReader(self.source):
-                if analysis is None:
-                    try:
-                        analysis = Analysis(frame, str(self.source))
-                    except NoFaceError as e:
-                        raise NoFaceError(f"{e}; the video must start with a frontal face") from None
-                    puppet = Puppet(self._actor or analysis.actor, analysis.deformer.feature_sizes(), model_iod(analysis.actor.model))
-                    m = analysis.last
-                else:
-                    m = analysis.update(frame)
-                yield (draw_contours(frame, m.contours, m.lost) if m.face else frame), m.pose, m.offsets, puppet
+            with VideoReader(self.source) as reader:
+                for frame in reader:
+                    if analysis is None:
+                        try:
+                            analysis = Analysis(frame, str(self.source))
+                        except NoFaceError as e:
+                            raise NoFaceError(f"{e}; the video must start with a frontal face") from None
+                        puppet = Puppet(self._actor or analysis.actor, analysis.deformer.feature_sizes(),
+                                        model_iod(analysis.actor.model))
+                        m = analysis.last
+                    else:
+                        m = analysis.update(frame)
+                    yield (draw_contours(frame, m.contours, m.lost) if m.face else frame), m.pose, m.offsets, puppet
             if analysis is None:
                 raise InputFileError(f"video {self.source} has no frames")
 
@@ -122,6 +125,17 @@ class Viewer:
             if not self.paused:
                 self._shown = next(self._frames)
             return self._render()
+
+    def close(self) -> None:
+        """Stops playing: the video's reader, and its decoding thread, end."""
+        with self._lock:
+            self._frames.close()
+
+    def __enter__(self) -> "Viewer":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
     def state(self) -> dict:
         """The user motion and whether playback is paused, as a JSON-ready dict."""

@@ -41,10 +41,13 @@ def test_keys_turn_zoom_and_exaggerate_the_replayed_face(recorded):
         viewer.key("F13")
 
 
-def test_a_video_plays_side_by_side_with_live_analysis(recorded):
-    viewer = Viewer(recorded[0])
-    frames = [viewer.frame() for _ in range(14)]  # past the end: it loops
+def test_a_video_plays_side_by_side_with_live_analysis_and_closing_stops_its_decoder(recorded):
+    decoding = lambda: [t for t in threading.enumerate() if t.name == f"decoder {recorded[0].name}"]  # noqa: E731
+    with Viewer(recorded[0]) as viewer:
+        frames = [viewer.frame() for _ in range(14)]  # past the end: it loops
+        assert decoding(), "the video is decoded beside the viewer's work"
     assert all(f.shape == (512, 1024, 3) for f in frames)
+    assert decoding() == []
 
 
 def test_the_web_page_serves_frames_and_takes_keys(recorded):

@@ -168,16 +168,17 @@ def view(source: Path, actor_file: Path | None, port: int, no_browser: bool) -> 
     from facemime.viewer import HELP, Viewer, make_server
 
     actor = load_actor(actor_file) if actor_file is not None else None
-    server = make_server(Viewer(source, actor), port)
-    url = f"http://127.0.0.1:{server.server_address[1]}/"
-    click.echo(url)
-    click.echo(f"keys: {HELP}; Ctrl-C stops", err=True)
-    if not no_browser:
-        webbrowser.open(url)
-    try:
-        server.serve_forever()
-    finally:
-        server.server_close()
+    with Viewer(source, actor) as viewer:
+        server = make_server(viewer, port)
+        url = f"http://127.0.0.1:{server.server_address[1]}/"
+        click.echo(url)
+        click.echo(f"keys: {HELP}; Ctrl-C stops", err=True)
+        if not no_browser:
+            webbrowser.open(url)
+        try:
+            server.serve_forever()
+        finally:
+            server.server_close()
 
 
 def main(argv: list[str] | None = None) -> None:
