@@ -9,7 +9,7 @@ from facemime.fit import fit_model
 from facemime.fit.actor import smear_texture
 from facemime.io.video import VideoReader
 from facemime.model import generic_head
-from facemime.track.contours import from_face_mesh
+from facemime.face.mesh import reference_points as face_mesh_points
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT.parent / "shared"
@@ -26,14 +26,12 @@ def shared() -> Path:
 def candide_path(shared: Path) -> Path:
     return shared / "models" / "candide3.wfm"
 
-EYE_CORNERS = {"eye_right_outer": 33, "eye_right_inner": 133, "eye_left_inner": 362, "eye_left_outer": 263}
 
 
 def reference_points(landmarks: np.ndarray) -> dict[str, np.ndarray]:
-    """Reference points from one frame's Face Mesh landmarks (478, 2+), pixels."""
-    pts = {n: landmarks[[i], :2].astype(float) for n, i in EYE_CORNERS.items()}
-    pts |= {"nose_tip": landmarks[[1], :2].astype(float), "chin": landmarks[[152], :2].astype(float)}
-    return pts | from_face_mesh(landmarks)
+    """Reference points from one frame's Face Mesh landmarks (478, 2+), pixels, without the
+    face outline (the points a user marks by hand)."""
+    return {n: p for n, p in face_mesh_points(landmarks).items() if n != "face_outline"}
 
 
 @pytest.fixture(scope="session")

@@ -21,3 +21,7 @@ class ModelFormatError(FacemimeError, ValueError):
 
 class OutputFileError(FacemimeError, OSError):
     """An output file cannot be written (a full disk, a failing encoder)."""
+
+
+class NoFaceError(FacemimeError, ValueError):
+    """No human face was found in an image."""

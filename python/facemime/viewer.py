@@ -25,9 +25,8 @@ import numpy as np
 
 from facemime.animate.analysis import Analysis
 from facemime.animate.synth import BACKGROUND, Puppet, UserMotion
-from facemime.errors import InputFileError, InvalidInputError
+from facemime.errors import InputFileError, InvalidInputError, NoFaceError
 from facemime.fit.actor import Actor, generic_actor
-from facemime.fit.detect import NoFaceError
 from facemime.fit.placement import model_iod
 from facemime.io.contours_json import read_motion
 from facemime.io.video import VideoReader

@@ -30,5 +30,7 @@ def test_the_face_is_kept_through_a_fast_hand_held_head_motion(shared):
     assert analysis.frames_without_face == 0
     # Measured: mouth outer 0.022, brows 0.023 (restarting from fits: 0.059, 0.040).
     assert np.mean(errors, axis=0).max() < 0.03
-    # Measured: 0.069 IOD in the median, 0.26 at most (the step alone: 0.16, 0.37).
-    assert np.median(nose_errors) < 0.1 and max(nose_errors) < 0.33
+    # Measured: 0.107 IOD in the median, 0.42 at most, with the actor fitted on the face
+    # landmarks' points (0.058 and 0.30 without their face outline, which fits lp_d6 and vr_1
+    # better; 0.069 and 0.26 with the earlier cascade points; the step alone: 0.16, 0.37).
+    assert np.median(nose_errors) < 0.12 and max(nose_errors) < 0.45

@@ -4,7 +4,8 @@ on a photo without a face."""
 import numpy as np
 import pytest
 
-from facemime.fit import NoFaceError, auto_points
+from facemime.errors import NoFaceError
+from facemime.fit import auto_points
 from facemime.fit.points import GROUPS
 from facemime.io.video import VideoReader
 from facemime.metrics import curve_error

@@ -20,7 +20,7 @@ import numpy as np
 
 from facemime.animate.deform import Deformer
 from facemime.animate.pose import PoseTracker
-from facemime.fit.detect import NoFaceError
+from facemime.errors import NoFaceError
 from facemime.fit.placement import model_iod
 from facemime.fit.run import fit_actor, init_contours
 from facemime.render.projection import Pose
@@ -69,7 +69,7 @@ class Analysis:
     """Analyses a video of one face, fed frame by frame (RGB uint8 (H, W, 3)).
 
     The first frame must show the face roughly frontal; an actor is fitted on it (raises
-    :class:`~facemime.fit.detect.NoFaceError` when there is none). ``name`` names the video in
+    :class:`~facemime.errors.NoFaceError` when there is none). ``name`` names the video in
     messages.
     """
 

@@ -16,9 +16,8 @@ import numpy as np
 
 from facemime.animate.analysis import Analysis
 from facemime.animate.synth import BACKGROUND, Puppet, UserMotion
-from facemime.errors import InputFileError, InvalidInputError
+from facemime.errors import InputFileError, InvalidInputError, NoFaceError
 from facemime.fit.actor import Actor
-from facemime.fit.detect import NoFaceError
 from facemime.fit.placement import model_iod
 from facemime.io.actor_file import load_actor
 from facemime.io.contours_json import track_document, write_json

@@ -2,11 +2,10 @@
 automatically), placement and elastic adjustment, texture smearing, and the resulting actor."""
 
 from facemime.fit.auto import AutoPoints, auto_points
-from facemime.fit.detect import FaceDetection, NoFaceError, detect_face
 from facemime.fit.placement import Fit, fit_model, frontal_pose
 from facemime.fit.points import GROUPS, NAMES, REQUIRED, ReferencePoints, check_points, model_chain
 
 __all__ = [
-    "AutoPoints", "auto_points", "FaceDetection", "NoFaceError", "detect_face", "Fit", "fit_model",
+    "AutoPoints", "auto_points", "Fit", "fit_model",
     "frontal_pose", "GROUPS", "NAMES", "REQUIRED", "ReferencePoints", "check_points", "model_chain",
 ]

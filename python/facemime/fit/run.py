@@ -8,10 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
-from facemime.errors import InvalidInputError
+from facemime.errors import InvalidInputError, NoFaceError
 from facemime.fit.actor import Actor, smear_texture
 from facemime.fit.auto import auto_points
-from facemime.fit.detect import NoFaceError
 from facemime.fit.placement import fit_model
 from facemime.fit.preview import preview_sheet
 from facemime.io.actor_file import save_actor
@@ -41,19 +40,17 @@ def fit_actor(photo: np.ndarray, name: str, points: dict | None = None, frame: i
     """Fit ``model`` (default: the generic head) to ``photo`` ((H, W, 3) uint8 RGB) on the given
     validated reference ``points`` or, without them, on points found automatically. ``name`` is
     the photo's file name, for messages and the actor's metadata. Returns the actor, warnings
-    (several faces, eyes not confirmed) and the final contour residual (pixels)."""
+    (several faces) and the final contour residual (pixels)."""
     model = model or generic_head()
     warnings: list[str] = []
     if points is None:
         try:
-            found = auto_points(photo, model)
+            found = auto_points(photo)
         except NoFaceError:
             raise NoFaceError(f"no face found in {name}") from None
         points = found.points
-        if found.detection.faces > 1:
-            warnings.append(f"{found.detection.faces} faces found in {name}; fitting the largest")
-        if not found.detection.eyes_found:
-            warnings.append(f"the eyes in {name} were placed from the face box alone; check the preview")
+        if found.face.faces > 1:
+            warnings.append(f"{found.face.faces} faces found in {name}; fitting the largest")
     fit = fit_model(model, points)
     source = {"file": Path(name).name, "frame": int(frame), "width": int(photo.shape[1]), "height": int(photo.shape[0])}
     return smear_texture(model, photo, fit, points, source), warnings, float(fit.residuals[-1])

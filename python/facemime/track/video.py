@@ -11,23 +11,27 @@ from pathlib import Path
 
 import numpy as np
 
-from facemime.errors import InputFileError, InvalidInputError
-from facemime.fit.detect import NoFaceError
-from facemime.fit.run import fit_actor, init_contours
+from facemime.errors import InputFileError, InvalidInputError, NoFaceError
+from facemime.fit.auto import auto_points
 from facemime.io.contours_json import read_init, track_document, write_json
 from facemime.io.outputs import check_outputs
 from facemime.io.video import CODECS, VideoReader, VideoWriter
 from facemime.progress import track as progress
-from facemime.track.contours import FEATURES
+from facemime.track.contours import CONTOUR_NAMES, FEATURES
 from facemime.track.overlay import draw_contours
 from facemime.track.tracker import FrameResult, Tracker, TrackerParams
 
 
 def automatic_contours(frame: np.ndarray, what: str) -> dict[str, np.ndarray]:
-    """The contours to start tracking from when none are given: the generic head fitted to
-    ``frame`` (H, W, 3 uint8 RGB; ``what`` names it in errors), its mouth and brows projected,
-    name -> (K, 2) float64 pixels. Raises NoFaceError where no face is found."""
-    return init_contours(fit_actor(frame, what)[0])
+    """The contours to start tracking from when none are given: the mouth and brows of the
+    largest face's automatic reference points (:func:`facemime.fit.auto_points`) on ``frame``
+    (H, W, 3 uint8 RGB; ``what`` names it in errors), name -> (K, 2) float64 pixels. Raises
+    NoFaceError where no face is found."""
+    try:
+        points = auto_points(frame).points
+    except NoFaceError:
+        raise NoFaceError(f"no face found in {what}") from None
+    return {n: points[n] for n in CONTOUR_NAMES}
 
 
 @dataclass

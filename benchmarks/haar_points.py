@@ -1,7 +1,11 @@
-"""Finding a face and its eyes with OpenCV's bundled Haar cascades (no model downloads).
+"""The automatic reference points facemime used before its face models, kept as the baseline of
+``benchmarks/fit_points.py``: OpenCV's bundled Haar cascades find the largest face and its eyes,
+the generic head is placed on the eyes, each brow and the lips are slid and scaled to where the
+image contrast puts them (brows darker, lips redder: CIELAB a* - L*/2), and the mouth and brow
+curves settle on their edges with the tracker's snakes.
 
-Boxes are (x, y, w, h) in pixels of the image, x right, y down; eye centres are (x, y) pixels,
-the image-left eye (the subject's right) first.
+Boxes are (x, y, w, h) pixels; points are (x, y) pixels (origin at the centre of the top-left
+pixel, y down).
 """
 
 from __future__ import annotations
@@ -12,7 +16,14 @@ from functools import cache
 import cv2
 import numpy as np
 
-from facemime.errors import FacemimeError
+from facemime.errors import FacemimeError, NoFaceError
+from facemime.fit.placement import frontal_pose, model_eye_centres, model_iod
+from facemime.fit.points import GROUPS, ReferencePoints, model_chain
+from facemime.model.head import HeadModel, generic_head
+from facemime.render.projection import project
+from facemime.track.contours import CONTOUR_NAMES
+from facemime.track.match import locate
+from facemime.track.tracker import Tracker, TrackerParams
 
 #: Another face counts (for the several-faces warning) when at least this fraction of the
 #: chosen face's width.
@@ -29,10 +40,6 @@ EYE_ANGLES = (0.0, -8.0, 8.0, -14.0, 14.0)
 EYE_CLUSTER = 0.05
 #: Plausible distance between the eye centres, fractions of the box width.
 EYE_GAP = (0.26, 0.52)
-
-
-class NoFaceError(FacemimeError, ValueError):
-    """No frontal face was found in an image."""
 
 
 @dataclass(frozen=True)
@@ -126,3 +133,70 @@ def _eyes(gray: np.ndarray, box: np.ndarray) -> tuple[np.ndarray, bool]:
     if not support.all() or not EYE_GAP[0] <= np.linalg.norm(eyes[1] - eyes[0]) / w <= EYE_GAP[1]:
         return prior, False  # one eye alone, or an implausible pair (a brow, a frame): trust the box
     return eyes, True
+
+
+#: Search settings per feature, in units of the inter-ocular distance (outer eye corners):
+#: reach (x, y), surrounding band width, scales tried.
+BROW_SEARCH = ((0.06, 0.12), 0.05, (0.85, 0.92, 1.0, 1.08, 1.16))
+MOUTH_SEARCH = ((0.06, 0.12), 0.06, (0.9, 1.0, 1.1))
+#: Snake passes that settle the mouth and brow curves on the image edges.
+SETTLE_PASSES = 4
+
+
+def lip_channel(rgb: np.ndarray) -> np.ndarray:
+    """How lip-like each pixel is, (H, W) float32: CIELAB a* (green to red) minus half the
+    lightness L*, as lips are redder *and* darker than the skin around them. (Measured on the
+    six shared videos: R - G or a* alone let the search slide onto a reddish chin.)"""
+    lab = cv2.cvtColor(rgb, cv2.COLOR_RGB2LAB).astype(np.float32)
+    return lab[..., 1] - 0.5 * lab[..., 0]
+
+
+def _polygon(p: np.ndarray, model: HeadModel, upper: str, lower: str) -> np.ndarray:
+    return np.concatenate([p[model.groups[upper]], p[model.groups[lower]][::-1]])
+
+
+def haar_points(rgb: np.ndarray, model: HeadModel | None = None) -> tuple[ReferencePoints, FaceDetection]:
+    """Reference points of the largest face in an (H, W, 3) uint8 RGB photo.
+
+    Raises :class:`facemime.errors.NoFaceError` when no face is found.
+    """
+    model = model or generic_head()
+    det = detect_face(rgb)
+    g = model.groups
+    pose = frontal_pose(model_eye_centres(model), det.eyes)
+    p = project(model.vertices, pose)[0]
+    iod = pose.scale * model_iod(model)
+
+    blur = max(0.6, 0.01 * iod)
+    dark = -cv2.GaussianBlur(cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY).astype(np.float32), (0, 0), blur)
+    red = cv2.GaussianBlur(lip_channel(rgb), (0, 0), blur)
+
+    def place(channel: np.ndarray, poly: np.ndarray, search: tuple, *others: np.ndarray) -> list[np.ndarray]:
+        (rx, ry), band, scales = search
+        found = locate(channel, poly, (rx * iod, ry * iod), max(2.0, band * iod), scales)
+        return [found.apply(q, poly.mean(axis=0)) for q in (poly, *others)]
+
+    points: ReferencePoints = {n: p[model_chain(model, n)] for n in GROUPS["eye_corners"]}
+    for side in ("left", "right"):
+        up, low = f"brow_{side}_upper", f"brow_{side}_lower"
+        _, points[up], points[low] = place(dark, _polygon(p, model, up, low), BROW_SEARCH, p[g[up]], p[g[low]])
+    outer = _polygon(p, model, "mouth_outer_upper", "mouth_outer_lower")
+    moved = place(red, outer, MOUTH_SEARCH, *(p[g[n]] for n in CONTOUR_NAMES[:4]))
+    for name, curve in zip(CONTOUR_NAMES[:4], moved[1:]):
+        points[name] = curve
+    mouth_shift = moved[1].mean(axis=0) - p[g["mouth_outer_upper"]].mean(axis=0)
+    points["nose_tip"] = p[g["nose"][[6]]]
+    points["chin"] = p[g["face_outline"][[9]]] + mouth_shift
+    points.update(settle(rgb, points))
+    h, w = rgb.shape[:2]
+    for name in points:
+        points[name] = np.clip(points[name], -0.5, [w - 0.5, h - 0.5])
+    return points, det
+
+
+def settle(rgb: np.ndarray, points: ReferencePoints) -> ReferencePoints:
+    """The mouth and brow curves of ``points`` moved onto the image edges by the snakes."""
+    h, w = rgb.shape[:2]
+    contours = {n: np.clip(points[n], 0.0, [w - 1.0, h - 1.0]) for n in CONTOUR_NAMES}
+    tracker = Tracker(rgb, contours, TrackerParams(calibration_passes=SETTLE_PASSES, motion=False))
+    return tracker.edges

@@ -1,0 +1,201 @@
+"""Face detection with MediaPipe's short-range face detector (BlazeFace, 128 x 128 input), run by
+OpenCV's ``cv2.dnn``.
+
+The network scores 896 fixed anchors and regresses, per anchor, a box and six keypoints as
+offsets from the anchor's centre in input pixels. Detections are decoded here, weighted
+non-maximum suppression merges the overlapping ones, and they are mapped back to the image.
+
+Boxes are (x0, y0, x1, y1) and keypoints (x, y), in pixels of the image searched: x right, y
+down, (0, 0) at the centre of the top-left pixel. The keypoints are, in order, the subject's
+right eye (image left), left eye, nose tip, mouth centre, right ear tragion, left ear tragion.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cache
+
+import cv2
+import numpy as np
+
+from facemime.face.network import load_network
+
+#: Side of the detector's square input, pixels.
+INPUT = 128
+#: Anchor layout of the short-range model: the feature maps' strides (input pixels) and the
+#: anchors per cell (two per stride-8 cell, six per stride-16 cell: 16*16*2 + 8*8*6 = 896).
+STRIDES = (8, 16)
+ANCHORS_PER_CELL = (2, 6)
+#: Lowest detection score (after the sigmoid) kept, and the overlap (intersection over union)
+#: above which two detections are merged: MediaPipe's settings for this model.
+MIN_SCORE = 0.5
+MIN_OVERLAP = 0.3
+#: Raw scores are clipped to this before the sigmoid (as MediaPipe does).
+SCORE_CLIP = 100.0
+
+
+@dataclass(frozen=True)
+class Detection:
+    """One face found by the detector.
+
+    Attributes
+    ----------
+    box : (4,) float64 array
+        (x0, y0, x1, y1), pixels.
+    keypoints : (6, 2) float64 array
+        (x, y) pixels: right eye, left eye, nose tip, mouth centre, right ear, left ear
+        (the subject's sides).
+    score : float
+        Detection confidence, 0..1.
+    """
+
+    box: np.ndarray
+    keypoints: np.ndarray
+    score: float
+
+    @property
+    def size(self) -> float:
+        """The larger side of the box, pixels."""
+        return float(max(self.box[2] - self.box[0], self.box[3] - self.box[1]))
+
+
+@cache
+def anchors() -> np.ndarray:
+    """The 896 anchor centres, (896, 2) float64, as fractions of the input side, in the
+    network's output order (row by row, cell by cell, the anchors of a cell together)."""
+    out = []
+    for stride, per_cell in zip(STRIDES, ANCHORS_PER_CELL):
+        cells = INPUT // stride
+        y, x = np.mgrid[0:cells, 0:cells]
+        centres = (np.column_stack([x.ravel(), y.ravel()]) + 0.5) / cells
+        out.append(np.repeat(centres, per_cell, axis=0))
+    return np.concatenate(out)
+
+
+def decode(scores: np.ndarray, regressors: np.ndarray, min_score: float = MIN_SCORE) -> list[Detection]:
+    """The detections of one network pass, in input fractions (0..1 across the input).
+
+    Parameters
+    ----------
+    scores : (896,) float array
+        Raw (pre-sigmoid) anchor scores.
+    regressors : (896, 16) float array
+        Per anchor: box centre offset (x, y), box width and height, then six keypoint offsets
+        (x, y), all in input pixels relative to the anchor's centre.
+    min_score : float
+        Lowest sigmoid score kept.
+
+    Returns
+    -------
+    Detections with ``box`` and ``keypoints`` as fractions of the input side, unsuppressed.
+
+    Examples
+    --------
+    >>> raw = np.zeros((896, 16)); raw[0, 2:4] = 16.0
+    >>> d = decode(np.r_[5.0, np.full(895, -5.0)], raw)
+    >>> len(d), d[0].box.round(4).tolist()
+    (1, [-0.0312, -0.0312, 0.0938, 0.0938])
+    """
+    scores = 1.0 / (1.0 + np.exp(-np.clip(np.asarray(scores, np.float64), -SCORE_CLIP, SCORE_CLIP)))
+    keep = np.flatnonzero(scores >= min_score)
+    raw = np.asarray(regressors, np.float64)[keep] / INPUT
+    centre = anchors()[keep]
+    xy = raw[:, :2] + centre
+    half = raw[:, 2:4] / 2
+    boxes = np.concatenate([xy - half, xy + half], axis=1)
+    keypoints = raw[:, 4:].reshape(-1, 6, 2) + centre[:, None]
+    return [Detection(b, k, float(s)) for b, k, s in zip(boxes, keypoints, scores[keep])]
+
+
+def overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Intersection over union of box ``a`` (4,) with each of boxes ``b`` (N, 4); boxes are
+    (x0, y0, x1, y1).
+
+    >>> overlap(np.array([0, 0, 2, 2.0]), np.array([[1, 0, 3, 2.0], [5, 5, 6, 6]]))
+    array([0.33333333, 0.        ])
+    """
+    w = np.clip(np.minimum(a[2], b[:, 2]) - np.maximum(a[0], b[:, 0]), 0, None)
+    h = np.clip(np.minimum(a[3], b[:, 3]) - np.maximum(a[1], b[:, 1]), 0, None)
+    inter = w * h
+    area = lambda r: (r[..., 2] - r[..., 0]) * (r[..., 3] - r[..., 1])  # noqa: E731
+    return inter / np.maximum(area(a) + area(b) - inter, 1e-12)
+
+
+def suppress(detections: list[Detection], min_overlap: float = MIN_OVERLAP) -> list[Detection]:
+    """Weighted non-maximum suppression: the strongest detection left takes every detection
+    overlapping it by more than ``min_overlap`` (itself included), and becomes their
+    score-weighted mean box and keypoints, with its own score. Strongest first.
+
+    >>> a = Detection(np.array([0, 0, 10, 10.0]), np.zeros((6, 2)), 0.9)
+    >>> b = Detection(np.array([2, 0, 12, 10.0]), np.ones((6, 2)), 0.6)
+    >>> c = Detection(np.array([50, 50, 60, 60.0]), np.zeros((6, 2)), 0.7)
+    >>> [(d.box.round(6).tolist(), d.score) for d in suppress([a, b, c])]
+    [([0.8, 0.0, 10.8, 10.0], 0.9), ([50.0, 50.0, 60.0, 60.0], 0.7)]
+    """
+    left = sorted(detections, key=lambda d: -d.score)
+    out = []
+    while left:
+        boxes = np.array([d.box for d in left])
+        group = overlap(left[0].box, boxes) > min_overlap
+        group[0] = True
+        w = np.array([d.score for d in left])[group]
+        members = [d for d, g in zip(left, group) if g]
+        box = (w[:, None] * boxes[group]).sum(axis=0) / w.sum()
+        keypoints = (w[:, None, None] * np.array([d.keypoints for d in members])).sum(axis=0) / w.sum()
+        out.append(Detection(box, keypoints, left[0].score))
+        left = [d for d, g in zip(left, group) if not g]
+    return out
+
+
+def _letterbox(rgb: np.ndarray, window: tuple[int, int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """The square ``window`` (x, y, side) of ``rgb`` (zero beyond the image) resized to the
+    input, and the affine (2, 3) that maps input pixels back to image pixels."""
+    x, y, side = window
+    scale = side / INPUT
+    # input pixel centre u maps to image coordinate x + (u + 0.5) * scale - 0.5
+    back = np.array([[scale, 0, x + 0.5 * scale - 0.5], [0, scale, y + 0.5 * scale - 0.5]])
+    crop = cv2.warpAffine(rgb, back, (INPUT, INPUT), flags=cv2.INTER_AREA | cv2.WARP_INVERSE_MAP,
+                          borderMode=cv2.BORDER_CONSTANT)
+    return crop, back
+
+
+def windows(width: int, height: int) -> list[tuple[int, int, int]]:
+    """The square windows (x, y, side) searched in a ``width`` x ``height`` image: the whole
+    image letterboxed (centred), then, for faces too small for it (a person standing in a tall
+    frame), squares of the shorter side along the longer one and squares of half the shorter
+    side, each overlapping its neighbours by half.
+
+    >>> windows(400, 200)
+    [(0, -100, 400), (0, 0, 200), (100, 0, 200), (200, 0, 200)]
+    """
+    long, short = max(width, height), min(width, height)
+    out = [((width - long) // 2, (height - long) // 2, long)]
+    sides = ([short] if long > short else []) + ([short // 2] if short // 2 >= INPUT else [])
+    for side in sides:
+        spots = [np.linspace(0, extent - side, int(np.ceil(2 * (extent - side) / side)) + 1).round().astype(int)
+                 for extent in (width, height)]
+        out += [(int(x), int(y), side) for y in spots[1] for x in spots[0]]
+    return out
+
+
+def detect_faces(rgb: np.ndarray, min_score: float = MIN_SCORE) -> list[Detection]:
+    """Faces in an (H, W, 3) uint8 RGB image, strongest first, in image pixels.
+
+    The whole image is searched first; only when it holds no face are the smaller windows of
+    :func:`windows` searched too (a face small in a large frame).
+    """
+    net = load_network("face_detection_short_range.tflite")
+    h, w = rgb.shape[:2]
+    found: list[Detection] = []
+    for i, window in enumerate(windows(w, h)):
+        if i == 1 and found:
+            break
+        crop, back = _letterbox(rgb, window)
+        # MediaPipe feeds this model pixels scaled to [-1, 1].
+        net.setInput(cv2.dnn.blobFromImage(crop, 2.0 / 255.0, mean=(127.5, 127.5, 127.5)))
+        scores, regressors = net.forward(["classificators", "regressors"])
+        for d in decode(scores.reshape(-1), regressors.reshape(-1, 16), min_score):
+            # input fractions -> input pixel centres -> image pixels
+            to_image = lambda f: (f * INPUT - 0.5) @ back[:, :2].T + back[:, 2]  # noqa: E731
+            found.append(Detection(to_image(d.box.reshape(2, 2)).ravel(), to_image(d.keypoints), d.score))
+    return suppress(found)

@@ -1,0 +1,40 @@
+"""Which of the Face Mesh's 468 landmarks mark facemime's reference points and contours.
+
+The index lists of the eight contours are those of the shared data's README
+(:data:`facemime.track.contours.FACE_MESH_INDICES`); the eye corners, nose tip and chin follow
+the same numbering, and the face outline is the Face Mesh's face oval, clockwise on screen from
+the top of the forehead like the model's ``face_outline``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from facemime.track.contours import from_face_mesh
+
+#: Single reference points -> Face Mesh index.
+POINT_INDICES = {
+    "eye_right_outer": 33,  # the subject's right eye: image left
+    "eye_right_inner": 133,
+    "eye_left_inner": 362,
+    "eye_left_outer": 263,
+    "nose_tip": 4,
+    "chin": 152,
+}
+#: The face oval, clockwise on screen from the top of the forehead (open: it stops beside its
+#: start, as the model's outline does).
+FACE_OVAL = (10, 338, 297, 332, 284, 251, 389, 356, 454, 323, 361, 288, 397, 365, 379, 378, 400, 377, 152,
+             148, 176, 149, 150, 136, 172, 58, 132, 93, 234, 127, 162, 21, 54, 103, 67, 109)
+
+
+def reference_points(landmarks: np.ndarray) -> dict[str, np.ndarray]:
+    """facemime's reference points (:mod:`facemime.fit.points`) from one face's Face Mesh
+    landmarks, a (468 or 478, 2+) array in pixels: name -> (K, 2) float64 pixels.
+
+    >>> points = reference_points(np.arange(478 * 2, dtype=float).reshape(478, 2))
+    >>> points["nose_tip"].tolist(), len(points["face_outline"]), len(points)
+    ([[8.0, 9.0]], 36, 15)
+    """
+    xy = np.asarray(landmarks, dtype=np.float64)[:, :2]
+    points = {name: xy[[i]] for name, i in POINT_INDICES.items()}
+    return points | from_face_mesh(xy) | {"face_outline": xy[list(FACE_OVAL)]}
