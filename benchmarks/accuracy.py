@@ -1,4 +1,4 @@
-"""Tracking accuracy on the six shared videos (NME of the shared data README), initialised from
+"""Tracking accuracy on the ten shared videos (NME of the shared data README), initialised from
 the reference contours of the first frame, against two baselines measured in the same run:
 
 - static: the first frame's contours held;
@@ -11,15 +11,15 @@ distance from the inner upper to the inner lower lip along the mouth's normal, m
 middle half of the mouth) over the IOD. NME hides an inner mouth that stays shut over teeth
 (its error is spread over the curves' points); this figure does not.
 
-With ``--variants`` the tracker also runs with other image operators H (gradient magnitude,
+The tracker is the product's (:class:`facemime.track.redetect.FaceTracker`: the snakes, put right
+by the face landmark model where they went astray); the same snakes without re-detection run
+beside it. With ``--variants`` the tracker also runs with other image operators H (gradient magnitude,
 luma only, colour only) to show why the default is what it is. With ``--starts N`` the default
 tracker also starts from N − 1 perturbed references (Gaussian noise of :data:`START_NOISE` px on
 every point, seeds 1..N−1): a face-pulling video's failures swing with such noise, and one start
-tells little about them. With ``--automatic`` it also starts from the automatic fit of the first
-frame, as ``facemime track`` does without ``--init``: a less precise start, on which settings
-that track well from the reference can fail (the inner lips' rigidity at 8 rather than 12 lost
-fewer frames on lp_d6 over 36 starts from the reference, but from lp_d3's automatic fit it put
-the outer lower lip on the chin for 30 frames).
+tells little about them. With ``--automatic`` it also starts from the face landmarks found on
+the first frame, as ``facemime track`` does without ``--init``, and prints that start's figures
+per video next to the reference start's.
 
     python benchmarks/accuracy.py [--data ../shared/data] [--videos lp_d0,vr_1] [--variants] [--starts 8]
                                   [--automatic]
@@ -40,11 +40,11 @@ import numpy as np
 
 from facemime.io.video import VideoReader
 from facemime.metrics import group_nme, pooled_summary, resample, summarize
-from facemime.track import Tracker, TrackerParams
+from facemime.track import TrackerParams
 from facemime.track.contours import CONTOUR_NAMES, GROUPS, from_face_mesh
-from facemime.track.video import automatic_contours
+from facemime.track.redetect import FaceTracker, Redetection
 
-VIDEOS = ("lp_d0", "lp_d3", "lp_d6", "lp_d12", "vr_1", "vr_2")
+VIDEOS = ("lp_d0", "lp_d3", "lp_d6", "lp_d12", "vr_1", "vr_2", "st_aoc", "st_kh", "mt_sun", "mt_yongen")
 ROOT = Path(__file__).resolve().parents[1]
 SCORED = tuple(GROUPS) + ("mouth_opening",)
 START_NOISE = 0.2  # px: standard deviation of the noise on the perturbed starts' points
@@ -59,26 +59,34 @@ def mouth_opening(contours: dict) -> float:
     return float(((lower - upper)[2:7] @ down).mean())
 
 
-def variants() -> dict[str, TrackerParams]:
-    p = TrackerParams()
+#: The snakes alone: no landmark checks (a feature lost for good stays lost).
+NO_REDETECTION = Redetection(check_every=0, lost_for=0)
+Method = tuple[TrackerParams, Redetection]
+
+
+def variants() -> dict[str, Method]:
+    p, r = TrackerParams(), Redetection()
     luma_only = {k: replace(getattr(p, k), luma=1.0, chroma=0.0) for k in ("mouth", "mouth_inner", "brows")}
     colour_only = {k: replace(getattr(p, k), luma=0.0, chroma=1.0) for k in ("mouth", "mouth_inner")}
     return {
-        "facemime (directional, luma + colour)": p,
-        "facemime, H = gradient magnitude": p.with_(operator="magnitude"),
-        "facemime, H = directional luma only": p.with_(**luma_only),
-        "facemime, H = directional colour only (mouth)": p.with_(**colour_only),
+        "facemime (directional, luma + colour)": (p, r),
+        "facemime without re-detection": (p, NO_REDETECTION),
+        "facemime, H = gradient magnitude": (p.with_(operator="magnitude"), r),
+        "facemime, H = directional luma only": (p.with_(**luma_only), r),
+        "facemime, H = directional colour only (mouth)": (p.with_(**colour_only), r),
     }
 
 
-def run_tracker(frames: list[np.ndarray], init: dict, params: TrackerParams) -> tuple[list[dict], int]:
-    tracker = Tracker(frames[0], init, params)
+def run_tracker(frames: list[np.ndarray], init: dict | None, method: Method) -> tuple[list[dict], int, list[int], float]:
+    """The contours of frames 1.. tracked from ``init`` (None: the first frame's landmarks),
+    the frames with a lost feature, those re-detected, and the seconds of the landmark checks."""
+    tracker = FaceTracker(frames[0], init, *method)
     out, lost = [], 0
     for frame in frames[1:]:
         r = tracker.update(frame)
         out.append(r.contours)
         lost += bool(r.lost)
-    return out, lost
+    return out, lost, tracker.redetected, tracker.checking_seconds
 
 
 def run_lk(frames: list[np.ndarray], init: dict) -> list[dict]:
@@ -121,14 +129,17 @@ def main() -> None:
                     "fit of the first frame (as `facemime track` without --init)")
     args = ap.parse_args()
     cv2.setNumThreads(1)
-    methods = variants() if args.variants else {"facemime (directional, luma + colour)": TrackerParams()}
+    methods = variants() if args.variants else dict(list(variants().items())[:2])
     names = ["static", "LK + FB"] + list(methods)
     series: dict[str, dict[str, list[np.ndarray]]] = {m: {g: [] for g in SCORED} for m in names}
     lost: dict[str, dict[str, int]] = {m: {} for m in methods}
+    redetected: dict[str, dict[str, list[int]]] = {m: {} for m in methods}
+    checks_ms: dict[str, dict[str, float]] = {m: {} for m in methods}  # per frame, amortised
     per_video: dict[str, dict] = {}
     labels: list[int | str] = list(range(1, args.starts)) + (["automatic"] if args.automatic else [])
     starts = {label: {g: [] for g in SCORED} for label in labels}
     starts_lost: dict[int | str, dict[str, int]] = {label: {} for label in labels}
+    starts_video: dict[int | str, dict[str, dict]] = {label: {} for label in labels}
     for video in args.videos.split(","):
         z = np.load(args.data / "video" / f"{video}.landmarks.npz")
         with VideoReader(args.data / "video" / f"{video}.mp4") as reader:
@@ -138,18 +149,20 @@ def main() -> None:
         frames, lm, valid, iod = frames[start:], lm[start:], valid[start:], iod[start:]
         init = from_face_mesh(lm[0])
         runs = {"static": [init] * (len(frames) - 1), "LK + FB": run_lk(frames, init)}
-        for m, params in methods.items():
+        for m, method in methods.items():
             t0 = time.perf_counter()
-            runs[m], lost[m][video] = run_tracker(frames, init, params)
+            runs[m], lost[m][video], redetected[m][video], checks = run_tracker(frames, init, method)
+            checks_ms[m][video] = 1e3 * checks / (len(frames) - 1)
             print(f"{video}: {m}: {len(frames) / (time.perf_counter() - t0):.0f} frames/s", flush=True)
         for label in labels:
-            if label == "automatic":
-                other = automatic_contours(frames[0], f"the first frame of {video}")
-            else:
+            other = None
+            if label != "automatic":
                 rng = np.random.default_rng(label)
                 other = {n: c + rng.normal(0.0, START_NOISE, c.shape) for n, c in init.items()}
-            tracks, starts_lost[label][video] = run_tracker(frames, other, TrackerParams())
-            for g, v in score(tracks, lm, valid, iod).items():
+            tracks, starts_lost[label][video], _, _ = run_tracker(frames, other, next(iter(methods.values())))
+            scores = score(tracks, lm, valid, iod)
+            starts_video[label][video] = {g: summarize(v) for g, v in scores.items()}
+            for g, v in scores.items():
                 starts[label][g].append(v)
         per_video[video] = {}
         for m, tracks in runs.items():
@@ -168,6 +181,9 @@ def main() -> None:
             print(f"  {m:48s} {s['mean']:7.4f} {s['median']:7.4f} {s['p90']:7.4f} {100 * s['failure_rate']:6.2f} {s['drift']:7.4f}   {pv}")
     for m in methods:
         print(f"frames with a lost feature, {m}: {lost[m]}")
+        print(f"frames re-detected, {m}: {dict((v, len(r)) for v, r in redetected[m].items())}")
+        print(f"landmark checks, {m}: ms per frame, amortised, one thread: "
+              + ", ".join(f"{v} {ms:.3f}" for v, ms in checks_ms[m].items()))
     default = next(iter(methods))
     spread = [{"seed": 0, "pooled": {g: pooled[default][g] for g in GROUPS}, "frames_with_lost": lost[default]}]
     spread += [{"seed": seed, "pooled": {g: pooled_summary(starts[seed][g]) for g in GROUPS},
@@ -180,8 +196,16 @@ def main() -> None:
             figures = "  ".join(f"{run['pooled'][g]['mean']:17.4f} / {100 * run['pooled'][g]['failure_rate']:5.2f}"
                                 for g in GROUPS)
             print(f"  {run['seed']!s:>9s}  {figures}  {sum(run['frames_with_lost'].values())}")
-    print(json.dumps({"pooled": pooled, "per_video": per_video, "frames_with_lost": lost,
-                      "starts": spread[1:]}, allow_nan=True))
+    if "automatic" in starts_video:
+        auto, ref = starts_video["automatic"], default
+        print("\nautomatic start against the reference start, per video: mean NME / failure % (reference -> automatic)")
+        for video in per_video:
+            print(f"  {video:10s} " + "  ".join(
+                f"{g} {per_video[video][ref][g]['mean']:.4f}/{100 * per_video[video][ref][g]['failure_rate']:.1f}"
+                f" -> {auto[video][g]['mean']:.4f}/{100 * auto[video][g]['failure_rate']:.1f}" for g in GROUPS))
+    print(json.dumps({"pooled": pooled, "per_video": per_video, "frames_with_lost": lost, "redetected": redetected,
+                      "checks_ms_per_frame": checks_ms,
+                      "starts": spread[1:], "starts_per_video": starts_video}, allow_nan=True))
 
 
 if __name__ == "__main__":

@@ -13,6 +13,11 @@ run of each counts (on a shared machine the slower runs measure the neighbours).
 pyramid and optical flow; image field, snake solver, corner detection) by wrapping their calls,
 and prints where a frame's time goes.
 
+Also timed, on each video: the automatic start (the time to the first tracked frame: face
+detection, two landmark passes, the tracker's set-up with its snakes settling), and the tracker
+with re-detection (:class:`facemime.track.redetect.FaceTracker`, from the same reference start)
+with its landmark checks' amortised cost per frame.
+
     python benchmarks/track.py [--data ../shared/data] [--frames 200] [--repeats 3] [--stages]
 
 The last line of output is one JSON object with at least ``fps_tracker`` and ``fps_snakes``.
@@ -41,6 +46,7 @@ import facemime.track.tracker as tracker_module
 from facemime.track import motion
 from facemime.track import Tracker
 from facemime.track.contours import CONTOUR_NAMES, from_face_mesh
+from facemime.track.redetect import FaceTracker
 
 VIDEOS = ("lp_d0", "lp_d3", "lp_d12")
 ROOT = Path(__file__).resolve().parents[1]
@@ -139,6 +145,22 @@ def track_seconds(frames: list[np.ndarray], init: dict[str, np.ndarray]) -> tupl
     return elapsed, clock.seconds["snakes"] + solver.times[1] - before, iterations
 
 
+def start_seconds(frame: np.ndarray) -> float:
+    """Seconds from a frame to the tracker started on the face found in it."""
+    t0 = time.perf_counter()
+    FaceTracker(frame)
+    return time.perf_counter() - t0
+
+
+def checked_seconds(frames: list[np.ndarray], init: dict[str, np.ndarray]) -> tuple[float, float]:
+    """Seconds the tracker with re-detection took on frames 1.., and those of its checks."""
+    tracker = FaceTracker(frames[0], init)
+    t0 = time.perf_counter()
+    for frame in frames[1:]:
+        tracker.update(frame)
+    return time.perf_counter() - t0, tracker.checking_seconds
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data")
@@ -149,14 +171,18 @@ def main() -> None:
     if args.repeats < 1:
         ap.error("--repeats must be at least 1")
     cv2.setNumThreads(1)
-    totals = {"frames": 0, "decode": 0.0, "tracker": 0.0, "snakes": 0.0, "lk": 0.0, "iterations": 0}
+    totals = {"frames": 0, "decode": 0.0, "tracker": 0.0, "snakes": 0.0, "lk": 0.0, "iterations": 0, "checked": 0.0,
+              "checks": 0.0}
+    starts = {}
     stages, staged = defaultdict(float), 0.0  # with --stages: seconds per stage, and in all
     for video in VIDEOS:
         path = args.data / "video" / f"{video}.mp4"
         frames, _ = decode(path, args.frames)
         init = from_face_mesh(np.load(args.data / "video" / f"{video}.landmarks.npz")["landmarks"][0])
         pts = np.concatenate([init[n] for n in CONTOUR_NAMES])
-        best = {"decode": np.inf, "tracker": np.inf, "snakes": np.inf, "lk": np.inf}
+        best = {"decode": np.inf, "tracker": np.inf, "snakes": np.inf, "lk": np.inf, "start": np.inf,
+                "checked": np.inf, "checks": np.inf}
+        start_seconds(frames[0])  # the face models load once per process
         # The runs of the three measurements alternate, so that a slow spell of a shared machine
         # does not fall on one of them only; each keeps its fastest run.
         for _ in range(args.repeats):
@@ -164,6 +190,9 @@ def main() -> None:
             track_s, snake_s, iterations = track_seconds(frames, init)
             best["tracker"], best["snakes"] = min(best["tracker"], track_s), min(best["snakes"], snake_s)
             best["lk"] = min(best["lk"], lk_seconds(frames, pts))
+            best["start"] = min(best["start"], start_seconds(frames[0]))
+            checked_s, checks_s = checked_seconds(frames, init)
+            best["checked"], best["checks"] = min(best["checked"], checked_s), min(best["checks"], checks_s)
         totals["iterations"] += iterations  # the same every run: the tracker is deterministic
         if args.stages:
             clock = StageClock()
@@ -172,10 +201,13 @@ def main() -> None:
                 stages[label] += seconds
         n = len(frames) - 1
         print(f"{video}: {n} frames  decode {len(frames) / best['decode']:7.0f} fps  tracker {n / best['tracker']:6.0f} fps  "
-              f"snakes alone {n / best['snakes']:7.0f} fps  LK+FB {n / best['lk']:6.0f} fps")
+              f"snakes alone {n / best['snakes']:7.0f} fps  LK+FB {n / best['lk']:6.0f} fps  "
+              f"with re-detection {n / best['checked']:6.0f} fps (checks {1e3 * best['checks'] / n:.3f} ms/frame)  "
+              f"automatic start {1e3 * best['start']:.1f} ms")
+        starts[video] = 1e3 * best["start"]
         totals["frames"] += n
         totals["decode"] += best["decode"] * n / len(frames)
-        for k in ("tracker", "snakes", "lk"):
+        for k in ("tracker", "snakes", "lk", "checked", "checks"):
             totals[k] += best[k]
     n = totals["frames"]
     result = {
@@ -188,11 +220,16 @@ def main() -> None:
         "tracker_vs_decode": totals["decode"] / totals["tracker"],
         "tracker_vs_lk": totals["lk"] / totals["tracker"],
         "mean_iterations": totals["iterations"] / n,
+        "fps_with_redetection": n / totals["checked"],
+        "checks_ms_per_frame": 1e3 * totals["checks"] / n,
+        "automatic_start_ms": starts,
         "repeats": args.repeats,
     }
     print(f"all: tracker {result['fps_tracker']:.0f} fps ({result['tracker_vs_decode']:.2f}x decoding, "
           f"{result['tracker_vs_lk']:.2f}x LK), snakes alone {result['fps_snakes']:.0f} fps, "
-          f"{result['mean_iterations']:.1f} iterations per frame")
+          f"{result['mean_iterations']:.1f} iterations per frame; with re-detection {result['fps_with_redetection']:.0f} "
+          f"fps (its checks {result['checks_ms_per_frame']:.3f} ms a frame); automatic start "
+          + ", ".join(f"{v} {ms:.1f} ms" for v, ms in starts.items()))
     if args.stages:
         ms = {label: 1e3 * seconds / n for label, seconds in sorted(stages.items(), key=lambda kv: -kv[1])}
         ms["the rest (Python, smaller native calls)"] = 1e3 * staged / n - sum(ms.values())

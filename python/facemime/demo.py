@@ -158,8 +158,8 @@ def run_demo(out_dir: Path, force: bool = False, seconds: float = 6.0) -> DemoRe
     timing["encode videos"] = time.perf_counter() - t0 - synth_seconds
     write_json(files[4], track_document(
         {"width": SIZE[0], "height": SIZE[1], "fps": FPS, "frames": count},
-        [{"index": i, "contours": m.contours, "confidence": m.confidence, "lost": m.lost, "face": m.face,
-          "pose": pose_dict(m.pose), "offsets": m.offsets} for i, m in enumerate(motions)],
+        [{"index": i, "contours": m.contours, "confidence": m.confidence, "lost": m.lost, "redetected": m.redetected,
+          "face": m.face, "pose": pose_dict(m.pose), "offsets": m.offsets} for i, m in enumerate(motions)],
         model=analysis.model_block))
     write_image(files[5], _still_sheet(stills))
     write_text(files[6], _report(nme, pose_error, timing, count, sorted(shown)))

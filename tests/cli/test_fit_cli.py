@@ -51,9 +51,18 @@ def test_track_without_init_starts_from_automatic_points(tmp_path, capsys, share
     assert code == 0, err
     frames = json.loads((tmp_path / "t.json").read_text())["frames"]
     assert [f["index"] for f in frames] == list(range(20))
+    assert all(f["redetected"] is False for f in frames)  # nothing went astray on these frames
     errors = [group_nme(f["contours"], from_face_mesh(z["landmarks"][f["index"]]), names, float(z["iod"][f["index"]]))
               for f in frames for names in GROUPS.values()]
     assert np.mean(errors) < 0.04 and max(errors) < 0.08
+
+
+@pytest.mark.parametrize("animal", ["lp_s22", "lp_s25", "lp_s39"])  # a monkey, a dog, a cat
+def test_an_animal_photo_has_no_face_to_fit(tmp_path, capsys, shared, animal):
+    code, stdout, err = run(capsys, "fit", str(shared / "photos" / f"{animal}.jpg"), "--out", str(tmp_path / "a.actor"))
+    assert code == 1 and stdout == ""
+    assert err.startswith(f"facemime: error: no face found in {shared / 'photos' / animal}.jpg") and err.count("\n") == 1
+    assert list(tmp_path.iterdir()) == []
 
 
 @pytest.mark.parametrize(("setup", "message"), [

@@ -59,23 +59,24 @@ def test_follows_the_brows_through_a_real_head_jump(shared):
 def test_a_brow_raised_fast_is_not_left_on_the_eyelid(shared):
     # lp_d6 frame 858: she raises her brows some 14 px within a frame as her head turns, and the
     # flow loses her left brow's knots. The first frame's brow, matched unturned, fits her
-    # eyelid's crease best, and the snakes settle there at a third of the brow's confidence:
-    # from frame 0 without trying the brow higher up, the brows' NME stayed at 0.076 to 0.125
-    # through frame 890, unflagged.
+    # eyelid's crease best, and the snakes alone settle there at a third of the brow's
+    # confidence: the brows' NME stays at 0.076 to 0.125 through frame 890, unflagged. The
+    # landmark model's checks keep the brows on: measured at most 0.022 over those frames.
     from facemime.io.video import VideoReader
     from facemime.track.contours import from_face_mesh as reference_contours
+    from facemime.track.redetect import FaceTracker, Redetection
 
     z = np.load(shared / "video" / "lp_d6.landmarks.npz")
     with VideoReader(shared / "video" / "lp_d6.mp4") as reader:
         frames = [f for _, f in zip(range(891), reader)]
     worst = {}
-    for raise_ in (3, 0):
-        tracker = Tracker(frames[0], reference_contours(z["landmarks"][0]), TrackerParams(brow_raise=raise_))
+    for checks in (Redetection(), Redetection(check_every=0, lost_for=0)):
+        tracker = FaceTracker(frames[0], reference_contours(z["landmarks"][0]), redetection=checks)
         errors = []
         for i, frame in enumerate(frames[1:], 1):
             contours = tracker.update(frame).contours
             if i >= 858:
                 reference = reference_contours(z["landmarks"][i])
                 errors.append(group_nme(contours, reference, GROUPS["brows"], float(z["iod"][i])))
-        worst[raise_] = max(errors)
-    assert worst[3] < 0.05 and worst[0] > 0.1, worst
+        worst[checks.check_every] = max(errors)
+    assert worst[30] < 0.05 and worst[0] > 0.1, worst

@@ -2,10 +2,12 @@
 brow contours tracked, the head pose followed, and the local motion (knot offsets in the head's
 own frame, see :mod:`facemime.animate.deform`) measured.
 
-When the face is lost (it leaves the frame or turns away: the head's step can no longer be
-measured, or every feature collapsed), frames are marked and every later frame is searched for
-the face again; once found, tracking restarts from points found on it, and offsets stay relative
-to the first frame. A frame whose step came from the head motion's coarse fallback (a fast,
+The contours are tracked by :class:`facemime.track.redetect.FaceTracker`: where they went astray
+the face landmark model puts them right. When the face is lost (it leaves the frame or turns
+away: the head's step can no longer be measured, or every feature collapsed), frames are marked
+and every later frame is searched for the face again; once found, tracking restarts from its
+landmarks, the pose from the actor's model fitted to them, and offsets stay relative to the
+first frame. A frame whose step came from the head motion's coarse fallback (a fast,
 blurred shake: the rigid points are dropped and found anew) keeps the face and its contours: its
 pose moves by that step (:meth:`facemime.animate.pose.PoseTracker.update`), and is anchored
 again by a fit of the actor on the frame at most once in :data:`ANCHOR_EVERY` frames.
@@ -21,11 +23,13 @@ import numpy as np
 from facemime.animate.deform import Deformer
 from facemime.animate.pose import PoseTracker
 from facemime.errors import NoFaceError
-from facemime.fit.placement import model_iod
+from facemime.face.mesh import reference_points
+from facemime.fit.placement import fit_model, model_iod
 from facemime.fit.run import fit_actor, init_contours
 from facemime.render.projection import Pose
 from facemime.track.contours import FEATURES
-from facemime.track.tracker import Tracker, TrackerParams
+from facemime.track.redetect import FaceTracker
+from facemime.track.tracker import TrackerParams
 
 
 #: Frames at least between two fits of the actor that anchor a pose carried by the head's step.
@@ -45,7 +49,8 @@ class FrameMotion:
     ``contours``: name -> (K, 2) px; ``confidence``: feature -> 0..1; ``lost``: features whose
     contours collapsed; ``face``: False when the face was not found (pose and offsets then
     repeat the last good frame's); ``pose``: the head pose of the analysis actor; ``offsets``:
-    (K, 2) knot offsets, model units.
+    (K, 2) knot offsets, model units; ``redetected``: the face landmark model put the contours
+    right on this frame.
     """
 
     contours: dict[str, np.ndarray]
@@ -54,6 +59,7 @@ class FrameMotion:
     face: bool
     pose: Pose
     offsets: np.ndarray
+    redetected: bool = False
 
 
 @dataclass
@@ -82,14 +88,11 @@ class Analysis:
         self.deformer = Deformer(self.actor.model)
         contours = init_contours(self.actor)
         self._knots0 = self.deformer.knot_positions(contours, self.actor.pose)
-        self._start(frame, contours, self.actor.pose)
+        self.tracker = FaceTracker(frame, contours, params)
+        self._follow_pose(self.actor.pose)
         self.last = FrameMotion(contours, {f: 1.0 for f in FEATURES}, [], True, self.actor.pose,
                                 np.zeros((len(self.deformer.knots), 2)))
         self.frames_without_face = 0
-
-    def _start(self, frame: np.ndarray, contours: dict[str, np.ndarray], pose: Pose) -> None:
-        self.tracker = Tracker(frame, contours, self.params)
-        self._follow_pose(pose)
 
     def _follow_pose(self, pose: Pose) -> None:
         """Follow the pose from ``pose`` on, on the rigid points of the current frame."""
@@ -107,13 +110,19 @@ class Analysis:
 
     def update(self, frame: np.ndarray) -> FrameMotion:
         """Analyse the next frame."""
-        if not self.last.face:
-            return self._recover(frame)
         t0 = time.perf_counter()
+        follower = self.tracker.tracker
         result = self.tracker.update(frame)
         t1 = time.perf_counter()
-        # The pose is measured on the rigid points, or moved by the head's step without them.
-        measured = self.pose.update(self.tracker.motion)
+        measured = True
+        if self.tracker.tracker is not follower:  # restarted on a face found anew: new rigid points
+            self._follow_pose(fit_model(self.actor.model, reference_points(self.tracker.landmarks)).pose)
+            fitting = time.perf_counter() - t1
+            self.timings.fit += fitting
+            t1 += fitting
+        elif self.last.face:
+            # The pose is measured on the rigid points, or moved by the head's step without them.
+            measured = self.pose.update(self.tracker.motion)
         face = result.motion_ok and len(result.lost) < len(FEATURES)
         self._since_anchor += 1
         if face and not measured and self._since_anchor >= ANCHOR_EVERY:
@@ -124,29 +133,14 @@ class Analysis:
             t1 += fitting  # not the pose's
         if face:
             offsets = self.deformer.knot_positions(result.contours, self.pose.pose) - self._knots0
-            self.last = FrameMotion(result.contours, result.confidence, result.lost, True, self.pose.pose, offsets)
+            self.last = FrameMotion(result.contours, result.confidence, result.lost, True, self.pose.pose, offsets,
+                                    result.redetected)
         else:
             self.frames_without_face += 1
             self.last = FrameMotion(self.last.contours, {f: 0.0 for f in FEATURES}, list(FEATURES), False,
                                     self.last.pose, self.last.offsets)
         self.timings.track += t1 - t0
         self.timings.pose += time.perf_counter() - t1
-        return self.last
-
-    def _recover(self, frame: np.ndarray) -> FrameMotion:
-        t0 = time.perf_counter()
-        try:
-            found, _, _ = fit_actor(frame, "frame", model=self.actor.model)
-        except NoFaceError:
-            found = None
-        self.timings.fit += time.perf_counter() - t0
-        if found is None:
-            self.frames_without_face += 1
-            return self.last
-        contours = init_contours(found)
-        self._start(frame, contours, found.pose)
-        offsets = self.deformer.knot_positions(contours, found.pose) - self._knots0
-        self.last = FrameMotion(contours, {f: 1.0 for f in FEATURES}, [], True, found.pose, offsets)
         return self.last
 
     @property

@@ -119,8 +119,8 @@ class SideBySide:
                 canvas[:, :w] = frame
             canvas[:, w:] = synth if motion.face else (synth * NO_FACE_DIM).astype(np.uint8)
             self.records.append({"index": len(self.records), "contours": motion.contours, "confidence": motion.confidence,
-                                 "lost": motion.lost, "face": motion.face, "pose": pose_dict(motion.pose),
-                                 "offsets": motion.offsets})
+                                 "lost": motion.lost, "redetected": motion.redetected, "face": motion.face,
+                                 "pose": pose_dict(motion.pose), "offsets": motion.offsets})
             seconds["synth"] += t2 - t1
             seconds["compose"] += time.perf_counter() - t2
             yield canvas

@@ -78,10 +78,13 @@ def track(video: Path, init: Path | None, out_file: Path, overlay: Path | None, 
     from facemime.track.video import track_video
 
     run = track_video(video, init, out_file, overlay, force)
+    for w in run.warnings:
+        click.echo(f"facemime: warning: {w}", err=True)
     click.echo(str(out_file))
     if overlay is not None:
         click.echo(str(overlay))
     lost = f", {run.frames_with_lost} with a lost feature" if run.frames_with_lost else ""
+    lost += f", {len(run.redetected)} put right by re-detection" if run.redetected else ""
     rate = f" at {(run.frames - 1) / run.seconds:.0f} frames/s" if run.frames > 1 and run.seconds > 0 else ""
     click.echo(f"tracked {run.frames} frames{rate} after a {run.start_seconds:.2f} s start on the first "
                f"(decoding and encoding excluded){lost}", err=True)

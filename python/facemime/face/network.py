@@ -23,6 +23,9 @@ def load_network(name: str) -> cv2.dnn.Net:
         if not path.is_file():
             raise FacemimeError(f"the face model {name} is missing from the installed package; reinstall facemime")
         try:
+            if hasattr(cv2.dnn, "ENGINE_CLASSIC"):
+                # OpenCV 5's new engine gives only one of each model's two outputs (5.0.0)
+                return cv2.dnn.readNetFromTFLite(str(path), engine=cv2.dnn.ENGINE_CLASSIC)
             return cv2.dnn.readNetFromTFLite(str(path))
         except cv2.error as e:
             raise FacemimeError(f"the face model {name} cannot be loaded by OpenCV {cv2.__version__}: "

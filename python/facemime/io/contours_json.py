@@ -115,7 +115,8 @@ def track_document(video: Mapping[str, Any], frames: Sequence[Mapping[str, Any]]
                    timing: Mapping[str, float] | None = None, model: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """A ``facemime.track/1`` document. ``frames``: dicts with ``index``, ``contours`` (name ->
     (N, 2) array) and optionally ``confidence`` (feature -> float), ``lost`` (list of
-    features), ``face`` (bool), ``pose`` (mapping) and ``offsets`` ((K, 2) array); ``model``
+    features), ``redetected`` (bool: the face landmark model put the contours right on this
+    frame), ``face`` (bool), ``pose`` (mapping) and ``offsets`` ((K, 2) array); ``model``
     describes the knots the offsets belong to (see the module docstring)."""
     out_frames = []
     for f in frames:
@@ -125,6 +126,8 @@ def track_document(video: Mapping[str, Any], frames: Sequence[Mapping[str, Any]]
             entry["confidence"] = {k: round(float(v), 4) for k, v in f["confidence"].items()}
         if "lost" in f:
             entry["lost"] = list(f["lost"])
+        if "redetected" in f:
+            entry["redetected"] = bool(f["redetected"])
         if "face" in f:
             entry["face"] = bool(f["face"])
         if "pose" in f:

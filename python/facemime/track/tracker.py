@@ -64,14 +64,6 @@ NARROWEST = 0.25
 #: many solver reaches (δ0/(1−σ)) from where the knots were moves them; a nearer one tells the
 #: snakes nothing new.
 AGREE = 1.0
-#: A brow the match moved that is still below this confidence once settled there is tried
-#: higher up the face (``brow_raise``); a placement there is kept only with at least
-#: :data:`RAISED`. Measured on the six videos: 0.5 tracked alike (the brows' mean NME 0.0002
-#: higher); at 0.6 the 23 noisy starts' brow failures rose from 0.01% to 0.28%.
-RAISE_BELOW = 0.4
-#: The least confidence of a brow tried higher up: a brow's own edges gave 0.7 to 1 there, the
-#: eyelid's crease and forehead lines 0.2 to 0.5 (lp_d6, lp_d12).
-RAISED = 0.6
 
 
 @dataclass(frozen=True)
@@ -115,17 +107,12 @@ class TrackerParams:
     smallest such edge, in skin standard deviations per px. ``brow_search``: a brow one of whose
     curves' edge response falls below this fraction of the first frame's (or whose shape
     degenerates) is looked for again by matching the first frame's brow around where the head
-    motion put it (:mod:`facemime.track.brows`; 0: off). ``brow_raise``: a brow the match moved
-    and that is still weaker than :data:`RAISE_BELOW` there is tried 1 to this many solver
-    reaches higher up the face and kept there when it then holds its edges
-    (:meth:`Tracker._raise_brow`; 0: off). From lp_d6's reference start her left brow, raised
-    some 14 px within frame 858 as her head turned, had settled on her eyelid's crease to frame
-    917 (brows' NME up to 0.125, unflagged), and at frames 792-793 likewise; tried higher, it is
-    followed: over the six videos' reference starts brow failures 0.31 → 0%, mean 0.0135 →
-    0.0128. The 23 noisy starts, the automatic start and 16 noisy automatic starts of each video
-    tracked as before (mean NMEs within 0.0001); lp_d6's mouth from the reference start drifted
-    as much as before but elsewhere (outer failures 1.29 → 1.79%, inner 0.40 → 0.70%: a mouth
-    pushed sideways at frames 822-827 rather than 851 and 906).
+    motion put it (:mod:`facemime.track.brows`; 0: off).
+    A brow the match left weak on the eyelid's crease below a brow raised fast (lp_d6 frames
+    858-917 from the reference start, once also tried higher up the face here) is put right by
+    the landmark model's checks (:class:`facemime.track.redetect.FaceTracker`): with them,
+    trying it higher changed no track of the ten videos from the reference, the automatic and
+    four noisy starts, and was removed.
     ``inner_search``: an inner mouth still lost once a lost mouth was looked for
     (``mouth_relocate``) is looked for again: each of its curves in turn is moved up and down
     the face by 1 to this many solver reaches (δ0/(1−σ)) and
@@ -195,7 +182,6 @@ class TrackerParams:
     lip_reach: float = 0.3
     lip_step: float = 0.3
     brow_search: float = 0.3
-    brow_raise: int = 3
     inner_search: int = 3
     mouth_patch: float = 0.5
     mouth_relocate: int = 1
@@ -216,7 +202,9 @@ class FrameResult:
     """One frame's output: ``contours`` name -> (N, 2) float64 pixels; ``confidence`` feature ->
     0..1; ``lost`` features flagged in this frame (a lost brow is reported where the brow search
     matched it, or else on its rest shape);
-    ``iterations`` the solver ran; ``motion_ok`` whether the head motion was measured."""
+    ``iterations`` the solver ran; ``motion_ok`` whether the head motion was measured;
+    ``redetected`` whether the tracker restarted on this frame from the face landmark model
+    (:class:`facemime.track.redetect.FaceTracker`)."""
 
     index: int
     contours: dict[str, np.ndarray]
@@ -224,6 +212,7 @@ class FrameResult:
     lost: list[str] = field(default_factory=list)
     iterations: int = 0
     motion_ok: bool = True
+    redetected: bool = False
 
 
 def _layout(contours: Mapping[str, np.ndarray], params: TrackerParams) -> tuple[np.ndarray, dict[str, np.ndarray]]:
@@ -532,14 +521,49 @@ class Tracker:
         return FrameResult(self.frame_index, self._named(self._scale.to_frame(self._reported)), confidence, lost,
                            iters, ok)
 
+    def reseat(self, contours: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """Move the contours of the frame last tracked to ``contours`` (all eight, (x, y) pixels
+        of that frame, in the convention of the first frame's: a landmark pass's), keeping what
+        the first frame set up (its shape as the rest shape, the edges' calibration, the lip
+        colour, the brow templates): the head's accumulated motion becomes the similarity that
+        best takes the first frame's contours onto these (robustly, over all their knots).
+        Returns the contours as now reported, name -> (N, 2) float64 pixels."""
+        contours = _check_contours(contours, *self._scale.size)
+        knots, _ = _layout({n: self._scale.to_work(c) for n, c in contours.items()}, self.params)
+        if len(knots) != len(self._knots):
+            raise InvalidInputError(f"contours give {len(knots)} knots, the tracker has {len(self._knots)}")
+        given = self._knots0 - self._offset  # the first frame's contours, as given
+        total = motion.robust_similarity(given, knots, limit=self.params.reach)[0]
+        if self._motion is not None:
+            self._motion.total = total
+            self._linear = total[:, :2]
+            down = self._linear @ np.asarray(self._down0)
+            self._down = down / max(float(np.linalg.norm(down)), 1e-12)
+        self._knots = knots + self._offset @ self._linear.T
+        self._reported = self._reported_knots()
+        return self.contours
+
+    def recalibrate(self, contours: Mapping[str, np.ndarray], weight: float) -> dict[str, np.ndarray]:
+        """Move the convention the contours are reported in ``weight`` (0..1) of the way towards
+        ``contours`` (all eight, (x, y) pixels of the frame last tracked): the calibration
+        offset between the image edges the snakes hold and the reported contours becomes that
+        much the offset that would report these. Returns the contours as now reported."""
+        contours = _check_contours(contours, *self._scale.size)
+        knots, _ = _layout({n: self._scale.to_work(c) for n, c in contours.items()}, self.params)
+        if len(knots) != len(self._knots):
+            raise InvalidInputError(f"contours give {len(knots)} knots, the tracker has {len(self._knots)}")
+        wanted = np.linalg.solve(self._linear, (self._knots - knots).T).T  # in the first frame's orientation
+        self._offset = (1.0 - weight) * self._offset + weight * wanted
+        self._reported = self._reported_knots()
+        return self.contours
+
     def _search_brow(self, frame: np.ndarray, feature: str, search: BrowSearch, knots: np.ndarray, start: np.ndarray,
                      rest: np.ndarray, down: np.ndarray, targets: np.ndarray, carried: np.ndarray, scale: float,
                      conf: float, shape_ok: bool) -> tuple[float, bool, np.ndarray, int]:
         """Look for a brow whose edge or shape was lost (``brow_search``) around where the head
         motion put it (``start``): when the match moves its knots at least :data:`AGREE` solver
         reaches, the brow is settled there by a solver pass and kept (in ``knots``, in place)
-        when its confidence rose or its shape (``shape_ok`` against ``carried``) was unsound; a
-        brow still weaker than :data:`RAISE_BELOW` then is tried higher up (:meth:`_raise_brow`).
+        when its confidence rose or its shape (``shape_ok`` against ``carried``) was unsound.
         Returns the brow's confidence and shape check then, where it goes should it be lost (the
         match, else ``carried``), and the solver's iterations."""
         p, idx = self.params, self._features[feature]
@@ -555,40 +579,7 @@ class Tracker:
                 if conf_again > conf or not shape_ok:
                     knots[idx], conf = again[idx], conf_again
                     shape_ok = self._shape_ok(knots, carried, feature)
-                if conf < RAISE_BELOW:
-                    conf, shape_ok, more = self._raise_brow(frame, feature, knots, start, rest, down, targets,
-                                                            carried, conf, shape_ok)
-                    iters += more
         return conf, shape_ok, fallback, iters
-
-    def _raise_brow(self, frame: np.ndarray, feature: str, knots: np.ndarray, start: np.ndarray, rest: np.ndarray,
-                    down: np.ndarray, targets: np.ndarray, carried: np.ndarray, conf: float,
-                    shape_ok: bool) -> tuple[float, bool, int]:
-        """Try a brow 1 to ``brow_raise`` solver reaches higher up the face than where the head
-        motion put it (``start``, against ``down``), each placement settled by a solver pass: a
-        brow raised faster than the snakes reach leaves them on the eyelid's crease, where the
-        first frame's brow, unturned, may match too. The placement with the highest confidence is
-        kept (in ``knots``, in place) when that is at least :data:`RAISED` and above ``conf``.
-        Returns the brow's confidence and shape check (against ``carried``), and the solver's
-        iterations."""
-        p, idx = self.params, self._features[feature]
-        reach = p.reach
-        # One field for every trial: a trial is at most brow_raise reaches from the start and its
-        # pass reads one more.
-        image = self._field(frame, start, ((idx, p.brow_raise + 1),))
-        best, iters = None, 0
-        for k in range(1, p.brow_raise + 1):
-            tried = knots.copy()
-            tried[idx] = start[idx] - k * reach * down
-            moved, more, resp = self._solve(image, tried, rest, down, targets, self._feature_curves[feature])
-            iters += more
-            c = self._confidences(resp)[feature]
-            if c >= RAISED and c > conf and (best is None or c > best[0]):
-                best = (c, moved[idx])
-        if best is None:
-            return conf, shape_ok, iters
-        knots[idx] = best[1]
-        return best[0], self._shape_ok(knots, carried, feature), iters
 
     def _mouth_sideways(self, frame: np.ndarray, start: np.ndarray, followed: np.ndarray, step: np.ndarray,
                         down: np.ndarray, reach: float) -> None:

@@ -9,29 +9,16 @@ from contextlib import nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
 
 from facemime.errors import InputFileError, InvalidInputError, NoFaceError
-from facemime.fit.auto import auto_points
 from facemime.io.contours_json import read_init, track_document, write_json
 from facemime.io.outputs import check_outputs
 from facemime.io.video import CODECS, VideoReader, VideoWriter
 from facemime.progress import track as progress
-from facemime.track.contours import CONTOUR_NAMES, FEATURES
+from facemime.track.contours import FEATURES
 from facemime.track.overlay import draw_contours
-from facemime.track.tracker import FrameResult, Tracker, TrackerParams
-
-
-def automatic_contours(frame: np.ndarray, what: str) -> dict[str, np.ndarray]:
-    """The contours to start tracking from when none are given: the mouth and brows of the
-    largest face's automatic reference points (:func:`facemime.fit.auto_points`) on ``frame``
-    (H, W, 3 uint8 RGB; ``what`` names it in errors), name -> (K, 2) float64 pixels. Raises
-    NoFaceError where no face is found."""
-    try:
-        points = auto_points(frame).points
-    except NoFaceError:
-        raise NoFaceError(f"no face found in {what}") from None
-    return {n: points[n] for n in CONTOUR_NAMES}
+from facemime.track.redetect import FaceTracker, Redetection
+from facemime.track.tracker import FrameResult, TrackerParams
 
 
 @dataclass
@@ -39,20 +26,24 @@ class TrackRun:
     """Summary of a tracked video: frames tracked (the first one included), seconds spent
     starting on the first frame (the automatic start's fit, the tracker's set-up) and tracking
     the frames after it (decoding and encoding excluded from both), frames with a lost
-    feature."""
+    feature, frames the face landmark model put the contours right on, warnings for the user."""
 
     frames: int
     start_seconds: float
     seconds: float
     frames_with_lost: int
+    redetected: list[int]
+    warnings: list[str]
 
 
 def track_video(video: str | Path, init: str | Path | None, out: str | Path, overlay: str | Path | None = None,
-                force: bool = False, params: TrackerParams | None = None) -> TrackRun:
+                force: bool = False, params: TrackerParams | None = None,
+                redetection: Redetection | None = None) -> TrackRun:
     """Track ``video`` from the contours in ``init`` (``facemime.init/1``) and write ``out``
     (``facemime.track/1``) and, if given, the ``overlay`` video. Existing outputs are refused
-    unless ``force``. Without ``init`` an actor is fitted automatically on the first frame and
-    its projected mouth and brow vertices start the tracker."""
+    unless ``force``. Without ``init`` the largest face's landmarks on the first frame start the
+    tracker; the landmark model puts the contours right where they went astray
+    (:class:`facemime.track.redetect.FaceTracker`)."""
     out = Path(out)
     outputs = [out] + ([Path(overlay)] if overlay is not None else [])
     if overlay is not None and Path(overlay).suffix.lower() not in CODECS:
@@ -62,7 +53,7 @@ def track_video(video: str | Path, init: str | Path | None, out: str | Path, ove
         start, contours = read_init(init, size=(reader.width, reader.height)) if init is not None else (0, None)
         writer = VideoWriter(overlay, reader.fps) if overlay is not None else None
         frames: list[dict] = []
-        tracker: Tracker | None = None
+        tracker: FaceTracker | None = None
         start_seconds, seconds, lost_frames, decoded = 0.0, 0.0, 0, 0
         with writer if writer is not None else nullcontext():
             for index, frame in enumerate(progress(reader, reader.frames or None, "tracking")):
@@ -73,19 +64,19 @@ def track_video(video: str | Path, init: str | Path | None, out: str | Path, ove
                     continue
                 t0 = time.perf_counter()
                 if tracker is None:
-                    if contours is None:
-                        try:
-                            contours = automatic_contours(frame, f"the first frame of {video}")
-                        except NoFaceError as e:
-                            raise NoFaceError(f"{e}; pass the contours with --init INIT.json") from None
-                    tracker = Tracker(frame, contours, params)
+                    try:
+                        tracker = FaceTracker(frame, contours, params, redetection)
+                    except NoFaceError:
+                        raise NoFaceError(f"no face found in the first frame of {video}; "
+                                          "pass the contours with --init INIT.json") from None
                     result = FrameResult(index, tracker.contours, {f: 1.0 for f in FEATURES})
                     start_seconds = time.perf_counter() - t0
                 else:
                     result = tracker.update(frame)
                     seconds += time.perf_counter() - t0
                 lost_frames += bool(result.lost)
-                frames.append({"index": index, "contours": result.contours, "confidence": result.confidence, "lost": result.lost})
+                frames.append({"index": index, "contours": result.contours, "confidence": result.confidence,
+                               "lost": result.lost, "redetected": result.redetected})
                 if writer is not None:
                     writer.write(draw_contours(frame, result.contours, result.lost))
             if decoded == 0:
@@ -94,5 +85,7 @@ def track_video(video: str | Path, init: str | Path | None, out: str | Path, ove
                 raise InvalidInputError(f"init frame {start} is beyond the last frame ({decoded - 1}) of {video}")
         info = {"width": reader.width, "height": reader.height, "fps": reader.fps, "frames": decoded}
         write_json(out, track_document(info, frames, {"processing_seconds": round(start_seconds + seconds, 4), "frames_processed": len(frames)}))
-    return TrackRun(len(frames), start_seconds, seconds, lost_frames)
+    warnings = [f"{tracker.faces} faces found in the first frame of {video}; tracking the largest"] if tracker.faces > 1 else []
+    return TrackRun(len(frames), start_seconds, seconds, lost_frames, [f["index"] for f in frames if f["redetected"]],
+                    warnings)
 
