@@ -26,9 +26,13 @@ def read(shared, name, count, size=None):
     return frames, refs, [float(v) * s for v in z["iod"][:count]]
 
 
-def test_after_a_cut_to_another_face_the_contours_are_back_on_it_within_two_frames(shared):
+@pytest.mark.parametrize(("second", "size"), [("vr_1", (512, 512)), ("st_kh", None)])
+def test_after_a_cut_to_another_face_the_contours_are_on_it_at_once(shared, second, size):
+    # To vr_1 (resized) the head's motion fails at the cut; to st_kh it does not, and the
+    # snakes held her nose and eyes unflagged until the next check, 20 frames later, before
+    # cuts were looked for. Measured: mean NME after the cut 0.021 (vr_1) and 0.015 (st_kh).
     a, refs_a, iods_a = read(shared, "lp_d0", 30)
-    b, refs_b, iods_b = read(shared, "vr_1", 30, (512, 512))
+    b, refs_b, iods_b = read(shared, second, 30, size)
     frames, refs, iods = a + b, refs_a + refs_b, iods_a + iods_b
     tracker = FaceTracker(frames[0])
     errors = []
@@ -37,7 +41,6 @@ def test_after_a_cut_to_another_face_the_contours_are_back_on_it_within_two_fram
         errors.append([group_nme(result.contours, refs[i], names, iods[i]) for names in GROUPS.values()])
     assert tracker.redetected and 30 <= tracker.redetected[0] <= 31
     after = np.array(errors[31:])  # frames 32..59, on the second face
-    # Measured: mean outer mouth NME 0.021 after the cut, at most 0.047.
     assert after.mean() < 0.04 and after.max() < 0.08, after.max(axis=0)
 
 

@@ -6,6 +6,9 @@ A landmark pass is made
 - every ``check_every`` frames, on the crop that the last pass's landmarks frame once carried
   along by the tracked contours (no detection; the detector where that crop holds no face);
 - on the frame a feature has been flagged lost ``lost_for`` frames in a row;
+- on a cut: a frame that differs from the one before by more than :data:`CUT` grey levels on
+  average over a sparse grid of about 32 x 32 pixels (with the face detector: after a cut the
+  face may be anywhere);
 - on every frame after the face was lost (the head's motion could not be measured, or every
   feature collapsed), with the face detector, until a face is found again.
 
@@ -48,6 +51,11 @@ from facemime.track.tracker import FrameResult, Tracker, TrackerParams
 #: MediaPipe's own threshold (a human face was found at the start; see
 #: :data:`facemime.face.finder.FACE_SCORE` for why the start asks for more).
 SEARCH_SCORE = 0.5
+#: A frame whose pixels on a sparse grid (every k-th row and column, k the shorter side / 32)
+#: differ from the previous frame's by more than this many levels on average is a cut.
+#: Measured between consecutive frames of the ten shared videos: at most 21.6 (lp_d12's
+#: hand-held shake; 2.0 to 19 on the others); at a cut from lp_d0 to st_kh, 60.
+CUT = 35.0
 
 
 @dataclass(frozen=True)
@@ -71,6 +79,13 @@ def contours_of(landmarks: np.ndarray, size: tuple[int, int]) -> dict[str, np.nd
     ``size`` (width, height), clipped to it."""
     points = reference_points(landmarks)
     return {n: np.clip(points[n], -0.5, np.asarray(size) - 0.5) for n in CONTOUR_NAMES}
+
+
+def sparse_grid(frame: np.ndarray) -> np.ndarray:
+    """Every k-th pixel of every k-th row of an (H, W, 3) frame, k = min(H, W) // 32, as
+    float32: a glance at the whole picture for finding cuts."""
+    k = max(1, min(frame.shape[:2]) // 32)
+    return frame[k // 2::k, k // 2::k].astype(np.float32)
 
 
 def disagreement(tracked: Mapping[str, np.ndarray], found: Mapping[str, np.ndarray], iod: float) -> dict[str, float]:
@@ -126,6 +141,7 @@ class FaceTracker:
         self._since_check = 0
         self._lost_for = dict.fromkeys(FEATURES, 0)
         self.frame_index = 0
+        self._glance = sparse_grid(frame)
         self.redetected: list[int] = []
         self.checking_seconds = 0.0
 
@@ -133,6 +149,7 @@ class FaceTracker:
         """Track one more frame, (H, W, 3) uint8 RGB; the result's ``redetected`` says whether
         the landmark model put its contours right."""
         self.frame_index += 1
+        glance, self._glance = self._glance, sparse_grid(frame)
         if not self._face:
             return self._timed(self._search, frame)
         result = replace(self.tracker.update(frame), index=self.frame_index)
@@ -143,8 +160,9 @@ class FaceTracker:
             self._face = False
             return result
         r = self.redetection
-        if 0 < r.check_every <= self._since_check or 0 < r.lost_for <= max(self._lost_for.values()):
-            return self._timed(self._check, frame, result)
+        cut = r.check_every > 0 and glance.shape == self._glance.shape and float(np.abs(self._glance - glance).mean()) > CUT
+        if cut or 0 < r.check_every <= self._since_check or 0 < r.lost_for <= max(self._lost_for.values()):
+            return self._timed(self._check, frame, result, cut)
         return result
 
     def _timed(self, step, *args) -> FrameResult:
@@ -154,12 +172,13 @@ class FaceTracker:
         finally:
             self.checking_seconds += time.perf_counter() - t0
 
-    def _check(self, frame: np.ndarray, result: FrameResult) -> FrameResult:
-        """One landmark pass where the face is expected, and the frame's result after it."""
+    def _check(self, frame: np.ndarray, result: FrameResult, cut: bool = False) -> FrameResult:
+        """One landmark pass where the face is expected (after a ``cut``, where the detector
+        finds it), and the frame's result after it."""
         self._since_check = 0
         now = np.concatenate([result.contours[n] for n in CONTOUR_NAMES])
         found = None
-        if self._landmarks is not None:
+        if self._landmarks is not None and not cut:
             # the last pass's landmarks carried by the contours' motion since (robustly: a
             # feature gone astray does not drag the crop)
             carry = robust_similarity(self._anchor, now, limit=0.05 * self._iod)[0]
