@@ -77,7 +77,8 @@ def variants() -> dict[str, Method]:
     }
 
 
-def run_tracker(frames: list[np.ndarray], init: dict | None, method: Method) -> tuple[list[dict], int, list[int], float]:
+def run_tracker(frames: list[np.ndarray], init: dict | None,
+                method: Method) -> tuple[list[dict], int, list[int], float]:
     """The contours of frames 1.. tracked from ``init`` (None: the first frame's landmarks),
     the frames with a lost feature, those re-detected, and the seconds of the landmark checks."""
     tracker = FaceTracker(frames[0], init, *method)

@@ -40,8 +40,8 @@ def group_errors(points: dict[str, np.ndarray], landmarks: np.ndarray, iod: floa
     ref = reference_points(landmarks)
     out = {}
     for group, names in GROUPS.items():
-        errs = [float(np.linalg.norm(points[n][0] - ref[n][0])) if n in POINT_INDICES else curve_error(points[n], ref[n])
-                for n in names]
+        errs = [float(np.linalg.norm(points[n][0] - ref[n][0])) if n in POINT_INDICES
+                else curve_error(points[n], ref[n]) for n in names]
         out[group] = float(np.mean(errs)) / iod
     return out
 

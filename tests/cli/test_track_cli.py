@@ -103,3 +103,21 @@ def test_bad_input_gives_one_line_and_leaves_nothing(tmp_path, capsys, monkeypat
     assert code == 1 and message in err and err.count("\n") == 1 and "Traceback" not in err
     assert not (tmp_path / "out.json").exists() and not (tmp_path / "o.mp4").exists()
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
+
+
+def test_two_faces_track_the_larger_with_a_warning(tmp_path, capsys, shared):
+    import cv2
+
+    from facemime.io.photo import read_photo
+
+    canvas = np.full((512, 960, 3), 200, np.uint8)
+    canvas[16:496, 460:940] = cv2.resize(read_photo(shared / "photos" / "lp_s42.jpg"), (480, 480))
+    canvas[56:456, 20:420] = cv2.resize(read_photo(shared / "photos" / "lp_s1.jpg"), (400, 400))
+    with VideoWriter(tmp_path / "two.mp4", fps=25) as w:
+        for _ in range(5):
+            w.write(canvas)
+    code, _, err = run(capsys, "track", str(tmp_path / "two.mp4"), "--out", str(tmp_path / "t.json"))
+    assert code == 0, err
+    assert f"facemime: warning: 2 faces found in the first frame of {tmp_path / 'two.mp4'}; tracking the largest" in err
+    mouth = np.array(json.loads((tmp_path / "t.json").read_text())["frames"][-1]["contours"]["mouth_outer_upper"])
+    assert (mouth[:, 0] > 460).all()  # on the larger face, the right one

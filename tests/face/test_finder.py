@@ -38,3 +38,17 @@ def test_the_shipped_models_load_and_an_unknown_one_is_refused():
         assert not load_network(name).empty()
     with pytest.raises(FacemimeError, match="unknown face model 'x.tflite'"):
         load_network("x.tflite")
+
+
+def test_the_shipped_models_are_the_files_their_readme_names():
+    import hashlib
+    import re
+    from importlib import resources
+
+    folder = resources.files("facemime.face") / "models"
+    rows = re.findall(r"\| `([\w.]+\.tflite)` \| (\d+) \| `([0-9a-f]{64})` \|", (folder / "README.md").read_text())
+    assert sorted(name for name, _, _ in rows) == sorted(MODELS)
+    for name, size, digest in rows:
+        data = (folder / name).read_bytes()
+        assert len(data) == int(size) and hashlib.sha256(data).hexdigest() == digest, name
+    assert "Apache License" in (folder / "LICENSE").read_text()

@@ -44,7 +44,8 @@ from facemime.face.finder import find_face, follow_face
 from facemime.face.mesh import reference_points
 from facemime.metrics import curve_error
 from facemime.track.contours import CONTOUR_NAMES, FEATURES
-from facemime.track.motion import apply, robust_similarity
+from facemime.track.motion import HeadMotion, apply, robust_similarity
+from facemime.track.scale import ScaledMotion
 from facemime.track.tracker import FrameResult, Tracker, TrackerParams
 
 #: Lowest detection score while searching for a face lost from a video that showed one:
@@ -91,7 +92,8 @@ def sparse_grid(frame: np.ndarray) -> np.ndarray:
 def disagreement(tracked: Mapping[str, np.ndarray], found: Mapping[str, np.ndarray], iod: float) -> dict[str, float]:
     """Per feature, the mean over its curves of the symmetric curve distance between
     ``tracked`` and ``found`` contours, over ``iod`` pixels."""
-    return {f: float(np.mean([curve_error(tracked[n], found[n]) for n in names])) / iod for f, names in FEATURES.items()}
+    return {f: float(np.mean([curve_error(tracked[n], found[n]) for n in names])) / iod
+            for f, names in FEATURES.items()}
 
 
 class FaceTracker:
@@ -160,7 +162,7 @@ class FaceTracker:
             self._face = False
             return result
         r = self.redetection
-        cut = r.check_every > 0 and glance.shape == self._glance.shape and float(np.abs(self._glance - glance).mean()) > CUT
+        cut = r.check_every > 0 and float(np.abs(self._glance - glance).mean()) > CUT
         if cut or 0 < r.check_every <= self._since_check or 0 < r.lost_for <= max(self._lost_for.values()):
             return self._timed(self._check, frame, result, cut)
         return result
@@ -246,6 +248,6 @@ class FaceTracker:
         return self._landmarks
 
     @property
-    def motion(self):
+    def motion(self) -> HeadMotion | ScaledMotion | None:
         """The current tracker's head-motion follower (see :attr:`Tracker.motion`)."""
         return self.tracker.motion

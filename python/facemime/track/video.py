@@ -85,7 +85,8 @@ def track_video(video: str | Path, init: str | Path | None, out: str | Path, ove
                 raise InvalidInputError(f"init frame {start} is beyond the last frame ({decoded - 1}) of {video}")
         info = {"width": reader.width, "height": reader.height, "fps": reader.fps, "frames": decoded}
         write_json(out, track_document(info, frames, {"processing_seconds": round(start_seconds + seconds, 4), "frames_processed": len(frames)}))
-    warnings = [f"{tracker.faces} faces found in the first frame of {video}; tracking the largest"] if tracker.faces > 1 else []
+    several = tracker.faces > 1
+    warnings = [f"{tracker.faces} faces found in the first frame of {video}; tracking the largest"] if several else []
     return TrackRun(len(frames), start_seconds, seconds, lost_frames, [f["index"] for f in frames if f["redetected"]],
                     warnings)
 
