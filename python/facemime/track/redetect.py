@@ -25,8 +25,9 @@ landmark passes' (:meth:`facemime.track.Tracker.recalibrate`, weight 1/n for the
 landmark model's error on one frame, 0.01 to 0.03 IOD, is largely its own on that frame, and the
 tracker otherwise carries the first frame's for good. On the ten shared videos' automatic starts
 this took the mean NME from 0.0198 / 0.0203 / 0.0172 (outer mouth / inner mouth / brows) to
-0.0187 / 0.0187 / 0.0126 (the reference starts: 0.0166 / 0.0169 / 0.0120). Contours given by
-the user keep their own convention.
+0.0187 / 0.0187 / 0.0126 (the reference starts: 0.0166 / 0.0169 / 0.0120; both with a reseat
+placing the head by all the knots, as it first did). Contours given by the user keep their own
+convention.
 
 Coordinates are (x, y) pixels, origin at the centre of the top-left pixel, y down.
 """

@@ -526,14 +526,16 @@ class Tracker:
         of that frame, in the convention of the first frame's: a landmark pass's), keeping what
         the first frame set up (its shape as the rest shape, the edges' calibration, the lip
         colour, the brow templates): the head's accumulated motion becomes the similarity that
-        best takes the first frame's contours onto these (robustly, over all their knots).
+        best takes the first frame's brows onto these (robustly; over all the knots, the mouth's
+        outnumber the brows', and a grimace's mouth turned and scaled the head: on lp_d6 the
+        mouth then left the lips for 15 frames after a reseat).
         Returns the contours as now reported, name -> (N, 2) float64 pixels."""
         contours = _check_contours(contours, *self._scale.size)
         knots, _ = _layout({n: self._scale.to_work(c) for n, c in contours.items()}, self.params)
         if len(knots) != len(self._knots):
             raise InvalidInputError(f"contours give {len(knots)} knots, the tracker has {len(self._knots)}")
         given = self._knots0 - self._offset  # the first frame's contours, as given
-        total = motion.robust_similarity(given, knots, limit=self.params.reach)[0]
+        total = motion.brow_similarity(self._named(given), self._named(knots))
         if self._motion is not None:
             self._motion.total = total
             self._linear = total[:, :2]
