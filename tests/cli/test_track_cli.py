@@ -64,7 +64,7 @@ def test_track_a_real_video_clip(tmp_path, capsys, shared):
 @pytest.mark.parametrize(
     ("setup", "message"),
     [
-        ("no-face", "no face found in the first frame of face.mp4; pass the contours with --init INIT.json"),
+        ("no-face", "no face found in any of the 12 frames of face.mp4; pass the contours with --init INIT.json"),
         ("missing-video", "video missing.mp4 does not exist"),
         ("not-a-video", "cannot read video notvideo.mp4"),
         ("bad-json", "init.json is not valid JSON"),
@@ -121,3 +121,19 @@ def test_two_faces_track_the_larger_with_a_warning(tmp_path, capsys, shared):
     assert f"facemime: warning: 2 faces found in the first frame of {tmp_path / 'two.mp4'}; tracking the largest" in err
     mouth = np.array(json.loads((tmp_path / "t.json").read_text())["frames"][-1]["contours"]["mouth_outer_upper"])
     assert (mouth[:, 0] > 460).all()  # on the larger face, the right one
+
+
+def test_without_init_tracking_starts_on_the_first_frame_with_a_face(tmp_path, capsys, shared):
+    z = np.load(shared / "video" / "lp_d0.landmarks.npz")
+    with av.open(str(shared / "video" / "lp_d0.mp4")) as c, VideoWriter(tmp_path / "late.mp4", fps=25) as w:
+        for i, frame in zip(range(15), c.decode(video=0)):
+            rgb = frame.to_ndarray(format="rgb24")
+            w.write(rgb if i >= 5 else np.full_like(rgb, 90))  # a grey lead-in of five frames
+    code, _, err = run(capsys, "track", str(tmp_path / "late.mp4"), "--out", str(tmp_path / "t.json"))
+    assert code == 0, err
+    assert f"facemime: warning: no face in frames 0-4 of {tmp_path / 'late.mp4'}; tracking from frame 5" in err
+    frames = json.loads((tmp_path / "t.json").read_text())["frames"]
+    assert [f["index"] for f in frames] == list(range(5, 15))
+    errors = [group_nme(f["contours"], from_face_mesh(z["landmarks"][f["index"]]), names, float(z["iod"][f["index"]]))
+              for f in frames for names in GROUPS.values()]
+    assert max(errors) < 0.05

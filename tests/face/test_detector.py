@@ -77,3 +77,18 @@ def test_the_shipped_detector_finds_the_faces_of_real_photos_and_nothing_in_a_bl
         assert (face.box[:2] < lips).all() and (lips < face.box[2:]).all()
         assert face.score > 0.9
     assert detect_faces(np.full((240, 320, 3), 128, np.uint8)) == []
+
+
+@pytest.mark.parametrize("quarters", [1, 2, 3])
+def test_a_face_turned_on_its_side_or_upside_down_is_found(shared, quarters):
+    image = read_photo(shared / "photos" / "lp_s42.jpg")
+    ref = np.load(shared / "photos" / "lp_s42.landmarks.npz")
+    h, w = image.shape[:2]
+    turned = np.ascontiguousarray(np.rot90(image, quarters))
+    (face,) = detect_faces(turned, 0.8)
+    # The iris centres, turned the same way (np.rot90: counter-clockwise, quarter by quarter).
+    iris = ref["landmarks"][0, [468, 473], :2].astype(float)
+    for _ in range(quarters):
+        iris = np.column_stack([iris[:, 1], w - 1 - iris[:, 0]])
+        w, h = h, w
+    assert np.linalg.norm(face.keypoints[:2] - iris, axis=1).max() < 0.1 * float(ref["iod"][0])

@@ -60,7 +60,7 @@ def find_face(rgb: np.ndarray, min_score: float = FACE_SCORE) -> Face:
 
     Raises :class:`facemime.errors.NoFaceError` when no face scores ``min_score`` or more.
     """
-    detections = [d for d in detect_faces(rgb) if d.score >= min_score]
+    detections = detect_faces(rgb, min_score)
     for detection in sorted(detections, key=lambda d: -d.size):
         first, score = landmark_pass(rgb, crop_from_detection(detection))
         if score < MIN_FACE_SCORE:

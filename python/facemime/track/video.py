@@ -41,8 +41,9 @@ def track_video(video: str | Path, init: str | Path | None, out: str | Path, ove
                 redetection: Redetection | None = None) -> TrackRun:
     """Track ``video`` from the contours in ``init`` (``facemime.init/1``) and write ``out``
     (``facemime.track/1``) and, if given, the ``overlay`` video. Existing outputs are refused
-    unless ``force``. Without ``init`` the largest face's landmarks on the first frame start the
-    tracker; the landmark model puts the contours right where they went astray
+    unless ``force``. Without ``init`` the largest face's landmarks on the first frame that shows
+    a face start the tracker (the frames before it are not tracked, as those before an init
+    frame); the landmark model puts the contours right where they went astray
     (:class:`facemime.track.redetect.FaceTracker`)."""
     out = Path(out)
     outputs = [out] + ([Path(overlay)] if overlay is not None else [])
@@ -66,9 +67,11 @@ def track_video(video: str | Path, init: str | Path | None, out: str | Path, ove
                 if tracker is None:
                     try:
                         tracker = FaceTracker(frame, contours, params, redetection)
-                    except NoFaceError:
-                        raise NoFaceError(f"no face found in the first frame of {video}; "
-                                          "pass the contours with --init INIT.json") from None
+                    except NoFaceError:  # only without init: look on the next frame
+                        if writer is not None:
+                            writer.write(frame)
+                        continue
+                    start = index
                     result = FrameResult(index, tracker.contours, {f: 1.0 for f in FEATURES})
                     start_seconds = time.perf_counter() - t0
                 else:
@@ -81,12 +84,17 @@ def track_video(video: str | Path, init: str | Path | None, out: str | Path, ove
                     writer.write(draw_contours(frame, result.contours, result.lost))
             if decoded == 0:
                 raise InputFileError(f"video {video} has no frames")
+            if tracker is None and init is None:
+                raise NoFaceError(f"no face found in any of the {decoded} frames of {video}; "
+                                  "pass the contours with --init INIT.json")
             if tracker is None:
                 raise InvalidInputError(f"init frame {start} is beyond the last frame ({decoded - 1}) of {video}")
         info = {"width": reader.width, "height": reader.height, "fps": reader.fps, "frames": decoded}
         write_json(out, track_document(info, frames, {"processing_seconds": round(start_seconds + seconds, 4), "frames_processed": len(frames)}))
-    several = tracker.faces > 1
-    warnings = [f"{tracker.faces} faces found in the first frame of {video}; tracking the largest"] if several else []
+    first = "the first frame" if start == 0 else f"frame {start}"
+    warnings = [f"{tracker.faces} faces found in {first} of {video}; tracking the largest"] if tracker.faces > 1 else []
+    if init is None and start > 0:
+        warnings.append(f"no face in frames 0-{start - 1} of {video}; tracking from frame {start}")
     return TrackRun(len(frames), start_seconds, seconds, lost_frames, [f["index"] for f in frames if f["redetected"]],
                     warnings)
 
