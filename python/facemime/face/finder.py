@@ -4,8 +4,9 @@ The largest detected face is taken. Its landmarks are measured on the detection'
 again on the crop those landmarks frame (:func:`facemime.face.landmarks.crop_from_landmarks`),
 and the two passes are averaged: on the ten shared videos' first frames and the seven shared
 photos, the mean of the two was closer to the reference than either pass alone or a third pass
-(mean eye-corner / mouth / brow NME 0.0165 / 0.0104 / 0.0116 against 0.0173 / 0.0116 / 0.0118
-for the first pass; worst image 0.029 / 0.019 / 0.029).
+(mean NME of the eye corners / outer lips / inner lips / brows 0.0165 / 0.0115 / 0.0104 / 0.0116
+against 0.0173 / 0.0120 / 0.0116 / 0.0118 for the first pass alone; worst image 0.029 / 0.023 /
+0.019 / 0.029).
 
 Points are (x, y) pixels, x right, y down, (0, 0) at the centre of the top-left pixel.
 """
