@@ -203,7 +203,7 @@ class FrameResult:
     0..1; ``lost`` features flagged in this frame (a lost brow is reported where the brow search
     matched it, or else on its rest shape);
     ``iterations`` the solver ran; ``motion_ok`` whether the head motion was measured;
-    ``redetected`` whether the tracker restarted on this frame from the face landmark model
+    ``redetected`` whether the face landmark model put the contours right on this frame
     (:class:`facemime.track.redetect.FaceTracker`)."""
 
     index: int
@@ -530,10 +530,7 @@ class Tracker:
         outnumber the brows', and a grimace's mouth turned and scaled the head: on lp_d6 the
         mouth then left the lips for 15 frames after a reseat).
         Returns the contours as now reported, name -> (N, 2) float64 pixels."""
-        contours = _check_contours(contours, *self._scale.size)
-        knots, _ = _layout({n: self._scale.to_work(c) for n, c in contours.items()}, self.params)
-        if len(knots) != len(self._knots):
-            raise InvalidInputError(f"contours give {len(knots)} knots, the tracker has {len(self._knots)}")
+        knots = self._knots_of(contours)
         given = self._knots0 - self._offset  # the first frame's contours, as given
         total = motion.brow_similarity(self._named(given), self._named(knots))
         if self._motion is not None:
@@ -550,14 +547,20 @@ class Tracker:
         ``contours`` (all eight, (x, y) pixels of the frame last tracked): the calibration
         offset between the image edges the snakes hold and the reported contours becomes that
         much the offset that would report these. Returns the contours as now reported."""
-        contours = _check_contours(contours, *self._scale.size)
-        knots, _ = _layout({n: self._scale.to_work(c) for n, c in contours.items()}, self.params)
-        if len(knots) != len(self._knots):
-            raise InvalidInputError(f"contours give {len(knots)} knots, the tracker has {len(self._knots)}")
+        knots = self._knots_of(contours)
         wanted = np.linalg.solve(self._linear, (self._knots - knots).T).T  # in the first frame's orientation
         self._offset = (1.0 - weight) * self._offset + weight * wanted
         self._reported = self._reported_knots()
         return self.contours
+
+    def _knots_of(self, contours: Mapping[str, np.ndarray]) -> np.ndarray:
+        """The knots, in the frames the snakes see, that lay out all eight ``contours`` ((x, y)
+        pixels of the frame) as the first frame's were laid out."""
+        contours = _check_contours(contours, *self._scale.size)
+        knots, _ = _layout({n: self._scale.to_work(c) for n, c in contours.items()}, self.params)
+        if len(knots) != len(self._knots):
+            raise InvalidInputError(f"contours give {len(knots)} knots, the tracker has {len(self._knots)}")
+        return knots
 
     def _search_brow(self, frame: np.ndarray, feature: str, search: BrowSearch, knots: np.ndarray, start: np.ndarray,
                      rest: np.ndarray, down: np.ndarray, targets: np.ndarray, carried: np.ndarray, scale: float,

@@ -9,7 +9,6 @@ from contextlib import nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 
-
 from facemime.errors import InputFileError, InvalidInputError, NoFaceError
 from facemime.io.contours_json import read_init, track_document, write_json
 from facemime.io.outputs import check_outputs
@@ -24,8 +23,8 @@ from facemime.track.tracker import FrameResult, TrackerParams
 @dataclass
 class TrackRun:
     """Summary of a tracked video: frames tracked (the first one included), seconds spent
-    starting on the first frame (the automatic start's fit, the tracker's set-up) and tracking
-    the frames after it (decoding and encoding excluded from both), frames with a lost
+    starting on the first frame (finding the face without an init, the tracker's set-up) and
+    tracking the frames after it (decoding and encoding excluded from both), frames with a lost
     feature, frames the face landmark model put the contours right on, warnings for the user."""
 
     frames: int
