@@ -8,6 +8,7 @@
 
 pub mod adjust;
 mod border;
+pub mod codec;
 pub mod corners;
 mod cpu;
 pub mod error;

@@ -4,6 +4,7 @@
 use pyo3::prelude::*;
 
 mod adjust;
+mod codec;
 mod error;
 mod flow;
 mod head;
@@ -20,6 +21,7 @@ mod template;
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     adjust::register(m)?;
+    codec::register(m)?;
     flow::register(m)?;
     head::register(m)?;
     lip_search::register(m)?;

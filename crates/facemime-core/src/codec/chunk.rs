@@ -1,0 +1,145 @@
+//! Chunk framing (`docs/bitstream.md`, "Chunks"): every unit of a stream is
+//! `tag, sequence number, length, payload, CRC-32`, so that damage is detected and the reader
+//! finds the next good chunk again.
+
+/// What a chunk holds (the tag's top three bits).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// The stream header.
+    Header = 1,
+    /// The actor (model and texture), once.
+    Actor = 2,
+    /// Frames coded without reference to earlier packets.
+    Intra = 3,
+    /// Frames predicted from the previous decoded frame.
+    Inter = 4,
+}
+
+impl Kind {
+    fn from_bits(bits: u8) -> Option<Kind> {
+        match bits {
+            1 => Some(Kind::Header),
+            2 => Some(Kind::Actor),
+            3 => Some(Kind::Intra),
+            4 => Some(Kind::Inter),
+            _ => None,
+        }
+    }
+
+    /// The largest payload a chunk of this kind may declare, bytes.
+    pub fn max_payload(self) -> usize {
+        match self {
+            Kind::Header => 1 << 20,
+            Kind::Actor => 1 << 26,
+            Kind::Intra | Kind::Inter => 1 << 16,
+        }
+    }
+}
+
+/// Most frames one packet holds.
+pub const MAX_PACKET_FRAMES: usize = 32;
+
+/// One chunk read from a stream.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Chunk {
+    pub kind: Kind,
+    /// Frames in a packet (1..=32); 0 for the header and the actor.
+    pub frames: usize,
+    /// The packet's sequence number (mod 2^16); 0 for the header and the actor.
+    pub seq: u16,
+    pub payload: Vec<u8>,
+}
+
+/// The bytes of a chunk.
+pub fn write(kind: Kind, frames: usize, seq: u16, payload: &[u8]) -> Vec<u8> {
+    let tag = ((kind as u8) << 5) | (frames.saturating_sub(1) as u8 & 0x1f);
+    let mut out = Vec::with_capacity(payload.len() + 12);
+    out.push(tag);
+    out.extend_from_slice(&seq.to_le_bytes());
+    let mut n = payload.len();
+    loop {
+        let byte = (n & 0x7f) as u8;
+        n >>= 7;
+        if n == 0 {
+            out.push(byte);
+            break;
+        }
+        out.push(byte | 0x80);
+    }
+    out.extend_from_slice(payload);
+    let crc = crc32fast::hash(&out);
+    out.extend_from_slice(&crc.to_le_bytes());
+    out
+}
+
+/// What reading a chunk at the start of a buffer found.
+#[derive(Debug, PartialEq)]
+pub enum Read {
+    /// A good chunk, and the bytes it took.
+    Chunk(Chunk, usize),
+    /// The buffer ends before the chunk does.
+    Short,
+    /// No chunk starts here (a bad tag, a length over its kind's limit, a wrong checksum).
+    Bad,
+}
+
+/// Reads the chunk that starts at `buf[0]`.
+pub fn read(buf: &[u8]) -> Read {
+    let Some(&tag) = buf.first() else { return Read::Short };
+    let Some(kind) = Kind::from_bits(tag >> 5) else { return Read::Bad };
+    let packet = matches!(kind, Kind::Intra | Kind::Inter);
+    if !packet && tag & 0x1f != 0 {
+        return Read::Bad;
+    }
+    if buf.len() < 3 {
+        return Read::Short;
+    }
+    let seq = u16::from_le_bytes([buf[1], buf[2]]);
+    let (mut len, mut at) = (0usize, 3usize);
+    for shift in (0..28).step_by(7) {
+        let Some(&b) = buf.get(at) else { return Read::Short };
+        at += 1;
+        len |= ((b & 0x7f) as usize) << shift;
+        if b & 0x80 == 0 {
+            break;
+        }
+        if shift == 21 {
+            return Read::Bad; // a length of more than four bytes
+        }
+    }
+    if len > kind.max_payload() {
+        return Read::Bad;
+    }
+    let end = at + len;
+    if buf.len() < end + 4 {
+        return Read::Short;
+    }
+    let crc = u32::from_le_bytes([buf[end], buf[end + 1], buf[end + 2], buf[end + 3]]);
+    if crc32fast::hash(&buf[..end]) != crc {
+        return Read::Bad;
+    }
+    let frames = if packet { (tag & 0x1f) as usize + 1 } else { 0 };
+    Read::Chunk(Chunk { kind, frames, seq, payload: buf[at..end].to_vec() }, end + 4)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_chunk_reads_back_and_any_flipped_bit_is_caught() {
+        let payload: Vec<u8> = (0..300u32).map(|i| (i * 7) as u8).collect();
+        let bytes = write(Kind::Inter, 5, 513, &payload);
+        let Read::Chunk(c, used) = read(&bytes) else { panic!("not read") };
+        assert_eq!((c.kind, c.frames, c.seq, used), (Kind::Inter, 5, 513, bytes.len()));
+        assert_eq!(c.payload, payload);
+        for bit in 0..bytes.len() * 8 {
+            let mut b = bytes.clone();
+            b[bit / 8] ^= 1 << (bit % 8);
+            assert!(!matches!(read(&b), Read::Chunk(..)), "bit {bit}");
+        }
+        for cut in 0..bytes.len() {
+            assert_ne!(read(&bytes[..cut]), Read::Chunk(c.clone(), used));
+        }
+    }
+}

@@ -1,0 +1,205 @@
+//! The bitstream end to end: round trips, loss, damage and hostile bytes.
+
+use facemime_core::codec::{Decoder, Encoder, Header, Output, Quantiser};
+use proptest::prelude::*;
+
+fn header(packet_frames: u8, keyframe_packets: u16) -> Header {
+    let mut quantisers = vec![Quantiser { step: 0.2, reference: 0, class: 6 }; 6];
+    quantisers[3] = Quantiser { step: 0.002, reference: 1000, class: 4 };
+    quantisers.extend((0..4).map(|i| Quantiser { step: 0.5, reference: 0, class: 5 + i }));
+    Header {
+        fps_num: 25, fps_den: 1, width: 512, height: 512, topology: *b"topology", packet_frames, keyframe_packets,
+        quantisers, basis_rows: 6, basis: (0..24).map(|i| (i * 1000 - 12000) as i16).collect(), actor_id: [7; 32],
+        actor_in_stream: false,
+    }
+}
+
+/// A clip of `n` frames: a drifting head and moving coefficients, with a few faceless frames.
+fn clip(n: usize, seed: u64) -> Vec<(bool, u8, Vec<f64>)> {
+    let mut x = 0x9e3779b97f4a7c15u64 ^ seed;
+    let mut rand = move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let mut v = vec![0.0, 0.0, 0.0, 2.0, 256.0, 256.0, 0.0, 0.0, 0.0, 0.0];
+    (0..n)
+        .map(|t| {
+            for (i, value) in v.iter_mut().enumerate() {
+                *value += if i == 3 { 0.003 } else { 1.5 } * rand();
+            }
+            (t % 37 < 34, (t % 11 == 0) as u8 * 3, v.clone())
+        })
+        .collect()
+}
+
+/// The stream's bytes, and the encoder's reconstruction of every frame.
+fn encode(h: &Header, frames: &[(bool, u8, Vec<f64>)]) -> (Vec<Vec<u8>>, Vec<Vec<f64>>) {
+    let mut enc = Encoder::new(h.clone(), 0.3).unwrap();
+    let mut chunks = vec![enc.header_chunk()];
+    let mut recon = Vec::new();
+    for (face, lost, v) in frames {
+        let (r, packet) = enc.push(*face, *lost, v).unwrap();
+        recon.push(r);
+        chunks.extend(packet);
+    }
+    chunks.extend(enc.finish().unwrap());
+    (chunks, recon)
+}
+
+fn decode(bytes: &[u8], from_start: bool) -> (Decoder, Vec<Output>) {
+    let mut d = Decoder::new(from_start);
+    let mut out = d.push(bytes);
+    out.extend(d.finish());
+    (d, out)
+}
+
+/// Every decoded frame with a face equals the encoder's reconstruction (a frame without one
+/// carries no values: it shows the receiver's last face); returns (decoded, concealed).
+fn check(out: &[Output], recon: &[Vec<f64>]) -> (usize, u64) {
+    let (mut decoded, mut concealed) = (0, 0);
+    for o in out {
+        match o {
+            Output::Frame { index, values, face, .. } => {
+                if *face {
+                    assert_eq!(values, &recon[*index as usize], "frame {index}");
+                }
+                decoded += 1;
+            }
+            Output::Concealed { count, .. } => concealed += count,
+        }
+    }
+    (decoded, concealed)
+}
+
+#[test]
+fn round_trip_gives_the_encoders_reconstruction_bit_for_bit() {
+    let h = header(5, 5);
+    let frames = clip(503, 1);
+    let (chunks, recon) = encode(&h, &frames);
+    let (d, out) = decode(&chunks.concat(), true);
+    assert_eq!(check(&out, &recon), (503, 0));
+    assert_eq!(d.header(), Some(&h));
+    let faces: Vec<bool> = out.iter().map(|o| matches!(o, Output::Frame { face: true, .. })).collect();
+    assert_eq!(faces, frames.iter().map(|f| f.0).collect::<Vec<_>>());
+    let lost: Vec<u8> = out.iter().map(|o| if let Output::Frame { lost, .. } = o { *lost } else { 99 }).collect();
+    assert_eq!(lost, frames.iter().map(|f| f.1).collect::<Vec<_>>());
+    // the reconstruction is within half a step (plus the hysteresis) of the input
+    for ((face, _, v), r) in frames.iter().zip(&recon) {
+        if *face {
+            for (i, q) in h.quantisers.iter().enumerate() {
+                assert!((v[i] - r[i]).abs() <= 0.8 * q.step as f64 + 1e-9);
+            }
+        }
+    }
+}
+
+#[test]
+fn a_lost_packet_is_concealed_until_the_next_intra_packet() {
+    let h = header(5, 4);
+    let (chunks, recon) = encode(&h, &clip(200, 2));
+    // chunk 0 is the header; packet k is chunk k + 1; drop packet 5 (inter, after intra 4)
+    let bytes: Vec<u8> = chunks.iter().enumerate().filter(|(i, _)| *i != 6).flat_map(|(_, c)| c.clone()).collect();
+    let (d, out) = decode(&bytes, true);
+    // packets 5, 6, 7 (15 frames) are concealed; intra packet 8 resynchronises
+    assert_eq!(check(&out, &recon), (185, 15));
+    assert_eq!((d.stats.lost_packets, d.stats.concealed), (1, 15));
+    assert_eq!(out[25..28], [Output::Concealed { first: 25, count: 5 }, Output::Concealed { first: 30, count: 5 },
+               Output::Concealed { first: 35, count: 5 }]);
+}
+
+#[test]
+fn late_and_repeated_packets_are_dropped_and_a_receiver_can_join_mid_stream() {
+    let h = header(4, 3);
+    let (chunks, recon) = encode(&h, &clip(120, 3));
+    let mut order: Vec<usize> = (0..chunks.len()).collect();
+    order.swap(8, 9);
+    order.insert(12, 3);
+    let bytes: Vec<u8> = order.iter().flat_map(|&i| chunks[i].clone()).collect();
+    let (d, out) = decode(&bytes, true);
+    check(&out, &recon);
+    assert_eq!(d.stats.late_packets, 2);
+    // joining at packet 4 (inter): concealed until intra packet 6
+    let joined: Vec<u8> = std::iter::once(&chunks[0]).chain(&chunks[5..]).flat_map(|c| c.clone()).collect();
+    let (_, out) = decode(&joined, false);
+    assert_eq!(out[0], Output::Concealed { first: 16, count: 4 });
+    assert_eq!(check(&out, &recon), (120 - 24, 8));
+}
+
+#[test]
+fn a_stream_cut_anywhere_decodes_its_whole_packets() {
+    let h = header(5, 5);
+    let (chunks, recon) = encode(&h, &clip(60, 4));
+    let bytes = chunks.concat();
+    for cut in 0..bytes.len() {
+        let (_, out) = decode(&bytes[..cut], true);
+        check(&out, &recon);
+    }
+}
+
+#[test]
+fn headers_from_other_versions_or_with_absurd_fields_are_refused_with_a_reason() {
+    let h = header(5, 5);
+    let mut raw = h.to_bytes();
+    raw[4] = 2;
+    let bytes = facemime_core::codec::chunk::write(facemime_core::codec::chunk::Kind::Header, 0, 0, &raw);
+    let (d, _) = decode(&bytes, true);
+    assert!(d.header().is_none());
+    assert!(d.header_error().unwrap().contains("version 2"));
+    let mut bad = h.clone();
+    bad.width = 0;
+    assert!(bad.validate().is_err());
+    assert!(Header::parse(&h.to_bytes()[..40]).is_err());
+    bad = h.clone();
+    bad.quantisers[2].step = f32::NAN;
+    assert!(Encoder::new(bad, 0.0).is_err());
+}
+
+#[test]
+fn values_beyond_the_formats_range_are_an_error_not_garbage() {
+    let mut enc = Encoder::new(header(5, 5), 0.0).unwrap();
+    let mut v = clip(1, 5)[0].2.clone();
+    v[7] = 1e12;
+    assert!(enc.push(true, 0, &v).is_err());
+    v[7] = f64::INFINITY;
+    assert!(enc.push(true, 0, &v).is_err());
+    assert!(enc.push(true, 0, &v[..3]).is_err());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..2000)) {
+        let (d, out) = decode(&bytes, true);
+        prop_assert!(out.is_empty() || d.header().is_some());
+    }
+
+    #[test]
+    fn mutated_streams_never_decode_garbage(edits in proptest::collection::vec((any::<prop::sample::Index>(), any::<u8>(), 0u8..4), 1..8),
+                                            pieces in 1usize..7) {
+        let h = header(3, 4);
+        let (chunks, recon) = encode(&h, &clip(90, 6));
+        let mut bytes = chunks.concat();
+        for (at, value, how) in edits {
+            let i = at.index(bytes.len());
+            match how {
+                0 => bytes[i] ^= value | 1,
+                1 => { bytes.remove(i); }
+                2 => bytes.insert(i, value),
+                _ => { bytes.truncate(i); if bytes.is_empty() { break; } }
+            }
+            if bytes.is_empty() { break; }
+        }
+        // fed in pieces, as a network delivers it
+        let mut d = Decoder::new(true);
+        let step = bytes.len() / pieces + 1;
+        let mut out = Vec::new();
+        for piece in bytes.chunks(step) {
+            out.extend(d.push(piece));
+        }
+        out.extend(d.finish());
+        check(&out, &recon);
+    }
+}
