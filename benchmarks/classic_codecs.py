@@ -5,19 +5,21 @@ to RGB for scoring.
 
     python benchmarks/classic_codecs.py --video ../shared/data/video/lp_d3.mp4 [--frames N]
 
-Quantisers are strings, ``"crf=51"`` or ``"qp=69"`` (an int is a CRF). The floor is the fewest
+Quantisers are strings, ``"crf=51"`` or ``"qp=51"`` (an int is a CRF). The floor is the fewest
 bytes among each codec's coarsest settings (:data:`FLOOR`):
 
-- x264: CRF 51 (the top of its CRF scale), QP 51 (the top of H.264's scale) and QP 69 (the top of
-  x264's QP scale; the stream still says 51, but x264 decides with the coarser QP's lambda, which
-  skips more blocks: on 120 frames of lp_d3, 14.0 kB against 15.8 kB at CRF 51 and 18.1 kB at QP 51).
-  Preset ``veryslow``, the slowest before ``placebo``.
+- x264: CRF 51 (the top of its CRF scale) and QP 51 (the top of H.264's scale). x264 also takes
+  QPs up to 69, emulated within the stream's QP 51, but they ruin the picture before they save
+  much: on 120 frames of lp_d3, QP 69 gave 14.0 kB at 17.3 dB whole-frame luma PSNR (the key
+  frame 14.7 dB), against 15.8 kB at 28.0 dB for CRF 51 and 18.1 kB at 29.1 dB for QP 51; so
+  they are left out. Preset ``veryslow``, the slowest before ``placebo``.
 - SVT-AV1 (v4.1.0 in this build): CRF 63 and QP 63 (QP turns adaptive quantisation off, and is
   the smaller of the two: 9.4 kB against 11.8 kB on 100 frames of lp_d3). Preset 0, the slowest:
-  on this 2-core machine (shared, load about 3-4), 512x512 lp_d3 at QP 63 took 0.37, 0.16, 0.085,
-  0.052 and 0.032 s a frame at presets 0-4 on 40 frames, 0.27 (preset 0), 0.12 (1) and 0.064 (2)
-  on 100 frames, and a whole 300-frame encode at preset 0 took 72 s, under the 2-minute limit.
-  Presets 0-2 give about the same bytes at the floor (within 2 %).
+  on this 2-core machine (shared with other work, load 3-5), 512x512 lp_d3 took 0.37, 0.16, 0.085,
+  0.052 and 0.032 s a frame at presets 0-4 (CRF 63, 40 frames), 0.27, 0.12 and 0.064 s at presets
+  0-2 (QP 63, 100 frames); a 300-frame encode at preset 0, QP 63, took 72 s, under the 2 minutes
+  allowed (all 354 frames: 87 s). Presets 0-4 gave about the same bytes at QP 63 (9.4-9.5 kB on
+  100 frames).
 
 One key frame only: x264 takes ``keyint=100000:min-keyint=100000:scenecut=0``; SVT-AV1 takes
 ``keyint=-1:scd=0`` (its log then says gop size 0, against 161 by default). SVT-AV1 only logs an
@@ -45,7 +47,7 @@ ONE_KEY_FRAME = {"libx264": {"x264-params": "keyint=100000:min-keyint=100000:sce
 #: The slowest preset used, per codec (see the module docstring for why SVT-AV1's is 0).
 PRESET = {"libx264": "veryslow", "libsvtav1": "0"}
 #: The coarsest quantisers, per codec; the floor is whichever gives the fewest bytes.
-FLOOR = {"libx264": ("crf=51", "qp=51", "qp=69"), "libsvtav1": ("crf=63", "qp=63")}
+FLOOR = {"libx264": ("crf=51", "qp=51"), "libsvtav1": ("crf=63", "qp=63")}
 
 
 def encode(frames: list[np.ndarray], fps: float, codec: str, crf_or_qp: int | str,

@@ -16,7 +16,7 @@ again by a fit of the actor on the frame at most once in :data:`ANCHOR_EVERY` fr
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -24,6 +24,7 @@ from facemime.animate.deform import Deformer
 from facemime.animate.pose import PoseTracker
 from facemime.errors import NoFaceError
 from facemime.face.mesh import reference_points
+from facemime.fit.actor import Actor
 from facemime.fit.placement import fit_model, model_iod
 from facemime.fit.run import fit_actor, init_contours
 from facemime.render.projection import Pose
@@ -75,15 +76,18 @@ class Analysis:
     """Analyses a video of one face, fed frame by frame (RGB uint8 (H, W, 3)).
 
     The first frame must show the face roughly frontal; an actor is fitted on it (raises
-    :class:`~facemime.errors.NoFaceError` when there is none). ``name`` names the video in
-    messages.
+    :class:`~facemime.errors.NoFaceError` when there is none), or, given ``actor`` (the same
+    person's, fitted before), only that actor's model is placed on it, so that the motion is
+    measured on the actor a receiver already holds. ``name`` names the video in messages.
     """
 
-    def __init__(self, frame: np.ndarray, name: str, params: TrackerParams | None = None):
+    def __init__(self, frame: np.ndarray, name: str, params: TrackerParams | None = None, actor: Actor | None = None):
         self.params = params
         self.timings = Timings()
         t0 = time.perf_counter()
-        self.actor, self.warnings, _ = fit_actor(frame, name)
+        self.actor, self.warnings, _ = fit_actor(frame, name, model=None if actor is None else actor.model)
+        if actor is not None:
+            self.actor = replace(actor, pose=self.actor.pose)
         self.timings.fit += time.perf_counter() - t0
         self.deformer = Deformer(self.actor.model)
         contours = init_contours(self.actor)

@@ -156,6 +156,57 @@ def run(video: Path, actor_file: Path | None, out_file: Path, track_file: Path |
 
 
 @cli.command()
+@click.argument("video", type=click.Path(path_type=Path))
+@click.option("--actor", "actor_file", type=click.Path(path_type=Path),
+              help="NAME.actor of this person that the receiver already holds: the stream names it instead of "
+                   "carrying it (default: fit one on the first frame and carry it).")
+@click.option("--quality", type=click.IntRange(0, 10), default=5, show_default=True,
+              help="0 (coarsest, about 1 kbit/s) to 10 (finest).")
+@click.option("--rate", type=float, help="Target rate of the motion, kbit/s: the finest quality that fits (instead of --quality).")
+@click.option("--keyframe", type=float, default=1.0, show_default=True,
+              help="Seconds between intra packets (where a receiver can join or recover from loss).")
+@click.option("--packet", type=float, default=0.5, show_default=True,
+              help="Seconds of frames per packet (shorter: less delay, more bytes).")
+@click.option("--embed-actor", is_flag=True, help="Carry the actor given with --actor in the stream too.")
+@click.option("--out", "out_file", type=click.Path(path_type=Path), required=True, help="X.fmstream to write.")
+@click.option("--force", is_flag=True, help="Overwrite an existing output file.")
+def encode(video: Path, actor_file: Path | None, quality: int, rate: float | None, keyframe: float, packet: float,
+           embed_actor: bool, out_file: Path, force: bool) -> None:
+    """Analyse the face in VIDEO and write its motion as a facemime stream: a couple of kilobits
+    a second, plus the actor once."""
+    from facemime.codec.files import encode_video
+    from facemime.codec.stream import Settings
+
+    settings = Settings(quality=quality, keyframe=keyframe, packet=packet)
+    result = encode_video(video, out_file, actor_file, settings, rate, True if embed_actor else None, force)
+    for w in result.warnings:
+        click.echo(f"facemime: warning: {w}", err=True)
+    click.echo(str(out_file))
+    actor = (f"the actor {result.actor_bytes} bytes once" if result.actor_bytes else f"the actor named ({actor_file})")
+    click.echo(f"encoded {result.frames} frames at quality {result.quality}: motion {result.motion_kbit_s:.2f} kbit/s "
+               f"({result.motion_bytes} bytes), header {result.header_bytes} bytes, {actor}", err=True)
+
+
+@cli.command()
+@click.argument("stream", type=click.Path(path_type=Path))
+@click.option("--actor", "actor_file", type=click.Path(path_type=Path),
+              help="NAME.actor the stream names, when the stream does not carry its actor.")
+@click.option("--out", "out_file", type=click.Path(path_type=Path), required=True,
+              help="Video of the synthesised face to write (.mp4 or .webm).")
+@click.option("--force", is_flag=True, help="Overwrite an existing output file.")
+def decode(stream: Path, actor_file: Path | None, out_file: Path, force: bool) -> None:
+    """Synthesise the face of a facemime STREAM into a video, with no access to the source video."""
+    from facemime.codec.files import decode_stream
+
+    result = decode_stream(stream, out_file, actor_file, force)
+    click.echo(str(out_file))
+    s = result.stats
+    damage = (f"; {result.concealed} frames concealed ({s['lost_packets']} packets lost, {s['damaged_bytes']} bytes "
+              f"damaged, {s['undecodable']} undecodable)" if result.concealed or s["damaged_bytes"] else "")
+    click.echo(f"decoded {result.frames} frames in {result.seconds:.1f} s{damage}", err=True)
+
+
+@cli.command()
 @click.argument("source", metavar="VIDEO_OR_TRACK", type=click.Path(path_type=Path))
 @click.option("--actor", "actor_file", type=click.Path(path_type=Path),
               help="NAME.actor to drive (default: the video's own face, or the generic head for a track file).")

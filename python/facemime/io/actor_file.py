@@ -6,7 +6,8 @@ The file is a ZIP archive with exactly two members and nothing executable:
   adjusted vertices, triangles, uv, groups, deformation units>, "pose": {"yaw", "pitch", "roll",
   "scale", "tx", "ty"} (the frontal pose onto the source photo), "source": {"file", "frame",
   "width", "height"}, "points": {name: [[x, y], ...]}, "texture": {"width", "height"}}``;
-- ``texture.png``: the RGB texture.
+- ``texture.png`` (or ``texture.webp``: the smaller form a stream carries, see
+  :func:`actor_bytes`): the RGB texture.
 
 Loading reads only those two members, refuses oversized ones before reading them, parses JSON
 and PNG (no pickle, no code) and validates every array, so a corrupt, truncated, foreign or
@@ -15,8 +16,11 @@ hostile file gives an :class:`ActorFileError` naming the file and the problem.
 
 from __future__ import annotations
 
+import hashlib
+import io
 import json
 import zipfile
+import zlib
 from pathlib import Path
 
 import cv2
@@ -24,7 +28,7 @@ import numpy as np
 
 from facemime.errors import FacemimeError, InputFileError, InvalidInputError, ModelFormatError
 from facemime.fit.actor import Actor
-from facemime.io.outputs import OutputFileError, atomic_file, check_outputs
+from facemime.io.outputs import OutputFileError, check_outputs, write_bytes
 from facemime.model.head import head_document, head_from_document
 from facemime.render.projection import Pose
 
@@ -39,13 +43,13 @@ class ActorFileError(FacemimeError, ValueError):
     """An ``.actor`` file is corrupt, truncated, foreign or of an unknown version."""
 
 
-def save_actor(path: str | Path, actor: Actor, force: bool = False) -> Path:
-    """Write ``actor`` to ``path`` atomically; refuses to overwrite unless ``force``."""
-    path = Path(path)
-    check_outputs([path], force)
-    ok, png = cv2.imencode(".png", cv2.cvtColor(actor.texture, cv2.COLOR_RGB2BGR))
-    if not ok:
-        raise OutputFileError(f"cannot encode the texture of {path}")
+#: Texture members a file may hold, and how each is written.
+TEXTURES = {"png": ("texture.png", []), "webp": ("texture.webp", [cv2.IMWRITE_WEBP_QUALITY])}
+
+
+def actor_json(actor: Actor) -> bytes:
+    """The ``actor.json`` member of ``actor``'s file (deterministic: its SHA-256 names the actor
+    in a stream, see ``docs/bitstream.md``)."""
     doc = {
         "format": ACTOR_FORMAT,
         "model": head_document(actor.model),
@@ -54,10 +58,28 @@ def save_actor(path: str | Path, actor: Actor, force: bool = False) -> Path:
         "points": {k: np.asarray(v).tolist() for k, v in actor.points.items()},
         "texture": {"width": int(actor.texture.shape[1]), "height": int(actor.texture.shape[0])},
     }
-    with atomic_file(path) as tmp, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
-        z.writestr("actor.json", json.dumps(doc))
-        z.writestr(zipfile.ZipInfo("texture.png"), png.tobytes(), zipfile.ZIP_STORED)
-    return path
+    return json.dumps(doc).encode()
+
+
+def actor_bytes(actor: Actor, texture: str = "png", quality: int = 90) -> bytes:
+    """``actor`` as the bytes of an actor file, its texture as PNG or WebP (``quality`` 1-100)."""
+    name, params = TEXTURES[texture]
+    ok, image = cv2.imencode("." + texture, cv2.cvtColor(actor.texture, cv2.COLOR_RGB2BGR),
+                             [p for flag in params for p in (flag, int(quality))])
+    if not ok:
+        raise OutputFileError(f"cannot encode the texture as {texture}")
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("actor.json", actor_json(actor))
+        z.writestr(zipfile.ZipInfo(name), image.tobytes(), zipfile.ZIP_STORED)
+    return buf.getvalue()
+
+
+def save_actor(path: str | Path, actor: Actor, force: bool = False) -> Path:
+    """Write ``actor`` to ``path`` atomically (PNG texture); refuses to overwrite unless ``force``."""
+    path = Path(path)
+    check_outputs([path], force)
+    return write_bytes(path, actor_bytes(actor))
 
 
 def _member(z: zipfile.ZipFile, name: str, limit: int, where: str) -> bytes:
@@ -73,14 +95,26 @@ def _member(z: zipfile.ZipFile, name: str, limit: int, where: str) -> bytes:
 def load_actor(path: str | Path) -> Actor:
     """Read and validate an ``.actor`` file."""
     path = Path(path)
-    where = str(path)
     if not path.is_file():
         raise InputFileError(f"actor file {path} does not exist" if not path.exists() else f"actor file {path} is not a file")
+    return actor_from_bytes(path, str(path))
+
+
+def actor_id(actor: Actor) -> bytes:
+    """The SHA-256 of the actor's ``actor.json`` member: what a stream names it by."""
+    return hashlib.sha256(actor_json(actor)).digest()
+
+
+def actor_from_bytes(source: str | Path | bytes, where: str) -> Actor:
+    """Read and validate an actor file's content: ``source`` is its path or its bytes; ``where``
+    names it in messages."""
     try:
-        with zipfile.ZipFile(path) as z:
+        with zipfile.ZipFile(io.BytesIO(source) if isinstance(source, bytes) else source) as z:
             text = _member(z, "actor.json", MAX_JSON_BYTES, where)
-            png = _member(z, "texture.png", MAX_TEXTURE_BYTES, where)
-    except (zipfile.BadZipFile, EOFError, zipfile.LargeZipFile, NotImplementedError) as e:
+            names = set(z.namelist())
+            member = next((name for name, _ in TEXTURES.values() if name in names), "texture.png")
+            image = _member(z, member, MAX_TEXTURE_BYTES, where)
+    except (zipfile.BadZipFile, EOFError, zipfile.LargeZipFile, NotImplementedError, zlib.error) as e:
         raise ActorFileError(f"{where}: not a facemime actor file, or truncated ({e})") from None
     except OSError as e:
         raise InputFileError(f"cannot read {where}: {e.strerror or e}") from None
@@ -92,7 +126,7 @@ def load_actor(path: str | Path) -> Actor:
         found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
         raise ActorFileError(f"{where}: expected format {ACTOR_FORMAT!r}, got {found!r}"
                              + (" (a newer facemime wrote it?)" if isinstance(found, str) and found.startswith("facemime.actor/") else ""))
-    texture = _texture(png, doc.get("texture"), where)
+    texture = _texture(image, member, doc.get("texture"), where)
     try:
         model = head_from_document(doc.get("model"), f"{where}: model")
     except ModelFormatError as e:
@@ -110,15 +144,32 @@ def load_actor(path: str | Path) -> Actor:
         raise ActorFileError(f"{where}: malformed actor ({e})") from None
 
 
-def _texture(png: bytes, meta: object, where: str) -> np.ndarray:
-    if len(png) < 24 or png[:8] != b"\x89PNG\r\n\x1a\n":
-        raise ActorFileError(f"{where}: texture.png is not a PNG image")
-    w, h = int.from_bytes(png[16:20], "big"), int.from_bytes(png[20:24], "big")  # the IHDR size
+def _image_size(data: bytes) -> tuple[int, int] | None:
+    """(width, height) from a PNG or WebP file's header, before decoding; None if it is neither."""
+    if len(data) >= 24 and data[:8] == b"\x89PNG\r\n\x1a\n":
+        return int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")  # the IHDR size
+    if len(data) >= 30 and data[:4] == b"RIFF" and data[8:12] == b"WEBP":
+        chunk = data[12:16]
+        if chunk == b"VP8X":  # 24-bit width - 1, height - 1
+            return int.from_bytes(data[24:27], "little") + 1, int.from_bytes(data[27:30], "little") + 1
+        if chunk == b"VP8 " and data[23:26] == b"\x9d\x01\x2a":  # lossy: 14-bit sizes after the start code
+            return int.from_bytes(data[26:28], "little") & 0x3FFF, int.from_bytes(data[28:30], "little") & 0x3FFF
+        if chunk == b"VP8L" and data[20] == 0x2F:  # lossless: 14-bit width - 1, height - 1
+            bits = int.from_bytes(data[21:25], "little")
+            return (bits & 0x3FFF) + 1, ((bits >> 14) & 0x3FFF) + 1
+    return None
+
+
+def _texture(data: bytes, member: str, meta: object, where: str) -> np.ndarray:
+    size = _image_size(data)
+    if size is None:
+        raise ActorFileError(f"{where}: {member} is not a PNG or WebP image")
+    w, h = size
     if not (1 <= w <= MAX_TEXTURE_SIDE and 1 <= h <= MAX_TEXTURE_SIDE):
         raise ActorFileError(f"{where}: texture is {w}x{h}; at most {MAX_TEXTURE_SIDE} pixels a side are allowed")
-    img = cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_COLOR)
-    if img is None:
-        raise ActorFileError(f"{where}: texture.png is corrupt")
+    img = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
+    if img is None or img.shape[:2] != (h, w):
+        raise ActorFileError(f"{where}: {member} is corrupt")
     if not isinstance(meta, dict) or [meta.get("width"), meta.get("height")] != [img.shape[1], img.shape[0]]:
         raise ActorFileError(f"{where}: texture is {img.shape[1]}x{img.shape[0]}, but actor.json says {meta}")
     return np.ascontiguousarray(cv2.cvtColor(img, cv2.COLOR_BGR2RGB))

@@ -87,6 +87,14 @@ def write_text(path: str | Path, text: str) -> Path:
     return path
 
 
+def write_bytes(path: str | Path, data: bytes) -> Path:
+    """Write a binary file atomically."""
+    path = Path(path)
+    with atomic_file(path) as tmp:
+        tmp.write_bytes(data)
+    return path
+
+
 def write_image(path: str | Path, image: np.ndarray) -> Path:
     """Write an RGB or gray uint8 image (PNG, JPEG, ... by suffix) atomically."""
     path = Path(path)

@@ -1,0 +1,4 @@
+"""Model-based coding: a face's motion as a bitstream of a couple of kilobits a second
+(``docs/bitstream.md``). :mod:`params` maps pose and offsets to the coded parameters,
+:mod:`stream` encodes and decodes frame by frame, :mod:`files` makes and plays ``.fmstream``
+files."""

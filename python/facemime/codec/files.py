@@ -1,0 +1,206 @@
+"""``facemime encode`` and ``facemime decode``: a face video to an ``.fmstream`` file, and an
+``.fmstream`` file (with the actor it carries or names) to a video of the synthesised face.
+
+Encoding analyses the whole video first (fit, track, head pose, knot offsets), learns the basis
+of the knots' motion from this clip (its principal directions; sent once, in the header), picks
+each parameter's starting table from the clip, then codes the frames. With a target rate, it
+takes the finest quality whose motion fits. Decoding needs only the stream and, when the stream
+does not carry it, the actor.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from facemime import _core
+from facemime.animate.analysis import Analysis, FrameMotion
+from facemime.animate.deform import Deformer
+from facemime.animate.run import NO_FACE_DIM
+from facemime.animate.synth import BACKGROUND, Puppet
+from facemime.codec.params import Basis, pose_vector
+from facemime.codec.stream import LADDER, MotionDecoder, MotionEncoder, Settings, StreamError
+from facemime.errors import InputFileError, InvalidInputError, NoFaceError
+from facemime.fit.actor import Actor
+from facemime.fit.placement import model_iod
+from facemime.io.actor_file import load_actor
+from facemime.io.outputs import check_outputs, write_bytes
+from facemime.io.video import CODECS, VideoReader, VideoWriter
+from facemime.progress import track as progress
+from facemime.render.texture_map import fill
+
+SUFFIX = ".fmstream"
+#: Largest stream file read, bytes.
+MAX_STREAM_BYTES = 1 << 30
+#: The most basis vectors any quality uses (the clip's basis is learned once at this size).
+MAX_COEFFICIENTS = max(m for _, m in LADDER)
+
+
+@dataclass
+class EncodeResult:
+    """What :func:`encode_video` wrote: frames, the quality used, bytes of the header (with the
+    basis), of the actor (0 when only named), of the motion (packets), and seconds (analysis,
+    coding)."""
+
+    frames: int
+    fps: float
+    quality: int
+    header_bytes: int
+    actor_bytes: int
+    motion_bytes: int
+    seconds: dict[str, float] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
+
+    @property
+    def motion_kbit_s(self) -> float:
+        """The motion's rate, kbit/s."""
+        return self.motion_bytes * 8 / 1000 / (self.frames / self.fps)
+
+
+@dataclass
+class Clip:
+    """A video's analysis: its actor, frame rate, size (width, height) and per-frame motion."""
+
+    actor: Actor
+    fps: float
+    size: tuple[int, int]
+    motion: list[FrameMotion]
+    warnings: list[str]
+    seconds: float
+
+
+def analyse(video: str | Path, actor: Actor | None = None) -> Clip:
+    """Fit (or place ``actor``), track and measure every frame of ``video``."""
+    t0 = time.perf_counter()
+    with VideoReader(video) as reader:
+        analysis, motion = None, []
+        for frame in progress(reader, reader.frames or None, "analysing"):
+            if analysis is None:
+                try:
+                    analysis = Analysis(frame, f"the first frame of {video}", actor=actor)
+                except NoFaceError as e:
+                    raise NoFaceError(f"{e}; the video must start with a frontal face") from None
+                motion.append(analysis.last)
+            else:
+                motion.append(analysis.update(frame))
+        if analysis is None:
+            raise InputFileError(f"video {video} has no frames")
+        return Clip(actor or analysis.actor, reader.fps, (reader.width, reader.height), motion,
+                    list(analysis.warnings), time.perf_counter() - t0)
+
+
+def encode_clip(clip: Clip, settings: Settings, carry_actor: bool, basis: Basis | None = None) -> tuple[bytes, bytes, list[bytes]]:
+    """The stream of an analysed clip: (header, actor chunk or b"", packets). ``basis``: the
+    clip's (default: learned from it, at the settings' size)."""
+    faces = [m for m in clip.motion if m.face]
+    m = settings.basis_size
+    if basis is None:
+        basis = Basis.learn(np.array([f.offsets for f in faces]).reshape(len(faces), -1, 2), m)
+    basis = Basis(basis.raw[:m])
+    steps = settings.steps(m)
+    values = np.array([np.concatenate([pose_vector(f.pose), basis.coefficients(f.offsets)]) for f in faces])
+    classes = _core.choose_classes(steps, settings.hysteresis, values.reshape(len(faces), len(steps)))
+    enc = MotionEncoder(clip.actor, clip.fps, clip.size, basis, settings, carry_actor, classes,
+                        reference=clip.motion[0].pose)
+    packets = [enc.push(f.face, f.lost, f.pose, f.offsets).data for f in clip.motion]
+    packets.append(enc.finish())
+    start = enc.start()
+    return enc.header, start[len(enc.header):], [p for p in packets if p]
+
+
+def encode_video(video: str | Path, out: str | Path, actor: str | Path | None = None, settings: Settings = Settings(),
+                 rate: float | None = None, carry_actor: bool | None = None, force: bool = False) -> EncodeResult:
+    """Analyse ``video`` and write the stream ``out`` (``.fmstream``). ``actor``: an ``.actor``
+    file the receiver holds (the stream names it; default: fit one on the first frame, and the
+    stream carries it). ``rate``: the motion's target, kbit/s: the finest quality that fits
+    (``settings.quality`` is then ignored). ``carry_actor``: put the actor in the stream (default:
+    only when it was fitted here)."""
+    out = Path(out)
+    if out.suffix.lower() != SUFFIX:
+        raise InvalidInputError(f"the stream must end in {SUFFIX}, got {out.name!r}")
+    if Path(video).exists() and out.exists() and out.resolve() == Path(video).resolve():
+        raise InvalidInputError("the stream would replace the input video")
+    if rate is not None and not (np.isfinite(rate) and rate > 0):
+        raise InvalidInputError(f"the target rate must be a positive number of kbit/s, got {rate}")
+    check_outputs([out], force)
+    given = load_actor(actor) if actor is not None else None
+    carry = given is None if carry_actor is None else carry_actor
+    clip = analyse(video, given)
+    t0 = time.perf_counter()
+    faces = [m.offsets for m in clip.motion if m.face]
+    basis = Basis.learn(np.array(faces).reshape(len(faces), -1, 2), MAX_COEFFICIENTS)
+    warnings = list(clip.warnings)
+    duration = len(clip.motion) / clip.fps
+    if rate is None:
+        chosen = settings
+        header, actor_chunk, packets = encode_clip(clip, settings, carry, basis)
+    else:
+        for quality in reversed(range(len(LADDER))):
+            chosen = replace(settings, quality=quality)
+            header, actor_chunk, packets = encode_clip(clip, chosen, carry, basis)
+            if sum(map(len, packets)) * 8 / 1000 / duration <= rate:
+                break
+        else:
+            warnings.append(f"the coarsest quality needs {sum(map(len, packets)) * 8 / 1000 / duration:.2f} kbit/s, "
+                            f"more than the {rate:g} asked for")
+    write_bytes(out, header + actor_chunk + b"".join(packets))
+    return EncodeResult(len(clip.motion), clip.fps, chosen.quality, len(header), len(actor_chunk),
+                        sum(map(len, packets)), {"analysis": clip.seconds, "coding": time.perf_counter() - t0}, warnings)
+
+
+@dataclass
+class DecodeResult:
+    """What :func:`decode_stream` did: frames written, frames concealed, and the decoder's
+    counts (see :attr:`MotionDecoder.stats`)."""
+
+    frames: int
+    concealed: int
+    stats: dict[str, int]
+    seconds: float
+
+
+def read_stream(path: str | Path) -> bytes:
+    """The bytes of a stream file (one-line errors for a missing, unreadable or huge file)."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputFileError(f"stream {path} does not exist" if not path.exists() else f"stream {path} is not a file")
+    size = path.stat().st_size
+    if size > MAX_STREAM_BYTES:
+        raise InputFileError(f"stream {path} is {size} bytes, more than the {MAX_STREAM_BYTES} allowed")
+    try:
+        return path.read_bytes()
+    except OSError as e:
+        raise InputFileError(f"cannot read {path}: {e.strerror or e}") from None
+
+
+def decode_stream(stream: str | Path, out: str | Path, actor: str | Path | None = None, force: bool = False) -> DecodeResult:
+    """Decode ``stream`` and write the synthesised face to ``out`` (.mp4 or .webm) at the stream's
+    frame rate and size. ``actor``: the ``.actor`` file the stream names when it does not carry
+    it. Frames without a face show the last face dimmed; lost frames repeat the last good one."""
+    out = Path(out)
+    if out.suffix.lower() not in CODECS:
+        raise InvalidInputError(f"the output video must end in .mp4 or .webm, got {out.name!r}")
+    if Path(stream).exists() and out.exists() and out.resolve() == Path(stream).resolve():
+        raise InvalidInputError("the video would replace the input stream")
+    check_outputs([out], force)
+    t0 = time.perf_counter()
+    data = read_stream(stream)
+    decoder = MotionDecoder(load_actor(actor) if actor is not None else None, name=str(stream))
+    frames = decoder.push(data) + decoder.finish()
+    if decoder.stats["frames"] == 0:
+        raise StreamError(f"{stream}: no frame could be decoded ({decoder.stats['damaged_bytes']} damaged bytes)")
+    info, target = decoder.info, decoder.actor
+    puppet = Puppet(target, Deformer(target.model).feature_sizes(), model_iod(target.model))
+    w, h = info.size
+    image, shown = np.empty((h, w, 3), np.uint8), np.empty((h, w, 3), np.uint8)
+    with VideoWriter(out, info.fps) as writer:
+        for f in progress(frames, len(frames), "decoding"):
+            if not f.concealed:
+                fill(image, BACKGROUND)
+                puppet.render(f.pose, f.offsets, (w, h), out=image)
+                shown[:] = image if f.face else (image * NO_FACE_DIM).astype(np.uint8)
+            writer.write(shown)
+    return DecodeResult(len(frames), decoder.stats["concealed"], decoder.stats, time.perf_counter() - t0)

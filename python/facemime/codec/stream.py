@@ -1,0 +1,291 @@
+"""The bitstream, frame by frame: :class:`MotionEncoder` turns each analysed frame's head pose
+and knot offsets into packets, :class:`MotionDecoder` turns bytes back into poses and offsets.
+Packets, prediction, quantisation and entropy coding are the Rust core's
+(``facemime._core.StreamEncoder`` / ``StreamDecoder``); the format is ``docs/bitstream.md``.
+
+A sender and a receiver can run live: the encoder hands out each packet as soon as its frames
+are in, and the decoder takes bytes in pieces of any size, conceals lost frames with the last
+good one and resynchronises at the next intra packet.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from fractions import Fraction
+
+import numpy as np
+
+from facemime import _core
+from facemime.animate.deform import Deformer
+from facemime.codec.params import POSE_PARAMETERS, Basis, pose_from_vector, pose_vector, topology_id
+from facemime.errors import FacemimeError, InvalidInputError
+from facemime.fit.actor import Actor
+from facemime.io.actor_file import ActorFileError, actor_bytes, actor_from_bytes, actor_id
+from facemime.render.projection import Pose
+from facemime.track.contours import FEATURES
+
+#: The quality a stream gets unless told otherwise (0 = coarsest ... 10 = finest).
+DEFAULT_QUALITY = 5
+#: Per quality: the factor on the steps below, and the basis coefficients sent. Measured with
+#: ``benchmarks/codec.py`` on the ten shared videos: the face's PSNR hardly depends on the steps
+#: (at quality 5 within 0.07 dB of the unquantised synthesis) and its SSIM more on the
+#: coefficients; quality 5 is the finest whose motion stays under 2 kbit/s on every video.
+LADDER = ((2.83, 4), (2.0, 6), (1.68, 8), (1.41, 10), (1.19, 12), (1.0, 16), (0.71, 16), (0.5, 20), (0.35, 24),
+          (0.25, 28), (0.18, 32))
+#: Quantiser steps at factor 1: yaw, pitch, roll (degrees), ln scale, tx, ty (px), and the
+#: basis coefficients (model units).
+POSE_STEPS = (1.0, 1.0, 1.0, 0.008, 1.0, 1.0)
+COEFFICIENT_STEP = 2.0
+
+
+class StreamError(FacemimeError, ValueError):
+    """A stream cannot be decoded: not a facemime stream, another model, no header, damage."""
+
+
+@dataclass(frozen=True)
+class Settings:
+    """How a stream is coded. ``quality``: 0-10 (:data:`LADDER`); ``keyframe``: seconds between
+    intra packets; ``packet``: seconds of frames per packet (at most 32 frames; shorter packets
+    mean less delay and more bytes of framing); ``coefficients``: basis vectors (default: the
+    quality's); ``hysteresis``: quantiser steps a value may wander before it is sent anew;
+    ``texture``: WebP quality of the actor's texture in the stream."""
+
+    quality: int = DEFAULT_QUALITY
+    keyframe: float = 1.0
+    packet: float = 0.5
+    coefficients: int | None = None
+    hysteresis: float = 0.3
+    texture: int = 80
+
+    def __post_init__(self) -> None:
+        if self.quality not in range(len(LADDER)):
+            raise InvalidInputError(f"quality must be an integer 0-10, got {self.quality}")
+        if not (np.isfinite(self.keyframe) and 0 < self.keyframe <= 3600):
+            raise InvalidInputError(f"the keyframe interval must be within (0, 3600] seconds, got {self.keyframe}")
+        if not (np.isfinite(self.packet) and 0 < self.packet <= self.keyframe):
+            raise InvalidInputError(f"the packet duration must be within (0, keyframe], got {self.packet}")
+        if self.coefficients is not None and not 0 <= self.coefficients <= 58:
+            raise InvalidInputError(f"coefficients must be within 0-58, got {self.coefficients}")
+        if not 1 <= self.texture <= 100:
+            raise InvalidInputError(f"texture quality must be within 1-100, got {self.texture}")
+
+    @property
+    def basis_size(self) -> int:
+        """Basis coefficients per frame."""
+        return LADDER[self.quality][1] if self.coefficients is None else self.coefficients
+
+    def steps(self, coefficients: int) -> list[float]:
+        """Quantiser step per parameter (pose, then ``coefficients`` coefficients)."""
+        scale = LADDER[self.quality][0]
+        return [s * scale for s in POSE_STEPS] + [COEFFICIENT_STEP * scale] * coefficients
+
+    def framing(self, fps: float) -> tuple[int, int]:
+        """(frames per packet, packets per intra packet) at ``fps``."""
+        frames = int(min(32, max(1, round(self.packet * fps))))
+        return frames, int(min(65535, max(1, round(self.keyframe * fps / frames))))
+
+
+def _fps_fraction(fps: float) -> tuple[int, int]:
+    f = Fraction(float(fps)).limit_denominator(1001)
+    if not 0 < f <= 1000:
+        raise InvalidInputError(f"frame rate {fps} is not within (0, 1000] frames/s")
+    return f.numerator, f.denominator
+
+
+def _lost_bits(lost: Sequence[str]) -> int:
+    return sum(1 << i for i, f in enumerate(FEATURES) if f in lost)
+
+
+@dataclass
+class EncodedFrame:
+    """What the receiver will decode for a frame: its pose and (K, 2) offsets (model units), and
+    the bytes this frame completed (a packet, or nothing)."""
+
+    pose: Pose
+    offsets: np.ndarray
+    data: bytes
+
+
+class MotionEncoder:
+    """Encodes one face's motion, frame by frame.
+
+    ``actor``: the actor the motion is measured on (its model's topology and content hash go in
+    the header; with ``carry_actor`` the actor itself follows the header, texture as WebP);
+    ``fps``, ``size`` (width, height px): the video's; ``basis``: the coefficients' basis
+    (learned from the clip, :meth:`Basis.learn`); ``classes``: per parameter, the spread class
+    of its starting table (``facemime._core.choose_classes``; default: a middle class).
+    """
+
+    def __init__(self, actor: Actor, fps: float, size: tuple[int, int], basis: Basis, settings: Settings = Settings(),
+                 carry_actor: bool = True, classes: Sequence[int] | None = None, reference: Pose | None = None):
+        self.settings, self.basis = settings, basis
+        m = len(basis.raw)
+        steps = settings.steps(m)
+        ref = pose_vector(reference or actor.pose)
+        references = [int(round(v / s)) for v, s in zip(ref, steps)] + [0] * m
+        frames, keyframes = settings.framing(fps)
+        self._core = _core.StreamEncoder(
+            _fps_fraction(fps), (int(size[0]), int(size[1])), topology_id(actor.model), frames, keyframes, steps,
+            references, list(classes) if classes is not None else [6] * (POSE_PARAMETERS + m), basis.raw,
+            actor_id(actor), carry_actor, settings.hysteresis)
+        self.actor_data = actor_bytes(actor, "webp", settings.texture) if carry_actor else b""
+
+    def start(self) -> bytes:
+        """The stream's first bytes: the header, and the actor when carried."""
+        return self.header + (_core.actor_chunk(self.actor_data) if self.actor_data else b"")
+
+    @property
+    def header(self) -> bytes:
+        """The header chunk alone (what a sender repeats to a receiver that joins)."""
+        return self._core.header_chunk()
+
+    def push(self, face: bool, lost: Sequence[str], pose: Pose, offsets: np.ndarray) -> EncodedFrame:
+        """Adds a frame: ``face`` (False: the pose and offsets are not sent), the features
+        ``lost``, the ``pose`` and (K, 2) ``offsets`` (model units)."""
+        values = np.concatenate([pose_vector(pose), self.basis.coefficients(offsets)])
+        recon, packet = self._core.push(bool(face), _lost_bits(lost), values)
+        return EncodedFrame(pose_from_vector(recon[:POSE_PARAMETERS]), self.basis.offsets(recon[POSE_PARAMETERS:]),
+                            packet or b"")
+
+    def finish(self) -> bytes:
+        """The last packet's bytes (empty when none is pending)."""
+        return self._core.finish() or b""
+
+
+@dataclass
+class DecodedFrame:
+    """One frame out of the decoder: its ``index`` from the stream's start, ``face`` (False: show
+    the last face, dimmed), the features ``lost``, ``pose`` and (K, 2) ``offsets``, and
+    ``concealed``: it was lost or damaged and repeats the last good frame."""
+
+    index: int
+    face: bool
+    lost: list[str]
+    pose: Pose
+    offsets: np.ndarray
+    concealed: bool = False
+
+
+@dataclass
+class StreamInfo:
+    """The header's facts: ``fps``, ``size`` (width, height px), frames per packet, packets per
+    intra packet, the basis, whether the actor is in the stream, and its content hash."""
+
+    fps: float
+    size: tuple[int, int]
+    packet_frames: int
+    keyframe_packets: int
+    basis: Basis
+    actor_in_stream: bool
+    actor_id: bytes
+    topology: bytes = field(repr=False, default=b"")
+
+
+class MotionDecoder:
+    """Decodes a stream fed in pieces. ``actor``: the receiver's own copy of the stream's actor
+    (needed when the stream does not carry it; refused if it is another actor). ``from_start``:
+    the bytes start at the stream's start (a file); False for a receiver joining a live stream.
+    """
+
+    def __init__(self, actor: Actor | None = None, from_start: bool = True, name: str = "the stream"):
+        self._core = _core.StreamDecoder(from_start)
+        self._given, self.name = actor, name
+        self.info: StreamInfo | None = None
+        self.actor: Actor | None = None
+        self._last: DecodedFrame | None = None
+        self._magic_seen = False
+
+    def _read_header(self) -> None:
+        h = self._core.header()
+        if h is None or (self.info is not None and h["basis"].tobytes() == self.info.basis.raw.tobytes()
+                         and h["actor_id"] == self.info.actor_id):
+            return
+        self.actor = None  # a first header, or a new one: its actor is looked up again
+        self.info = StreamInfo(h["fps"][0] / h["fps"][1], tuple(h["size"]), h["packet_frames"], h["keyframe_packets"],
+                               Basis(h["basis"]), h["actor_in_stream"], h["actor_id"], h["topology"])
+
+    def _resolve_actor(self) -> None:
+        if self.actor is not None or self.info is None:
+            return
+        data = self._core.actor()
+        if self._given is not None:
+            if actor_id(self._given) != self.info.actor_id:
+                raise StreamError(f"{self.name} was made for another actor than the one given")
+            actor = self._given
+        elif data is not None:
+            try:
+                actor = actor_from_bytes(data, f"the actor in {self.name}")
+            except ActorFileError as e:
+                raise StreamError(str(e)) from None
+            if actor_id(actor) != self.info.actor_id:
+                raise StreamError(f"the actor in {self.name} does not match its header")
+        elif self.info.actor_in_stream:
+            return  # the actor chunk has not come yet (or was lost)
+        else:
+            raise StreamError(f"{self.name} does not carry its actor: give the actor file (--actor)")
+        if topology_id(actor.model) != self.info.topology:
+            raise StreamError(f"{self.name} was made for another head model than this actor's")
+        knots = len(Deformer(actor.model).knots)
+        if self.info.basis.raw.shape[1] != 2 * knots:
+            raise StreamError(f"{self.name}'s basis does not fit the {knots} knots of its actor")
+        self.actor = actor
+
+    def _frames(self, decoded: tuple) -> list[DecodedFrame]:
+        index, face, lost, values, concealed = decoded
+        out: list[tuple[int, DecodedFrame | None, int]] = []
+        for i, f, l, v in zip(index, face, lost, values):
+            out.append((int(i), DecodedFrame(int(i), bool(f), [n for b, n in enumerate(FEATURES) if l >> b & 1],
+                                             pose_from_vector(v[:POSE_PARAMETERS]),
+                                             self.info.basis.offsets(v[POSE_PARAMETERS:])), 0))
+        for first, count in concealed:
+            out.append((int(first), None, int(count)))
+        frames = []
+        for first, frame, count in sorted(out, key=lambda t: t[0]):
+            if frame is not None:
+                frames.append(frame)
+                self._last = frame
+                continue
+            for k in range(count):
+                last = self._last
+                if last is None:
+                    frames.append(DecodedFrame(first + k, False, list(FEATURES), self._reference(), self._rest(), True))
+                else:
+                    frames.append(DecodedFrame(first + k, last.face, last.lost, last.pose, last.offsets, True))
+        return frames
+
+    def _reference(self) -> Pose:
+        h = self._core.header()
+        return pose_from_vector(np.array(h["references"][:POSE_PARAMETERS]) * np.array(h["steps"][:POSE_PARAMETERS]))
+
+    def _rest(self) -> np.ndarray:
+        return np.zeros((self.info.basis.raw.shape[1] // 2, 2))
+
+    def push(self, data: bytes) -> list[DecodedFrame]:
+        """Reads ``data``; returns the frames it completed, in order (concealed ones included)."""
+        self._magic_seen = self._magic_seen or b"FMST" in data
+        decoded = self._core.push(bytes(data))
+        self._read_header()
+        self._resolve_actor()
+        return self._frames(decoded)
+
+    def finish(self) -> list[DecodedFrame]:
+        """Reads the end of the stream; raises :class:`StreamError` when nothing was decodable."""
+        decoded = self._core.finish()
+        self._read_header()
+        if self.info is None:
+            reason = self._core.header_error()
+            if reason:
+                raise StreamError(f"{self.name}: {reason}")
+            raise StreamError(f"{self.name}: its header is damaged or cut short; nothing can be decoded" if self._magic_seen
+                              else f"{self.name} is not a facemime stream (no header found)")
+        self._resolve_actor()
+        if self.actor is None:
+            raise StreamError(f"{self.name}'s actor is missing or damaged: give the actor file (--actor)")
+        return self._frames(decoded)
+
+    @property
+    def stats(self) -> dict[str, int]:
+        """What the decoder met: packets, lost_packets, late_packets, undecodable, damaged_runs,
+        damaged_bytes, frames, concealed."""
+        return self._core.stats()
