@@ -27,16 +27,16 @@ from facemime.track.contours import FEATURES
 
 #: The quality a stream gets unless told otherwise (0 = coarsest ... 10 = finest).
 DEFAULT_QUALITY = 5
-#: Per quality: the factor on the steps below, and the basis coefficients sent. Measured with
-#: ``benchmarks/codec.py`` on the ten shared videos: the face's PSNR hardly depends on the steps
-#: (at quality 5 within 0.07 dB of the unquantised synthesis) and its SSIM more on the
-#: coefficients; quality 5 is the finest whose motion stays under 2 kbit/s on every video.
+#: Per quality: the factor on the steps below, and the basis coefficients sent. Quality 5 is the
+#: finest whose motion stays under 2 kbit/s on every shared video (``benchmarks/codec.py``).
 LADDER = ((2.83, 4), (2.0, 6), (1.68, 8), (1.41, 10), (1.19, 12), (1.0, 16), (0.71, 16), (0.5, 20), (0.35, 24),
           (0.25, 28), (0.18, 32))
 #: Quantiser steps at factor 1: yaw, pitch, roll (degrees), ln scale, tx, ty (px), and the
-#: basis coefficients (model units).
-POSE_STEPS = (1.0, 1.0, 1.0, 0.008, 1.0, 1.0)
-COEFFICIENT_STEP = 2.0
+#: basis coefficients (model units). The synthesised face's fidelity is sensitive to the pose:
+#: on lp_d0, steps of 1 degree and 1 px cost 0.008 in face SSIM, 0.7 degrees 0.0055, 0.5 degrees
+#: 0.001; halving the coefficients' step from 3 (2 mm changed it by less than 0.001 anywhere).
+POSE_STEPS = (0.5, 0.5, 0.5, 0.004, 0.5, 0.5)
+COEFFICIENT_STEP = 3.0
 
 
 class StreamError(FacemimeError, ValueError):
@@ -65,8 +65,8 @@ class Settings:
             raise InvalidInputError(f"the keyframe interval must be within (0, 3600] seconds, got {self.keyframe}")
         if not (np.isfinite(self.packet) and 0 < self.packet <= self.keyframe):
             raise InvalidInputError(f"the packet duration must be within (0, keyframe], got {self.packet}")
-        if self.coefficients is not None and not 0 <= self.coefficients <= 58:
-            raise InvalidInputError(f"coefficients must be within 0-58, got {self.coefficients}")
+        if self.coefficients is not None and not 0 <= self.coefficients <= 249:
+            raise InvalidInputError(f"coefficients must be within 0-249, got {self.coefficients}")
         if not 1 <= self.texture <= 100:
             raise InvalidInputError(f"texture quality must be within 1-100, got {self.texture}")
 

@@ -152,6 +152,9 @@ impl Encoder {
         }
         let frames = std::mem::take(&mut self.pending);
         let payload = packet::encode(&mut self.state, &frames)?;
+        if payload.len() > Kind::Inter.max_payload() {
+            return invalid!("a packet of {} bytes is more than the format allows: use fewer frames per packet", payload.len());
+        }
         let kind = if intra { Kind::Intra } else { Kind::Inter };
         let bytes = chunk::write(kind, frames.len(), self.packets as u16, &payload);
         self.packets += 1;

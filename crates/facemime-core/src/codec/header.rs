@@ -14,7 +14,7 @@ pub const VERSION: u8 = 1;
 /// ln scale (scale in px per model unit), tx, ty (px).
 pub const POSE_PARAMETERS: usize = 6;
 /// Most parameters per frame.
-pub const MAX_PARAMETERS: usize = 64;
+pub const MAX_PARAMETERS: usize = 255;
 /// Largest picture side, px.
 pub const MAX_SIDE: u16 = 16384;
 /// Largest quantised value's magnitude.
