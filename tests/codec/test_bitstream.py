@@ -78,3 +78,12 @@ def test_mutated_streams_decode_only_true_frames(edits, piece, from_start):
             if f:
                 assert v.tolist() == truth[int(i)]
         assert np.all(concealed[:, 1] >= 1) if len(concealed) else True
+
+
+def test_a_decoder_written_from_the_specification_reads_the_golden_stream():
+    from .reference_decoder import decode as reference
+
+    expected = json.loads(golden.EXPECTED.read_text())["frames"]
+    frames = reference(golden.STREAM.read_bytes())
+    assert [(f["index"], f["face"], f["lost"]) for f in frames] == [(f["index"], f["face"], f["lost"]) for f in expected]
+    assert [f["values"] for f in frames if f["face"]] == [f["values"] for f in expected if f["face"]]
