@@ -61,7 +61,8 @@ QUALITIES = (0, 1, 2, 3, 5, 7, 10)
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def face_masks(landmarks: np.ndarray, valid: np.ndarray, shape: tuple[int, int], frames: list[int]) -> dict[int, np.ndarray]:
+def face_masks(landmarks: np.ndarray, valid: np.ndarray, shape: tuple[int, int],
+               frames: list[int]) -> dict[int, np.ndarray]:
     """Frame -> boolean mask of the hull of its reference Face Mesh points (valid frames only)."""
     out = {}
     for i in frames:
@@ -76,7 +77,8 @@ def luma(img: np.ndarray) -> np.ndarray:
     return cv2.cvtColor(img, cv2.COLOR_RGB2GRAY).astype(np.float64)
 
 
-def score(images: dict[int, np.ndarray], real: dict[int, np.ndarray], masks: dict[int, np.ndarray]) -> tuple[float, float]:
+def score(images: dict[int, np.ndarray], real: dict[int, np.ndarray],
+          masks: dict[int, np.ndarray]) -> tuple[float, float]:
     """Mean luma PSNR (dB) and SSIM inside the face over the scored frames."""
     psnr, ssim = [], []
     for i, m in masks.items():
@@ -256,14 +258,16 @@ def main() -> None:
         report["videos"][name] = {"frames": len(s.clip.motion), "fps": s.clip.fps, "size": s.clip.size,
                                   "unquantised": {"psnr": base[0], "ssim": base[1]}, "curve": curve, "rate_1": at_rate,
                                   "lossy_5pct": lossy(s, 0.05)}
-        print(f"{name}: {len(s.clip.motion)} frames, {len(s.masks)} scored, {time.perf_counter() - t0:.0f} s", flush=True)
+        print(f"{name}: {len(s.clip.motion)} frames, {len(s.masks)} scored, {time.perf_counter() - t0:.0f} s",
+              flush=True)
     print(f"\n{'video':10s} {'unquant. dB':>11s} " + " ".join(f"{'q' + str(q):>17s}" for q in QUALITIES)
           + f" {'--rate 1':>19s}   (motion kbit/s, ΔPSNR dB / ΔSSIM against the unquantised synthesis)")
     for name, v in report["videos"].items():
         u = v["unquantised"]
-        cells = [f"{c['kbit_s']:5.2f} {c['psnr'] - u['psnr']:+.2f}/{c['ssim'] - u['ssim']:+.4f}" for c in v["curve"].values()]
+        delta = lambda c: f"{c['psnr'] - u['psnr']:+.2f}/{c['ssim'] - u['ssim']:+.4f}"  # noqa: E731
+        cells = [f"{c['kbit_s']:5.2f} {delta(c)}" for c in v["curve"].values()]
         r = v["rate_1"]
-        cells.append(f"q{r['quality']} {r['kbit_s']:4.2f} {r['psnr'] - u['psnr']:+.2f}/{r['ssim'] - u['ssim']:+.4f}" if r else "-")
+        cells.append(f"q{r['quality']} {r['kbit_s']:4.2f} {delta(r)}" if r else "-")
         print(f"{name:10s} {u['psnr']:6.2f}/{u['ssim']:.3f} " + " ".join(f"{c:>17s}" for c in cells))
     default = [v["curve"][5] for v in report["videos"].values()]
     print(f"\ndefault (quality 5): motion max {max(d['kbit_s'] for d in default):.2f} kbit/s; one-time bytes: header "
@@ -286,11 +290,13 @@ def main() -> None:
                     "own basis 24": (replace(Settings(), coefficients=24), s.basis)}
         reps[name] = {k: s.coded(st, b) for k, (st, b) in variants.items()}
     report["representations"] = reps
-    print(f"\n{'representation':24s} {'max kbit/s':>10s} {'mean kbit/s':>11s} {'mean ΔPSNR':>10s} {'mean ΔSSIM':>10s} {'worst ΔSSIM':>11s}")
+    print(f"\n{'representation':24s} {'max kbit/s':>10s} {'mean kbit/s':>11s} {'mean ΔPSNR':>10s} {'mean ΔSSIM':>10s} "
+          f"{'worst ΔSSIM':>11s}")
     for k in next(iter(reps.values())):
         rows = [(reps[n][k], report["videos"][n]["unquantised"]) for n in reps]
         print(f"{k:24s} {max(r['kbit_s'] for r, _ in rows):10.2f} {np.mean([r['kbit_s'] for r, _ in rows]):11.2f} "
-              f"{np.mean([r['psnr'] - u['psnr'] for r, u in rows]):+10.3f} {np.mean([r['ssim'] - u['ssim'] for r, u in rows]):+10.4f} "
+              f"{np.mean([r['psnr'] - u['psnr'] for r, u in rows]):+10.3f} "
+              f"{np.mean([r['ssim'] - u['ssim'] for r, u in rows]):+10.4f} "
               f"{min(r['ssim'] - u['ssim'] for r, u in rows):+11.4f}")
 
     report["classic"] = {}
@@ -301,7 +307,8 @@ def main() -> None:
         report["classic"][name] = {**c, "facemime": ours}
         print(f"\n{name}: facemime {ours['kbit_s']:.2f} kbit/s {ours['psnr']:.2f} dB SSIM {ours['ssim']:.3f} | "
               + " | ".join(f"{k} ({v['quantiser']}, preset {v['preset']}) {v['kbit_s']:.1f} kbit/s {v['psnr']:.2f} dB "
-                           f"SSIM {v['ssim']:.3f}: {v['kbit_s'] / ours['kbit_s']:.0f}x facemime's rate" for k, v in c.items()),
+                           f"SSIM {v['ssim']:.3f}: {v['kbit_s'] / ours['kbit_s']:.0f}x facemime's rate"
+                           for k, v in c.items()),
               flush=True)
 
     first = scenes[names[0]]
@@ -317,9 +324,10 @@ def main() -> None:
     finally:
         os.sched_setaffinity(0, cpus)
     sp = report["speed"]
-    print(f"\nspeed on one core ({sp['video']}): decoding to parameters {sp['decode_core_fps']:.0f} frames/s (Rust core), "
-          f"{sp['decode_python_fps']:.0f} through MotionDecoder; to pictures {sp['decode_pictures_fps']:.0f} frames/s against "
-          f"run's synthesis {sp['run_synthesis_fps']:.0f}; encoding {100 * sp['encode_share_of_analysis']:.2f}% of the analysis")
+    print(f"\nspeed on one core ({sp['video']}): decoding to parameters {sp['decode_core_fps']:.0f} frames/s "
+          f"(Rust core), {sp['decode_python_fps']:.0f} through MotionDecoder; to pictures "
+          f"{sp['decode_pictures_fps']:.0f} frames/s against run's synthesis {sp['run_synthesis_fps']:.0f}; "
+          f"encoding {100 * sp['encode_share_of_analysis']:.2f}% of the analysis")
     header, actor, packets = encode_clip(first.clip, Settings(), True, first.basis)
     report["fuzz"] = fuzz(header + b"".join(packets), args.fuzz)
     print(f"fuzz: {report['fuzz']['streams']} mutated or random streams decoded, none crashed")

@@ -65,7 +65,8 @@ def test_a_stream_naming_its_actor_decodes_only_with_that_actor(clip, shared, tm
         code, out, err = run(capsys, "decode", str(tmp_path / "s.fmstream"), *args, "--out", str(tmp_path / "x.mp4"))
         assert code == 1 and out == "" and err.count("\n") == 1 and message in err, err
         assert not (tmp_path / "x.mp4").exists()
-    code, _, err = run(capsys, "decode", str(tmp_path / "s.fmstream"), "--actor", str(own), "--out", str(tmp_path / "x.mp4"))
+    code, _, err = run(capsys, "decode", str(tmp_path / "s.fmstream"), "--actor", str(own),
+                       "--out", str(tmp_path / "x.mp4"))
     assert code == 0, err
 
 

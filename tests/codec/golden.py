@@ -28,8 +28,8 @@ def frames() -> list[tuple[bool, int, np.ndarray]]:
     """(face, lost bits, values) per frame: a head turning and drifting, coefficients swinging,
     frames 17-19 without a face, a lost brow on frame 30; one value escapes its table."""
     t = np.arange(FRAMES)
-    values = np.column_stack([10 * np.sin(t / 6), 3 * np.cos(t / 9), t / 10, np.log(2.0) + t / 2000, 160 + 2 * t,
-                              120 - t, 12 * np.sin(t / 3), 5 * np.cos(t / 4), t % 7 - 3.0, np.where(t == 25, 90.0, 0.0)])
+    pose = [10 * np.sin(t / 6), 3 * np.cos(t / 9), t / 10, np.log(2.0) + t / 2000, 160 + 2 * t, 120 - t]
+    values = np.column_stack(pose + [12 * np.sin(t / 3), 5 * np.cos(t / 4), t % 7 - 3.0, np.where(t == 25, 90.0, 0.0)])
     return [(not 17 <= i <= 19, 8 if i == 30 else 0, values[i]) for i in range(FRAMES)]
 
 

@@ -98,3 +98,25 @@ def test_the_actor_travels_with_a_webp_texture(clip):
 def test_coarser_quality_costs_fewer_bytes(clip):
     sizes = [sum(map(len, encode_clip(clip, Settings(quality=q), False)[2])) for q in (0, 5, 10)]
     assert sizes[0] < sizes[1] < sizes[2]
+
+
+def test_a_stream_whose_sequence_numbers_run_far_ahead_is_refused_as_a_file(clip):
+    data, _ = encoded(clip, Settings(packet=0.2))
+    header, first = data[0], next(d for d in data[1:] if d)
+    assert first[3] < 128  # a one-byte length: the payload follows at byte 4
+    tag, payload = first[0], first[4:-4]  # the first (intra) packet's
+    forged = b"".join(forge(tag, seq, payload) for seq in range(0, 65536, 250))
+    dec = MotionDecoder(max_concealed=10)
+    with pytest.raises(StreamError, match="too damaged"):
+        dec.push(header + forged)
+        dec.finish()
+    live = MotionDecoder()  # a live receiver conceals, within bounds
+    assert len(live.push(header + forged[:2000])) < 300 * 256 * 5
+
+
+def forge(tag: int, seq: int, payload: bytes) -> bytes:
+    import zlib
+
+    """A well-framed packet: ``tag``, sequence number ``seq``, ``payload`` (under 128 bytes)."""
+    body = bytes([tag]) + seq.to_bytes(2, "little") + bytes([len(payload)]) + payload
+    return body + zlib.crc32(body).to_bytes(4, "little")

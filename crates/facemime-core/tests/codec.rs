@@ -4,12 +4,36 @@ use facemime_core::codec::{Decoder, Encoder, Header, Output, Quantiser};
 use proptest::prelude::*;
 
 fn header(packet_frames: u8, keyframe_packets: u16) -> Header {
-    let mut quantisers = vec![Quantiser { step: 0.2, reference: 0, class: 6 }; 6];
-    quantisers[3] = Quantiser { step: 0.002, reference: 1000, class: 4 };
-    quantisers.extend((0..4).map(|i| Quantiser { step: 0.5, reference: 0, class: 5 + i }));
+    let mut quantisers = vec![
+        Quantiser {
+            step: 0.2,
+            reference: 0,
+            class: 6
+        };
+        6
+    ];
+    quantisers[3] = Quantiser {
+        step: 0.002,
+        reference: 1000,
+        class: 4,
+    };
+    quantisers.extend((0..4).map(|i| Quantiser {
+        step: 0.5,
+        reference: 0,
+        class: 5 + i,
+    }));
     Header {
-        fps_num: 25, fps_den: 1, width: 512, height: 512, topology: *b"topology", packet_frames, keyframe_packets,
-        quantisers, basis_rows: 6, basis: (0..24).map(|i| (i * 1000 - 12000) as i16).collect(), actor_id: [7; 32],
+        fps_num: 25,
+        fps_den: 1,
+        width: 512,
+        height: 512,
+        topology: *b"topology",
+        packet_frames,
+        keyframe_packets,
+        quantisers,
+        basis_rows: 6,
+        basis: (0..24).map(|i| (i * 1000 - 12000) as i16).collect(),
+        actor_id: [7; 32],
         actor_in_stream: false,
     }
 }
@@ -61,7 +85,12 @@ fn check(out: &[Output], recon: &[Vec<f64>]) -> (usize, u64) {
     let (mut decoded, mut concealed) = (0, 0);
     for o in out {
         match o {
-            Output::Frame { index, values, face, .. } => {
+            Output::Frame {
+                index,
+                values,
+                face,
+                ..
+            } => {
                 if *face {
                     assert_eq!(values, &recon[*index as usize], "frame {index}");
                 }
@@ -81,9 +110,21 @@ fn round_trip_gives_the_encoders_reconstruction_bit_for_bit() {
     let (d, out) = decode(&chunks.concat(), true);
     assert_eq!(check(&out, &recon), (503, 0));
     assert_eq!(d.header(), Some(&h));
-    let faces: Vec<bool> = out.iter().map(|o| matches!(o, Output::Frame { face: true, .. })).collect();
+    let faces: Vec<bool> = out
+        .iter()
+        .map(|o| matches!(o, Output::Frame { face: true, .. }))
+        .collect();
     assert_eq!(faces, frames.iter().map(|f| f.0).collect::<Vec<_>>());
-    let lost: Vec<u8> = out.iter().map(|o| if let Output::Frame { lost, .. } = o { *lost } else { 99 }).collect();
+    let lost: Vec<u8> = out
+        .iter()
+        .map(|o| {
+            if let Output::Frame { lost, .. } = o {
+                *lost
+            } else {
+                99
+            }
+        })
+        .collect();
     assert_eq!(lost, frames.iter().map(|f| f.1).collect::<Vec<_>>());
     // the reconstruction is within half a step (plus the hysteresis) of the input
     for ((face, _, v), r) in frames.iter().zip(&recon) {
@@ -100,13 +141,33 @@ fn a_lost_packet_is_concealed_until_the_next_intra_packet() {
     let h = header(5, 4);
     let (chunks, recon) = encode(&h, &clip(200, 2));
     // chunk 0 is the header; packet k is chunk k + 1; drop packet 5 (inter, after intra 4)
-    let bytes: Vec<u8> = chunks.iter().enumerate().filter(|(i, _)| *i != 6).flat_map(|(_, c)| c.clone()).collect();
+    let bytes: Vec<u8> = chunks
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| *i != 6)
+        .flat_map(|(_, c)| c.clone())
+        .collect();
     let (d, out) = decode(&bytes, true);
     // packets 5, 6, 7 (15 frames) are concealed; intra packet 8 resynchronises
     assert_eq!(check(&out, &recon), (185, 15));
     assert_eq!((d.stats.lost_packets, d.stats.concealed), (1, 15));
-    assert_eq!(out[25..28], [Output::Concealed { first: 25, count: 5 }, Output::Concealed { first: 30, count: 5 },
-               Output::Concealed { first: 35, count: 5 }]);
+    assert_eq!(
+        out[25..28],
+        [
+            Output::Concealed {
+                first: 25,
+                count: 5
+            },
+            Output::Concealed {
+                first: 30,
+                count: 5
+            },
+            Output::Concealed {
+                first: 35,
+                count: 5
+            }
+        ]
+    );
 }
 
 #[test]
@@ -121,9 +182,18 @@ fn late_and_repeated_packets_are_dropped_and_a_receiver_can_join_mid_stream() {
     check(&out, &recon);
     assert_eq!(d.stats.late_packets, 2);
     // joining at packet 4 (inter): concealed until intra packet 6
-    let joined: Vec<u8> = std::iter::once(&chunks[0]).chain(&chunks[5..]).flat_map(|c| c.clone()).collect();
+    let joined: Vec<u8> = std::iter::once(&chunks[0])
+        .chain(&chunks[5..])
+        .flat_map(|c| c.clone())
+        .collect();
     let (_, out) = decode(&joined, false);
-    assert_eq!(out[0], Output::Concealed { first: 16, count: 4 });
+    assert_eq!(
+        out[0],
+        Output::Concealed {
+            first: 16,
+            count: 4
+        }
+    );
     assert_eq!(check(&out, &recon), (120 - 24, 8));
 }
 
@@ -143,7 +213,8 @@ fn headers_from_other_versions_or_with_absurd_fields_are_refused_with_a_reason()
     let h = header(5, 5);
     let mut raw = h.to_bytes();
     raw[4] = 2;
-    let bytes = facemime_core::codec::chunk::write(facemime_core::codec::chunk::Kind::Header, 0, 0, &raw);
+    let bytes =
+        facemime_core::codec::chunk::write(facemime_core::codec::chunk::Kind::Header, 0, 0, &raw);
     let (d, _) = decode(&bytes, true);
     assert!(d.header().is_none());
     assert!(d.header_error().unwrap().contains("version 2"));

@@ -10,7 +10,9 @@ use pyo3::types::{PyBytes, PyDict};
 use crate::error::CoreErr;
 
 fn fixed<const N: usize>(name: &str, bytes: &[u8]) -> PyResult<[u8; N]> {
-    bytes.try_into().map_err(|_| PyValueError::new_err(format!("{name} must be {N} bytes")))
+    bytes
+        .try_into()
+        .map_err(|_| PyValueError::new_err(format!("{name} must be {N} bytes")))
 }
 
 /// A pushed frame's reconstruction and the packet it completed.
@@ -45,7 +47,9 @@ impl StreamEncoder {
         hysteresis: f64,
     ) -> PyResult<Self> {
         if steps.len() != references.len() || steps.len() != classes.len() {
-            return Err(PyValueError::new_err("steps, references and classes must have one entry per parameter"));
+            return Err(PyValueError::new_err(
+                "steps, references and classes must have one entry per parameter",
+            ));
         }
         let b = basis.as_array();
         let header = Header {
@@ -60,14 +64,21 @@ impl StreamEncoder {
                 .iter()
                 .zip(&references)
                 .zip(&classes)
-                .map(|((&step, &reference), &class)| Quantiser { step, reference, class })
+                .map(|((&step, &reference), &class)| Quantiser {
+                    step,
+                    reference,
+                    class,
+                })
                 .collect(),
-            basis_rows: u16::try_from(b.ncols()).map_err(|_| PyValueError::new_err("basis vectors are too long"))?,
+            basis_rows: u16::try_from(b.ncols())
+                .map_err(|_| PyValueError::new_err("basis vectors are too long"))?,
             basis: b.iter().copied().collect(),
             actor_id: fixed("actor_id", actor_id)?,
             actor_in_stream,
         };
-        Ok(StreamEncoder { enc: codec::Encoder::new(header, hysteresis).map_err(CoreErr)? })
+        Ok(StreamEncoder {
+            enc: codec::Encoder::new(header, hysteresis).map_err(CoreErr)?,
+        })
     }
 
     /// The header chunk (the stream's first bytes).
@@ -84,14 +95,20 @@ impl StreamEncoder {
         lost: u8,
         values: PyReadonlyArray1<f64>,
     ) -> PyResult<Pushed<'py>> {
-        let v = values.as_slice().map_err(|_| PyValueError::new_err("values must be contiguous"))?;
+        let v = values
+            .as_slice()
+            .map_err(|_| PyValueError::new_err("values must be contiguous"))?;
         let (recon, packet) = self.enc.push(face, lost, v).map_err(CoreErr)?;
         Ok((recon.into_pyarray(py), packet.map(|p| PyBytes::new(py, &p))))
     }
 
     /// The last packet, if frames are pending.
     fn finish<'py>(&mut self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyBytes>>> {
-        Ok(self.enc.finish().map_err(CoreErr)?.map(|p| PyBytes::new(py, &p)))
+        Ok(self
+            .enc
+            .finish()
+            .map_err(CoreErr)?
+            .map(|p| PyBytes::new(py, &p)))
     }
 
     /// Whether the next packet will be an intra packet.
@@ -104,15 +121,24 @@ impl StreamEncoder {
 #[pyfunction]
 fn actor_chunk<'py>(py: Python<'py>, payload: &[u8]) -> PyResult<Bound<'py, PyBytes>> {
     if payload.len() > chunk::Kind::Actor.max_payload() {
-        return Err(PyValueError::new_err("the actor is larger than a stream may carry (64 MiB)"));
+        return Err(PyValueError::new_err(
+            "the actor is larger than a stream may carry (64 MiB)",
+        ));
     }
-    Ok(PyBytes::new(py, &chunk::write(chunk::Kind::Actor, 0, 0, payload)))
+    Ok(PyBytes::new(
+        py,
+        &chunk::write(chunk::Kind::Actor, 0, 0, payload),
+    ))
 }
 
 /// Spread class per parameter for a clip (see `facemime_core::codec::choose_classes`):
 /// `values` (T, N), the frames that show a face.
 #[pyfunction]
-fn choose_classes(steps: Vec<f64>, hysteresis: f64, values: PyReadonlyArray2<f64>) -> PyResult<Vec<u8>> {
+fn choose_classes(
+    steps: Vec<f64>,
+    hysteresis: f64,
+    values: PyReadonlyArray2<f64>,
+) -> PyResult<Vec<u8>> {
     let v = values.as_array();
     let frames: Vec<Vec<f64>> = v.rows().into_iter().map(|r| r.to_vec()).collect();
     Ok(codec::choose_classes(&steps, hysteresis, &frames).map_err(CoreErr)?)
@@ -138,10 +164,16 @@ pub struct StreamDecoder {
 impl StreamDecoder {
     fn arrays<'py>(&self, py: Python<'py>, out: Vec<Output>) -> Decoded<'py> {
         let n = self.dec.header().map_or(0, |h| h.quantisers.len());
-        let (mut index, mut face, mut lost, mut values, mut concealed) = (vec![], vec![], vec![], vec![], vec![]);
+        let (mut index, mut face, mut lost, mut values, mut concealed) =
+            (vec![], vec![], vec![], vec![], vec![]);
         for o in out {
             match o {
-                Output::Frame { index: i, face: f, lost: l, values: v } if v.len() == n => {
+                Output::Frame {
+                    index: i,
+                    face: f,
+                    lost: l,
+                    values: v,
+                } if v.len() == n => {
                     index.push(i);
                     face.push(f);
                     lost.push(l);
@@ -156,8 +188,12 @@ impl StreamDecoder {
             index.into_pyarray(py),
             face.into_pyarray(py),
             lost.into_pyarray(py),
-            ndarray::Array2::from_shape_vec((rows, n), values).expect("F x N").into_pyarray(py),
-            ndarray::Array2::from_shape_vec((concealed.len() / 2, 2), concealed).expect("C x 2").into_pyarray(py),
+            ndarray::Array2::from_shape_vec((rows, n), values)
+                .expect("F x N")
+                .into_pyarray(py),
+            ndarray::Array2::from_shape_vec((concealed.len() / 2, 2), concealed)
+                .expect("C x 2")
+                .into_pyarray(py),
         )
     }
 }
@@ -166,7 +202,9 @@ impl StreamDecoder {
 impl StreamDecoder {
     #[new]
     fn new(from_start: bool) -> Self {
-        StreamDecoder { dec: codec::Decoder::new(from_start) }
+        StreamDecoder {
+            dec: codec::Decoder::new(from_start),
+        }
     }
 
     /// Reads `data`; returns the frames it completed.
@@ -185,18 +223,32 @@ impl StreamDecoder {
     /// packet_frames, keyframe_packets, steps, references, classes, basis (M, rows) int16,
     /// actor_id, actor_in_stream.
     fn header<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
-        let Some(h) = self.dec.header() else { return Ok(None) };
+        let Some(h) = self.dec.header() else {
+            return Ok(None);
+        };
         let d = PyDict::new(py);
         d.set_item("fps", (h.fps_num, h.fps_den))?;
         d.set_item("size", (h.width, h.height))?;
         d.set_item("topology", PyBytes::new(py, &h.topology))?;
         d.set_item("packet_frames", h.packet_frames)?;
         d.set_item("keyframe_packets", h.keyframe_packets)?;
-        d.set_item("steps", h.quantisers.iter().map(|q| q.step).collect::<Vec<_>>())?;
-        d.set_item("references", h.quantisers.iter().map(|q| q.reference).collect::<Vec<_>>())?;
-        d.set_item("classes", h.quantisers.iter().map(|q| q.class).collect::<Vec<_>>())?;
-        let basis = ndarray::Array2::from_shape_vec((h.coefficients(), h.basis_rows as usize), h.basis.clone())
-            .expect("M x rows");
+        d.set_item(
+            "steps",
+            h.quantisers.iter().map(|q| q.step).collect::<Vec<_>>(),
+        )?;
+        d.set_item(
+            "references",
+            h.quantisers.iter().map(|q| q.reference).collect::<Vec<_>>(),
+        )?;
+        d.set_item(
+            "classes",
+            h.quantisers.iter().map(|q| q.class).collect::<Vec<_>>(),
+        )?;
+        let basis = ndarray::Array2::from_shape_vec(
+            (h.coefficients(), h.basis_rows as usize),
+            h.basis.clone(),
+        )
+        .expect("M x rows");
         d.set_item("basis", basis.into_pyarray(py))?;
         d.set_item("actor_id", PyBytes::new(py, &h.actor_id))?;
         d.set_item("actor_in_stream", h.actor_in_stream)?;

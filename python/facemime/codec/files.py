@@ -35,6 +35,9 @@ from facemime.render.texture_map import fill
 SUFFIX = ".fmstream"
 #: Largest stream file read, bytes.
 MAX_STREAM_BYTES = 1 << 30
+#: A stream file is refused when it conceals more than this many frames per frame decoded (and a
+#: minute besides): sequence numbers that jump far ahead would otherwise make hours of video.
+MAX_CONCEALED_RATIO = 10
 #: The most basis vectors any quality uses (the clip's basis is learned once at this size).
 MAX_COEFFICIENTS = max(m for _, m in LADDER)
 
@@ -92,7 +95,8 @@ def analyse(video: str | Path, actor: Actor | None = None) -> Clip:
                     list(analysis.warnings), time.perf_counter() - t0)
 
 
-def encode_clip(clip: Clip, settings: Settings, carry_actor: bool, basis: Basis | None = None) -> tuple[bytes, bytes, list[bytes]]:
+def encode_clip(clip: Clip, settings: Settings, carry_actor: bool,
+                basis: Basis | None = None) -> tuple[bytes, bytes, list[bytes]]:
     """The stream of an analysed clip: (header, actor chunk or b"", packets). ``basis``: the
     clip's (default: learned from it, at the settings' size)."""
     faces = [m for m in clip.motion if m.face]
@@ -147,8 +151,9 @@ def encode_video(video: str | Path, out: str | Path, actor: str | Path | None = 
             warnings.append(f"the coarsest quality needs {sum(map(len, packets)) * 8 / 1000 / duration:.2f} kbit/s, "
                             f"more than the {rate:g} asked for")
     write_bytes(out, header + actor_chunk + b"".join(packets))
+    seconds = {"analysis": clip.seconds, "coding": time.perf_counter() - t0}
     return EncodeResult(len(clip.motion), clip.fps, chosen.quality, len(header), len(actor_chunk),
-                        sum(map(len, packets)), {"analysis": clip.seconds, "coding": time.perf_counter() - t0}, warnings)
+                        sum(map(len, packets)), seconds, warnings)
 
 
 @dataclass
@@ -176,7 +181,8 @@ def read_stream(path: str | Path) -> bytes:
         raise InputFileError(f"cannot read {path}: {e.strerror or e}") from None
 
 
-def decode_stream(stream: str | Path, out: str | Path, actor: str | Path | None = None, force: bool = False) -> DecodeResult:
+def decode_stream(stream: str | Path, out: str | Path, actor: str | Path | None = None,
+                  force: bool = False) -> DecodeResult:
     """Decode ``stream`` and write the synthesised face to ``out`` (.mp4 or .webm) at the stream's
     frame rate and size. ``actor``: the ``.actor`` file the stream names when it does not carry
     it. Frames without a face show the last face dimmed; lost frames repeat the last good one."""
@@ -188,7 +194,8 @@ def decode_stream(stream: str | Path, out: str | Path, actor: str | Path | None 
     check_outputs([out], force)
     t0 = time.perf_counter()
     data = read_stream(stream)
-    decoder = MotionDecoder(load_actor(actor) if actor is not None else None, name=str(stream))
+    decoder = MotionDecoder(load_actor(actor) if actor is not None else None, name=str(stream),
+                            max_concealed=MAX_CONCEALED_RATIO)
     frames = decoder.push(data) + decoder.finish()
     if decoder.stats["frames"] == 0:
         raise StreamError(f"{stream}: no frame could be decoded ({decoder.stats['damaged_bytes']} damaged bytes)")

@@ -13,6 +13,7 @@ from __future__ import annotations
 import hashlib
 import json
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -43,7 +44,7 @@ class Basis:
 
     raw: np.ndarray
 
-    @property
+    @cached_property
     def vectors(self) -> np.ndarray:
         return self.raw.astype(np.float64) / BASIS_ONE
 

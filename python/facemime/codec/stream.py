@@ -186,10 +186,14 @@ class MotionDecoder:
     """Decodes a stream fed in pieces. ``actor``: the receiver's own copy of the stream's actor
     (needed when the stream does not carry it; refused if it is another actor). ``from_start``:
     the bytes start at the stream's start (a file); False for a receiver joining a live stream.
+    ``max_concealed``: for a file, refuse a stream that conceals more than this many frames per
+    frame decoded, and a minute besides (a stream whose sequence numbers jump far ahead).
     """
 
-    def __init__(self, actor: Actor | None = None, from_start: bool = True, name: str = "the stream"):
+    def __init__(self, actor: Actor | None = None, from_start: bool = True, name: str = "the stream",
+                 max_concealed: float | None = None):
         self._core = _core.StreamDecoder(from_start)
+        self._max_concealed = max_concealed
         self._given, self.name = actor, name
         self.info: StreamInfo | None = None
         self.actor: Actor | None = None
@@ -233,6 +237,11 @@ class MotionDecoder:
 
     def _frames(self, decoded: tuple) -> list[DecodedFrame]:
         index, face, lost, values, concealed = decoded
+        stats = self._core.stats()
+        if (self._max_concealed is not None and self.info is not None
+                and stats["concealed"] > self._max_concealed * stats["frames"] + 60 * self.info.fps):
+            raise StreamError(f"{self.name} is too damaged to play: {stats['concealed']} frames lost against "
+                              f"{stats['frames']} decoded")
         out: list[tuple[int, DecodedFrame | None, int]] = []
         for i, f, l, v in zip(index, face, lost, values):
             out.append((int(i), DecodedFrame(int(i), bool(f), [n for b, n in enumerate(FEATURES) if l >> b & 1],
@@ -277,8 +286,9 @@ class MotionDecoder:
             reason = self._core.header_error()
             if reason:
                 raise StreamError(f"{self.name}: {reason}")
-            raise StreamError(f"{self.name}: its header is damaged or cut short; nothing can be decoded" if self._magic_seen
-                              else f"{self.name} is not a facemime stream (no header found)")
+            if self._magic_seen:
+                raise StreamError(f"{self.name}: its header is damaged or cut short; nothing can be decoded")
+            raise StreamError(f"{self.name} is not a facemime stream (no header found)")
         self._resolve_actor()
         if self.actor is None:
             raise StreamError(f"{self.name}'s actor is missing or damaged: give the actor file (--actor)")

@@ -85,8 +85,12 @@ pub enum Read {
 
 /// Reads the chunk that starts at `buf[0]`.
 pub fn read(buf: &[u8]) -> Read {
-    let Some(&tag) = buf.first() else { return Read::Short };
-    let Some(kind) = Kind::from_bits(tag >> 5) else { return Read::Bad };
+    let Some(&tag) = buf.first() else {
+        return Read::Short;
+    };
+    let Some(kind) = Kind::from_bits(tag >> 5) else {
+        return Read::Bad;
+    };
     let packet = matches!(kind, Kind::Intra | Kind::Inter);
     if !packet && tag & 0x1f != 0 {
         return Read::Bad;
@@ -97,7 +101,9 @@ pub fn read(buf: &[u8]) -> Read {
     let seq = u16::from_le_bytes([buf[1], buf[2]]);
     let (mut len, mut at) = (0usize, 3usize);
     for shift in (0..28).step_by(7) {
-        let Some(&b) = buf.get(at) else { return Read::Short };
+        let Some(&b) = buf.get(at) else {
+            return Read::Short;
+        };
         at += 1;
         len |= ((b & 0x7f) as usize) << shift;
         if b & 0x80 == 0 {
@@ -119,7 +125,15 @@ pub fn read(buf: &[u8]) -> Read {
         return Read::Bad;
     }
     let frames = if packet { (tag & 0x1f) as usize + 1 } else { 0 };
-    Read::Chunk(Chunk { kind, frames, seq, payload: buf[at..end].to_vec() }, end + 4)
+    Read::Chunk(
+        Chunk {
+            kind,
+            frames,
+            seq,
+            payload: buf[at..end].to_vec(),
+        },
+        end + 4,
+    )
 }
 
 #[cfg(test)]
@@ -130,8 +144,13 @@ mod tests {
     fn a_chunk_reads_back_and_any_flipped_bit_is_caught() {
         let payload: Vec<u8> = (0..300u32).map(|i| (i * 7) as u8).collect();
         let bytes = write(Kind::Inter, 5, 513, &payload);
-        let Read::Chunk(c, used) = read(&bytes) else { panic!("not read") };
-        assert_eq!((c.kind, c.frames, c.seq, used), (Kind::Inter, 5, 513, bytes.len()));
+        let Read::Chunk(c, used) = read(&bytes) else {
+            panic!("not read")
+        };
+        assert_eq!(
+            (c.kind, c.frames, c.seq, used),
+            (Kind::Inter, 5, 513, bytes.len())
+        );
         assert_eq!(c.payload, payload);
         for bit in 0..bytes.len() * 8 {
             let mut b = bytes.clone();

@@ -8,13 +8,18 @@ use super::header::Header;
 use super::packet::{self, State, FACE};
 
 /// A jump of more packets than this is taken as a new start, not concealed frame by frame.
-pub const MAX_GAP_PACKETS: u64 = 4096;
+pub const MAX_GAP_PACKETS: u64 = 256;
 
 /// What the decoder outputs, in frame order.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Output {
     /// A decoded frame: its index from the stream's start, flags and parameter values.
-    Frame { index: u64, face: bool, lost: u8, values: Vec<f64> },
+    Frame {
+        index: u64,
+        face: bool,
+        lost: u8,
+        values: Vec<f64>,
+    },
     /// `count` frames from `first` that could not be decoded (lost, damaged, or after a loss
     /// before the next intra packet): show the last good frame for them.
     Concealed { first: u64, count: u64 },
@@ -59,8 +64,16 @@ pub struct Decoder {
 impl Decoder {
     pub fn new(from_start: bool) -> Decoder {
         Decoder {
-            from_start, buf: Vec::new(), in_damage: false, header: None, header_error: None, actor: None, state: None,
-            next: None, shown: Vec::new(), stats: Stats::default(),
+            from_start,
+            buf: Vec::new(),
+            in_damage: false,
+            header: None,
+            header_error: None,
+            actor: None,
+            state: None,
+            next: None,
+            shown: Vec::new(),
+            stats: Stats::default(),
         }
     }
 
@@ -138,7 +151,9 @@ impl Decoder {
             return;
         };
         let per = header.packet_frames as u64;
-        let expected = self.next.unwrap_or(if self.from_start { 0 } else { c.seq as u64 });
+        let expected = self
+            .next
+            .unwrap_or(if self.from_start { 0 } else { c.seq as u64 });
         let delta = c.seq.wrapping_sub(expected as u16) as u64;
         if delta >= 1 << 15 {
             self.stats.late_packets += 1;
@@ -176,7 +191,12 @@ impl Decoder {
                         self.shown = f.q;
                     }
                     let values = dequantise(header, &self.shown);
-                    out.push(Output::Frame { index: first + j as u64, face, lost: (f.flags >> 1) & 0x0f, values });
+                    out.push(Output::Frame {
+                        index: first + j as u64,
+                        face,
+                        lost: (f.flags >> 1) & 0x0f,
+                        values,
+                    });
                 }
             }
             Err(_) => {

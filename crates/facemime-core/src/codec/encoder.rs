@@ -27,19 +27,29 @@ impl Quantise {
         if steps.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
             return invalid!("quantiser steps must be finite and positive");
         }
-        Ok(Quantise { steps, hysteresis, held: None })
+        Ok(Quantise {
+            steps,
+            hysteresis,
+            held: None,
+        })
     }
 
     /// The quantised values of one frame's parameters.
     pub fn apply(&mut self, values: &[f64]) -> Result<Vec<i32>> {
         if values.len() != self.steps.len() {
-            return invalid!("a frame has {} parameters, the stream {}", values.len(), self.steps.len());
+            return invalid!(
+                "a frame has {} parameters, the stream {}",
+                values.len(),
+                self.steps.len()
+            );
         }
         let mut q = Vec::with_capacity(values.len());
         for (i, (&v, &step)) in values.iter().zip(&self.steps).enumerate() {
             let u = v / step;
             if !u.is_finite() || u.abs() > MAX_VALUE as f64 {
-                return invalid!("parameter {i} is {v}: not finite, or beyond the format's range at step {step}");
+                return invalid!(
+                    "parameter {i} is {v}: not finite, or beyond the format's range at step {step}"
+                );
             }
             q.push(match &self.held {
                 Some(h) if (u - h[i] as f64).abs() <= 0.5 + self.hysteresis => h[i],
@@ -73,18 +83,23 @@ pub fn choose_classes(steps: &[f64], hysteresis: f64, frames: &[Vec<f64>]) -> Re
         .iter()
         .map(|s| {
             let mean = (s / n).max(1e-3);
-            (0..CLASSES).min_by(|&a, &b| {
-                let da = (class_spread(a) / mean).ln().abs();
-                let db = (class_spread(b) / mean).ln().abs();
-                da.total_cmp(&db)
-            }).unwrap_or(0) as u8
+            (0..CLASSES)
+                .min_by(|&a, &b| {
+                    let da = (class_spread(a) / mean).ln().abs();
+                    let db = (class_spread(b) / mean).ln().abs();
+                    da.total_cmp(&db)
+                })
+                .unwrap_or(0) as u8
         })
         .collect())
 }
 
 /// Values of quantised parameters: `q * step` (the reconstruction both sides share).
 pub fn dequantise(header: &Header, q: &[i32]) -> Vec<f64> {
-    q.iter().zip(&header.quantisers).map(|(&v, h)| v as f64 * h.step as f64).collect()
+    q.iter()
+        .zip(&header.quantisers)
+        .map(|(&v, h)| v as f64 * h.step as f64)
+        .collect()
 }
 
 /// Encodes frames one at a time into packets of `header.packet_frames` frames.
@@ -103,10 +118,20 @@ impl Encoder {
     /// An encoder for `header` (validated), quantising with `hysteresis` steps (see [`Quantise`]).
     pub fn new(header: Header, hysteresis: f64) -> Result<Encoder> {
         header.validate()?;
-        let quantise = Quantise::new(header.quantisers.iter().map(|q| q.step as f64).collect(), hysteresis)?;
+        let quantise = Quantise::new(
+            header.quantisers.iter().map(|q| q.step as f64).collect(),
+            hysteresis,
+        )?;
         let state = State::new(&header);
         let shown = header.quantisers.iter().map(|q| q.reference).collect();
-        Ok(Encoder { header, quantise, state, pending: Vec::new(), shown, packets: 0 })
+        Ok(Encoder {
+            header,
+            quantise,
+            state,
+            pending: Vec::new(),
+            shown,
+            packets: 0,
+        })
     }
 
     pub fn header(&self) -> &Header {
@@ -122,13 +147,29 @@ impl Encoder {
     /// Adds a frame: `face` (false: the parameters are ignored and the last face is shown),
     /// `lost` (bits 0..=3: the features lost), `values` (one per parameter). Returns what the
     /// decoder will output for it, and the packet when this frame completed one.
-    pub fn push(&mut self, face: bool, lost: u8, values: &[f64]) -> Result<(Vec<f64>, Option<Vec<u8>>)> {
-        let q = if face { self.quantise.apply(values)? } else { self.shown.clone() };
+    pub fn push(
+        &mut self,
+        face: bool,
+        lost: u8,
+        values: &[f64],
+    ) -> Result<(Vec<f64>, Option<Vec<u8>>)> {
+        let q = if face {
+            self.quantise.apply(values)?
+        } else {
+            self.shown.clone()
+        };
         if face {
             self.shown = q.clone();
         }
-        self.pending.push(CodedFrame { flags: (face as u8 * FACE) | ((lost & 0x0f) << 1), q: q.clone() });
-        let packet = if self.pending.len() == self.header.packet_frames as usize { Some(self.flush()?) } else { None };
+        self.pending.push(CodedFrame {
+            flags: (face as u8 * FACE) | ((lost & 0x0f) << 1),
+            q: q.clone(),
+        });
+        let packet = if self.pending.len() == self.header.packet_frames as usize {
+            Some(self.flush()?)
+        } else {
+            None
+        };
         Ok((dequantise(&self.header, &q), packet))
     }
 
@@ -142,7 +183,8 @@ impl Encoder {
 
     /// Whether the next packet is an intra packet.
     pub fn next_is_intra(&self) -> bool {
-        self.packets.is_multiple_of(self.header.keyframe_packets as u64)
+        self.packets
+            .is_multiple_of(self.header.keyframe_packets as u64)
     }
 
     fn flush(&mut self) -> Result<Vec<u8>> {
@@ -153,7 +195,10 @@ impl Encoder {
         let frames = std::mem::take(&mut self.pending);
         let payload = packet::encode(&mut self.state, &frames)?;
         if payload.len() > Kind::Inter.max_payload() {
-            return invalid!("a packet of {} bytes is more than the format allows: use fewer frames per packet", payload.len());
+            return invalid!(
+                "a packet of {} bytes is more than the format allows: use fewer frames per packet",
+                payload.len()
+            );
         }
         let kind = if intra { Kind::Intra } else { Kind::Inter };
         let bytes = chunk::write(kind, frames.len(), self.packets as u16, &payload);

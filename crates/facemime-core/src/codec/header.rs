@@ -75,10 +75,14 @@ impl<'a> Bytes<'a> {
         Ok(self.take(1)?[0])
     }
     fn u16(&mut self) -> Result<u16> {
-        Ok(u16::from_le_bytes(self.take(2)?.try_into().expect("two bytes")))
+        Ok(u16::from_le_bytes(
+            self.take(2)?.try_into().expect("two bytes"),
+        ))
     }
     fn u32(&mut self) -> Result<u32> {
-        Ok(u32::from_le_bytes(self.take(4)?.try_into().expect("four bytes")))
+        Ok(u32::from_le_bytes(
+            self.take(4)?.try_into().expect("four bytes"),
+        ))
     }
 }
 
@@ -90,29 +94,58 @@ impl Header {
 
     /// Checks every field's range.
     pub fn validate(&self) -> Result<()> {
-        if self.fps_num == 0 || self.fps_den == 0 || self.fps_num as f64 / self.fps_den as f64 > 1000.0 {
-            return invalid!("frame rate {}/{} is not in (0, 1000] frames/s", self.fps_num, self.fps_den);
+        if self.fps_num == 0
+            || self.fps_den == 0
+            || self.fps_num as f64 / self.fps_den as f64 > 1000.0
+        {
+            return invalid!(
+                "frame rate {}/{} is not in (0, 1000] frames/s",
+                self.fps_num,
+                self.fps_den
+            );
         }
         if self.width == 0 || self.height == 0 || self.width > MAX_SIDE || self.height > MAX_SIDE {
-            return invalid!("picture size {}x{} is not within 1..{MAX_SIDE}", self.width, self.height);
+            return invalid!(
+                "picture size {}x{} is not within 1..{MAX_SIDE}",
+                self.width,
+                self.height
+            );
         }
-        if self.packet_frames == 0 || self.packet_frames as usize > super::chunk::MAX_PACKET_FRAMES {
-            return invalid!("{} frames per packet is not within 1..32", self.packet_frames);
+        if self.packet_frames == 0 || self.packet_frames as usize > super::chunk::MAX_PACKET_FRAMES
+        {
+            return invalid!(
+                "{} frames per packet is not within 1..32",
+                self.packet_frames
+            );
         }
         if self.keyframe_packets == 0 {
             return invalid!("the keyframe interval must be at least one packet");
         }
         let n = self.quantisers.len();
         if !(POSE_PARAMETERS..=MAX_PARAMETERS).contains(&n) {
-            return invalid!("{n} parameters per frame is not within {POSE_PARAMETERS}..{MAX_PARAMETERS}");
+            return invalid!(
+                "{n} parameters per frame is not within {POSE_PARAMETERS}..{MAX_PARAMETERS}"
+            );
         }
         for (i, q) in self.quantisers.iter().enumerate() {
-            if !(q.step.is_finite() && q.step > 0.0) || q.class as usize >= CLASSES || q.reference.unsigned_abs() as i64 > MAX_VALUE {
-                return invalid!("parameter {i} has a bad quantiser (step {}, class {})", q.step, q.class);
+            if !(q.step.is_finite() && q.step > 0.0)
+                || q.class as usize >= CLASSES
+                || q.reference.unsigned_abs() as i64 > MAX_VALUE
+            {
+                return invalid!(
+                    "parameter {i} has a bad quantiser (step {}, class {})",
+                    q.step,
+                    q.class
+                );
             }
         }
         if self.basis.len() != self.coefficients() * self.basis_rows as usize {
-            return invalid!("the basis holds {} entries, not {} x {}", self.basis.len(), self.coefficients(), self.basis_rows);
+            return invalid!(
+                "the basis holds {} entries, not {} x {}",
+                self.basis.len(),
+                self.coefficients(),
+                self.basis_rows
+            );
         }
         Ok(())
     }
@@ -152,23 +185,35 @@ impl Header {
         }
         let version = b.u8()?;
         if version != VERSION {
-            return invalid!("stream format version {version}; this decoder reads version {VERSION}");
+            return invalid!(
+                "stream format version {version}; this decoder reads version {VERSION}"
+            );
         }
         let (fps_num, fps_den, width, height) = (b.u32()?, b.u32()?, b.u16()?, b.u16()?);
         let topology: [u8; 8] = b.take(8)?.try_into().expect("eight bytes");
         let (packet_frames, keyframe_packets, n) = (b.u8()?, b.u16()?, b.u8()? as usize);
         if !(POSE_PARAMETERS..=MAX_PARAMETERS).contains(&n) {
-            return invalid!("{n} parameters per frame is not within {POSE_PARAMETERS}..{MAX_PARAMETERS}");
+            return invalid!(
+                "{n} parameters per frame is not within {POSE_PARAMETERS}..{MAX_PARAMETERS}"
+            );
         }
         let mut quantisers = Vec::with_capacity(n);
         for _ in 0..n {
             let step = f32::from_le_bytes(b.take(4)?.try_into().expect("four bytes"));
             let reference = b.u32()? as i32;
-            quantisers.push(Quantiser { step, reference, class: b.u8()? });
+            quantisers.push(Quantiser {
+                step,
+                reference,
+                class: b.u8()?,
+            });
         }
         let basis_rows = b.u16()?;
         let entries = (n - POSE_PARAMETERS) * basis_rows as usize;
-        let basis = b.take(2 * entries)?.chunks_exact(2).map(|c| i16::from_le_bytes([c[0], c[1]])).collect();
+        let basis = b
+            .take(2 * entries)?
+            .chunks_exact(2)
+            .map(|c| i16::from_le_bytes([c[0], c[1]]))
+            .collect();
         let actor_id: [u8; 32] = b.take(32)?.try_into().expect("32 bytes");
         let actor_in_stream = match b.u8()? {
             0 => false,
@@ -179,8 +224,18 @@ impl Header {
             return invalid!("the stream header has {} bytes too many", buf.len() - b.at);
         }
         let header = Header {
-            fps_num, fps_den, width, height, topology, packet_frames, keyframe_packets, quantisers, basis_rows, basis,
-            actor_id, actor_in_stream,
+            fps_num,
+            fps_den,
+            width,
+            height,
+            topology,
+            packet_frames,
+            keyframe_packets,
+            quantisers,
+            basis_rows,
+            basis,
+            actor_id,
+            actor_in_stream,
         };
         header.validate()?;
         Ok(header)

@@ -21,8 +21,8 @@ pub const CLASSES: usize = 16;
 /// two-sided geometric (discrete Laplacian) whose mean absolute value grows ×1.27 per class,
 /// from 0.35 (class 0) to 12.6 (class 15) quantiser steps.
 pub const DECAY: [u32; CLASSES] = [
-    3764, 6909, 11147, 16245, 21852, 27600, 33170, 38337, 42966, 47001, 50443, 53330, 55718,
-    57674, 59263, 60544,
+    3764, 6909, 11147, 16245, 21852, 27600, 33170, 38337, 42966, 47001, 50443, 53330, 55718, 57674,
+    59263, 60544,
 ];
 /// Mean absolute value of each class's distribution, in quantiser steps (informative: how an
 /// encoder picks a class; decoders never need it).
@@ -71,7 +71,9 @@ impl Table {
     /// The uniform table over `1 << bits` symbols (`bits` ≤ 12).
     pub fn uniform(bits: u32) -> Table {
         let share = 1u32 << (PRECISION as u32 - bits);
-        Table { cdf: (0..=(1u32 << bits)).map(|s| (s * share) as u16).collect() }
+        Table {
+            cdf: (0..=(1u32 << bits)).map(|s| (s * share) as u16).collect(),
+        }
     }
 
     /// Number of symbols.
@@ -91,7 +93,10 @@ impl EntropyModel<PRECISION> for Table {
 }
 
 impl EncoderModel<PRECISION> for Table {
-    fn left_cumulative_and_probability(&self, symbol: impl std::borrow::Borrow<usize>) -> Option<(u16, NonZeroU16)> {
+    fn left_cumulative_and_probability(
+        &self,
+        symbol: impl std::borrow::Borrow<usize>,
+    ) -> Option<(u16, NonZeroU16)> {
         let s = *symbol.borrow();
         let (lo, hi) = (*self.cdf.get(s)?, *self.cdf.get(s + 1)?);
         Some((lo, NonZeroU16::new(hi - lo)?))
@@ -139,7 +144,12 @@ impl Context {
     /// A context starting from frequencies `freq` (each ≥ 1).
     pub fn new(freq: &[u32]) -> Context {
         let total = freq.iter().sum::<u32>();
-        Context { freq: freq.to_vec(), total, step: (total >> 4).max(1), table: Table::from_frequencies(freq) }
+        Context {
+            freq: freq.to_vec(),
+            total,
+            step: (total >> 4).max(1),
+            table: Table::from_frequencies(freq),
+        }
     }
 
     /// The value context of spread `class`.
@@ -206,7 +216,10 @@ mod tests {
     fn wider_classes_spread_their_mass() {
         let share = |c: usize| {
             let t = Table::from_frequencies(&starting_frequencies(c));
-            t.left_cumulative_and_probability(RADIUS as usize).unwrap().1.get()
+            t.left_cumulative_and_probability(RADIUS as usize)
+                .unwrap()
+                .1
+                .get()
         };
         assert!((1..CLASSES).all(|c| share(c) < share(c - 1)));
     }

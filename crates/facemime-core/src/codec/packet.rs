@@ -39,7 +39,11 @@ impl State {
     /// The state at the start of an intra packet.
     pub fn new(header: &Header) -> State {
         State {
-            values: header.quantisers.iter().map(|q| Context::values(q.class as usize)).collect(),
+            values: header
+                .quantisers
+                .iter()
+                .map(|q| Context::values(q.class as usize))
+                .collect(),
             flags: Context::flags(),
             pred: None,
             reference: header.quantisers.iter().map(|q| q.reference).collect(),
@@ -54,18 +58,25 @@ fn coder_error<E: std::fmt::Debug>(e: E) -> crate::error::CoreError {
 }
 
 fn put(enc: &mut SmallRangeEncoder, uniform: &[Table], v: i64, table: &Table) -> Result<usize> {
-    let symbol = if v.abs() <= RADIUS as i64 { (v + RADIUS as i64) as usize } else { ESCAPE };
+    let symbol = if v.abs() <= RADIUS as i64 {
+        (v + RADIUS as i64) as usize
+    } else {
+        ESCAPE
+    };
     enc.encode_symbol(symbol, table).map_err(coder_error)?;
     if symbol == ESCAPE {
         let m = (v.unsigned_abs() - RADIUS as u64 - 1) as u32;
-        enc.encode_symbol((v < 0) as usize, &uniform[1]).map_err(coder_error)?;
+        enc.encode_symbol((v < 0) as usize, &uniform[1])
+            .map_err(coder_error)?;
         let n = 32 - m.leading_zeros();
-        enc.encode_symbol(n as usize, &uniform[5]).map_err(coder_error)?;
+        enc.encode_symbol(n as usize, &uniform[5])
+            .map_err(coder_error)?;
         let mut left = n.saturating_sub(1);
         while left > 0 {
             let b = left.min(12);
             let chunk = (m >> (left - b)) & ((1 << b) - 1);
-            enc.encode_symbol(chunk as usize, &uniform[b as usize]).map_err(coder_error)?;
+            enc.encode_symbol(chunk as usize, &uniform[b as usize])
+                .map_err(coder_error)?;
             left -= b;
         }
     }
@@ -85,7 +96,10 @@ fn get(dec: &mut RangeDecoder, uniform: &[Table], table: &Table) -> Result<(i64,
     let mut left = n.saturating_sub(1);
     while left > 0 {
         let b = left.min(12);
-        m = (m << b) | dec.decode_symbol(&uniform[b as usize]).map_err(coder_error)? as u64;
+        m = (m << b)
+            | dec
+                .decode_symbol(&uniform[b as usize])
+                .map_err(coder_error)? as u64;
         left -= b;
     }
     let magnitude = m as i64 + RADIUS as i64 + 1;
@@ -100,10 +114,15 @@ pub fn encode(state: &mut State, frames: &[CodedFrame]) -> Result<Vec<u8>> {
     let mut enc = SmallRangeEncoder::new();
     for f in frames {
         if f.q.len() != state.reference.len() {
-            return invalid!("a frame has {} parameters, the stream {}", f.q.len(), state.reference.len());
+            return invalid!(
+                "a frame has {} parameters, the stream {}",
+                f.q.len(),
+                state.reference.len()
+            );
         }
         let flags = f.flags as usize & 0x1f;
-        enc.encode_symbol(flags, state.flags.table()).map_err(coder_error)?;
+        enc.encode_symbol(flags, state.flags.table())
+            .map_err(coder_error)?;
         state.flags.update(flags);
         if f.flags & FACE == 0 {
             continue;
@@ -114,11 +133,21 @@ pub fn encode(state: &mut State, frames: &[CodedFrame]) -> Result<Vec<u8>> {
             }
             match &state.pred {
                 Some(p) => {
-                    let s = put(&mut enc, &state.uniform, q as i64 - p[i] as i64, state.values[i].table())?;
+                    let s = put(
+                        &mut enc,
+                        &state.uniform,
+                        q as i64 - p[i] as i64,
+                        state.values[i].table(),
+                    )?;
                     state.values[i].update(s);
                 }
                 None => {
-                    put(&mut enc, &state.uniform, q as i64 - state.reference[i] as i64, &state.intra)?;
+                    put(
+                        &mut enc,
+                        &state.uniform,
+                        q as i64 - state.reference[i] as i64,
+                        &state.intra,
+                    )?;
                 }
             }
         }
@@ -134,14 +163,22 @@ pub fn decode(state: &mut State, payload: &[u8], frames: usize) -> Result<Vec<Co
     if !payload.len().is_multiple_of(2) {
         return invalid!("a packet's payload has an odd length");
     }
-    let words: Vec<u16> = payload.chunks_exact(2).map(|c| u16::from_le_bytes([c[0], c[1]])).collect();
+    let words: Vec<u16> = payload
+        .chunks_exact(2)
+        .map(|c| u16::from_le_bytes([c[0], c[1]]))
+        .collect();
     let mut dec = SmallRangeDecoder::from_compressed(words).map_err(coder_error)?;
     let mut out = Vec::with_capacity(frames);
     for _ in 0..frames {
-        let flags: usize = dec.decode_symbol(state.flags.table()).map_err(coder_error)?;
+        let flags: usize = dec
+            .decode_symbol(state.flags.table())
+            .map_err(coder_error)?;
         state.flags.update(flags);
         if flags as u8 & FACE == 0 {
-            out.push(CodedFrame { flags: flags as u8, q: Vec::new() });
+            out.push(CodedFrame {
+                flags: flags as u8,
+                q: Vec::new(),
+            });
             continue;
         }
         let mut q = Vec::with_capacity(state.reference.len());
@@ -160,7 +197,10 @@ pub fn decode(state: &mut State, payload: &[u8], frames: usize) -> Result<Vec<Co
             q.push(v as i32);
         }
         state.pred = Some(q.clone());
-        out.push(CodedFrame { flags: flags as u8, q });
+        out.push(CodedFrame {
+            flags: flags as u8,
+            q,
+        });
     }
     Ok(out)
 }
