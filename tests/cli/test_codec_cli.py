@@ -99,3 +99,8 @@ def test_bad_streams_and_outputs_give_one_line(stream, tmp_path, capsys):
     code, _, err = run(capsys, "decode", str(damaged), "--out", str(tmp_path / "d.mp4"))
     assert code == 0 and "concealed" in err, err
     assert len(list(VideoReader(tmp_path / "d.mp4"))) == FRAMES
+
+
+def test_quality_and_rate_are_one_or_the_other(clip, tmp_path, capsys):
+    code, out, err = run(capsys, "encode", str(clip), "--quality", "3", "--rate", "1", "--out", str(tmp_path / "s.fmstream"))
+    assert code == 1 and "not both" in err and not (tmp_path / "s.fmstream").exists()

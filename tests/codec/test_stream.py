@@ -120,3 +120,14 @@ def forge(tag: int, seq: int, payload: bytes) -> bytes:
     """A well-framed packet: ``tag``, sequence number ``seq``, ``payload`` (under 128 bytes)."""
     body = bytes([tag]) + seq.to_bytes(2, "little") + bytes([len(payload)]) + payload
     return body + zlib.crc32(body).to_bytes(4, "little")
+
+
+def test_a_stream_for_another_head_model_is_refused(clip):
+    from facemime import _core
+    from facemime.io.actor_file import actor_id
+
+    basis = Basis.learn(np.array([m.offsets for m in clip.motion]), 4)
+    enc = _core.StreamEncoder((25, 1), clip.size, b"othermdl", 5, 5, Settings().steps(4), [0] * 10, [6] * 10,
+                              basis.raw, actor_id(clip.actor), False, 0.3)
+    with pytest.raises(StreamError, match="another head model"):
+        MotionDecoder(clip.actor).push(enc.header_chunk())

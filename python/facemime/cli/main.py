@@ -160,8 +160,7 @@ def run(video: Path, actor_file: Path | None, out_file: Path, track_file: Path |
 @click.option("--actor", "actor_file", type=click.Path(path_type=Path),
               help="NAME.actor of this person that the receiver already holds: the stream names it instead of "
                    "carrying it (default: fit one on the first frame and carry it).")
-@click.option("--quality", type=click.IntRange(0, 10), default=5, show_default=True,
-              help="0 (coarsest, about 1 kbit/s) to 10 (finest).")
+@click.option("--quality", type=click.IntRange(0, 10), help="0 (coarsest) to 10 (finest); default 5, under 2 kbit/s.")
 @click.option("--rate", type=float, help="Target rate of the motion, kbit/s: the finest quality that fits (instead of --quality).")
 @click.option("--keyframe", type=float, default=1.0, show_default=True,
               help="Seconds between intra packets (where a receiver can join or recover from loss).")
@@ -170,14 +169,17 @@ def run(video: Path, actor_file: Path | None, out_file: Path, track_file: Path |
 @click.option("--embed-actor", is_flag=True, help="Carry the actor given with --actor in the stream too.")
 @click.option("--out", "out_file", type=click.Path(path_type=Path), required=True, help="X.fmstream to write.")
 @click.option("--force", is_flag=True, help="Overwrite an existing output file.")
-def encode(video: Path, actor_file: Path | None, quality: int, rate: float | None, keyframe: float, packet: float,
+def encode(video: Path, actor_file: Path | None, quality: int | None, rate: float | None, keyframe: float, packet: float,
            embed_actor: bool, out_file: Path, force: bool) -> None:
     """Analyse the face in VIDEO and write its motion as a facemime stream: a couple of kilobits
     a second, plus the actor once."""
     from facemime.codec.files import encode_video
-    from facemime.codec.stream import Settings
+    from facemime.codec.stream import DEFAULT_QUALITY, Settings
+    from facemime.errors import InvalidInputError
 
-    settings = Settings(quality=quality, keyframe=keyframe, packet=packet)
+    if quality is not None and rate is not None:
+        raise InvalidInputError("give --quality or --rate, not both")
+    settings = Settings(quality=DEFAULT_QUALITY if quality is None else quality, keyframe=keyframe, packet=packet)
     result = encode_video(video, out_file, actor_file, settings, rate, True if embed_actor else None, force)
     for w in result.warnings:
         click.echo(f"facemime: warning: {w}", err=True)
