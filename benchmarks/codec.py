@@ -137,8 +137,10 @@ def lossy(scene: Scene, drop: float, seeds: int = 10) -> dict:
         kept = [p for p in packets if rng.random() >= drop]
         dec = MotionDecoder()
         frames = dec.push(header + actor + b"".join(kept)) + dec.finish()
+        missing = len(scene.clip.motion) - len(frames)  # the last packets lost: their frames hold the last one
+        frames += [frames[-1]] * missing
         psnr, ssim = scene.quality([f.pose for f in frames], [f.offsets for f in frames])
-        runs.append((len(packets) - len(kept), dec.stats["concealed"], psnr, ssim))
+        runs.append((len(packets) - len(kept), dec.stats["concealed"] + missing, psnr, ssim))
     dropped, concealed, psnr, ssim = np.mean(runs, axis=0)
     return {"packets": len(packets), "dropped": dropped, "concealed": concealed, "frames": len(scene.clip.motion),
             "psnr": psnr, "ssim": ssim, "seeds": seeds}

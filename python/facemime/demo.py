@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 import html
+import shutil
 import time
 from dataclasses import dataclass
 from importlib import resources
@@ -29,8 +30,9 @@ from facemime.fit.actor import generic_actor
 from facemime.fit.placement import model_iod
 from facemime.fit.preview import preview_sheet
 from facemime.fit.run import fit_actor
-from facemime.io import VideoWriter, check_outputs, write_image
-from facemime.io.actor_file import save_actor
+from facemime.io import VideoWriter, write_image
+from facemime.io.outputs import Outputs, write_bytes
+from facemime.io.actor_file import actor_bytes
 from facemime.io.contours_json import track_document, write_json
 from facemime.io.outputs import write_text
 from facemime.metrics import group_nme, summarize
@@ -91,10 +93,21 @@ def _still_sheet(rows: list[np.ndarray]) -> np.ndarray:
 
 
 def run_demo(out_dir: Path, force: bool = False, seconds: float = 6.0) -> DemoResult:
-    """Write the demo files into ``out_dir``; refuses to overwrite them unless ``force``."""
+    """Write the demo files into ``out_dir``, all or none; refuses to overwrite them unless
+    ``force``. A failed or interrupted demo leaves no folder it created."""
     files = [out_dir / n for n in FILES]
-    check_outputs(files, force)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    created = not out_dir.exists()
+    try:
+        with Outputs(files, force) as outputs:
+            return _demo(files, [outputs.stage(f) for f in files], seconds)
+    except BaseException:
+        if created:
+            shutil.rmtree(out_dir, ignore_errors=True)
+        raise
+
+
+def _demo(files: list[Path], paths: list[Path], seconds: float) -> DemoResult:
+    """The demo's work: ``files`` are the outputs' names, ``paths`` where to write them."""
     timing: dict[str, float] = {}
 
     # 1. The actor.
@@ -103,8 +116,8 @@ def run_demo(out_dir: Path, force: bool = False, seconds: float = 6.0) -> DemoRe
     t0 = time.perf_counter()
     actor = fit_actor(photo, "astronaut.jpg")[0]
     timing["fit"] = time.perf_counter() - t0
-    save_actor(files[0], actor, force)
-    write_image(files[1], preview_sheet(actor, photo))
+    write_bytes(paths[0], actor_bytes(actor))
+    write_image(paths[1], preview_sheet(actor, photo))
 
     # 2. The scripted performance, with its true contours and pose.
     count = int(seconds * FPS)
@@ -144,7 +157,7 @@ def run_demo(out_dir: Path, force: bool = False, seconds: float = 6.0) -> DemoRe
     stills, shown = [], {int(count * f) for f in (0.2, 0.43, 0.6, 0.87)}
     t0 = time.perf_counter()
     synth_seconds = 0.0
-    with VideoWriter(files[2], FPS) as perf_video, VideoWriter(files[3], FPS) as video:
+    with VideoWriter(paths[2], FPS) as perf_video, VideoWriter(paths[3], FPS) as video:
         for i, (frame, m) in enumerate(zip(frames, motions)):
             perf_video.write(frame)
             s0 = time.perf_counter()
@@ -156,13 +169,13 @@ def run_demo(out_dir: Path, force: bool = False, seconds: float = 6.0) -> DemoRe
                 stills.append(row)
     timing["re-synthesise (2 faces)"] = synth_seconds
     timing["encode videos"] = time.perf_counter() - t0 - synth_seconds
-    write_json(files[4], track_document(
+    write_json(paths[4], track_document(
         {"width": SIZE[0], "height": SIZE[1], "fps": FPS, "frames": count},
         [{"index": i, "contours": m.contours, "confidence": m.confidence, "lost": m.lost, "redetected": m.redetected,
           "face": m.face, "pose": pose_dict(m.pose), "offsets": m.offsets} for i, m in enumerate(motions)],
         model=analysis.model_block))
-    write_image(files[5], _still_sheet(stills))
-    write_text(files[6], _report(nme, pose_error, timing, count, sorted(shown)))
+    write_image(paths[5], _still_sheet(stills))
+    write_text(paths[6], _report(nme, pose_error, timing, count, sorted(shown)))
     return DemoResult(files, count, {g: s["mean"] for g, s in nme.items()}, pose_error, timing)
 
 

@@ -18,14 +18,14 @@ def test_fit_a_photo_writes_an_actor_and_a_preview(tmp_path, capsys, astronaut):
     out = tmp_path / "eileen.actor"
     code, stdout, err = run(capsys, "fit", str(astronaut), "--out", str(out))
     assert code == 0, err
-    assert stdout.split() == [str(out), str(tmp_path / "eileen.png")]
+    assert stdout.split() == [str(out), str(tmp_path / "eileen.preview.png")]
     assert "fitted in" in err and "warning" not in err
     actor = load_actor(out)
     assert actor.source == {"file": "astronaut.png", "frame": 0, "width": 512, "height": 512}
     # The face of the astronaut photo is near (225, 115) with eyes ~45 px apart.
     eyes = np.array([actor.points[n][0] for n in ("eye_right_outer", "eye_left_outer")])
     assert np.linalg.norm(eyes.mean(axis=0) - (224, 102)) < 12 and 45 < np.linalg.norm(eyes[1] - eyes[0]) < 80
-    preview = cv2.imread(str(tmp_path / "eileen.png"))
+    preview = cv2.imread(str(tmp_path / "eileen.preview.png"))
     assert preview.shape == (360, 1440, 3)
     for k in range(1, 4):  # each render shows a textured face, not an empty background
         panel = preview[:, 360 * k:360 * (k + 1)]
@@ -114,4 +114,4 @@ def test_bad_input_gives_one_line(tmp_path, capsys, monkeypatch, astronaut, setu
     if setup == "exists":
         assert (tmp_path / "a.actor").read_text() == "keep me"
     else:
-        assert not (tmp_path / "a.actor").exists() and not (tmp_path / "a.png").exists()
+        assert not (tmp_path / "a.actor").exists() and not (tmp_path / "a.preview.png").exists()

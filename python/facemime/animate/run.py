@@ -21,7 +21,7 @@ from facemime.fit.actor import Actor
 from facemime.fit.placement import model_iod
 from facemime.io.actor_file import load_actor
 from facemime.io.contours_json import track_document, write_json
-from facemime.io.outputs import check_outputs
+from facemime.io.outputs import Outputs
 from facemime.io.video import CODECS, VideoReader, VideoWriter
 from facemime.progress import track as progress
 from facemime.render.projection import Pose
@@ -142,29 +142,28 @@ def run_video(video: str | Path, out: str | Path, actor: str | Path | Actor | No
               params: TrackerParams | None = None) -> RunResult:
     """Analyse ``video`` and write ``out`` (.mp4 or .webm, side by side) and ``track`` (default:
     ``out`` with the suffix ``.json``). ``actor``: an ``.actor`` file or an :class:`Actor` to
-    drive (default: the actor fitted on the first frame). Existing outputs are refused unless
-    ``force``."""
+    drive (default: the actor fitted on the first frame). Both outputs or neither are written;
+    existing ones are refused unless ``force``, an input always."""
     out = Path(out)
     if out.suffix.lower() not in CODECS:
         raise InvalidInputError(f"the output video must end in .mp4 or .webm, got {out.name!r}")
     track = out.with_suffix(".json") if track is None else Path(track)
     if track.suffix.lower() != ".json":
         raise InvalidInputError(f"the track file must end in .json, got {track.name!r}")
-    if track.resolve() == out.resolve():
-        raise InvalidInputError("the output video and the track file must be different files")
-    check_outputs([out, track], force)
-    target = load_actor(actor) if isinstance(actor, (str, Path)) else actor
-    encode = 0.0
-    with VideoReader(video) as reader, VideoWriter(out, reader.fps) as writer:
-        work = SideBySide(progress(reader, reader.frames or None, "running"), str(video), target, user, params)
-        for canvas in work:
-            t0 = time.perf_counter()
-            writer.write(canvas)
-            encode += time.perf_counter() - t0
-        result = work.result([out, track], encode)
-        info = {"width": reader.width, "height": reader.height, "fps": reader.fps, "frames": result.frames}
+    actor_path = actor if isinstance(actor, (str, Path)) else None
+    with Outputs([out, track], force, inputs=[video, actor_path]) as outputs:
+        target = load_actor(actor_path) if actor_path is not None else actor
+        encode = 0.0
+        with VideoReader(video) as reader, VideoWriter(outputs.stage(out), reader.fps) as writer:
+            work = SideBySide(progress(reader, reader.frames or None, "running"), str(video), target, user, params)
+            for canvas in work:
+                t0 = time.perf_counter()
+                writer.write(canvas)
+                encode += time.perf_counter() - t0
+            result = work.result([out, track], encode)
+            info = {"width": reader.width, "height": reader.height, "fps": reader.fps, "frames": result.frames}
         busy = sum(v for k, v in result.seconds.items() if k not in ("encode", "fit", "decode"))
-        write_json(track, track_document(info, work.records, {"processing_seconds": round(busy, 4),
-                                                              "frames_processed": result.frames},
-                                         work.analysis.model_block))
+        write_json(outputs.stage(track), track_document(info, work.records, {"processing_seconds": round(busy, 4),
+                                                                             "frames_processed": result.frames},
+                                                        work.analysis.model_block))
     return result

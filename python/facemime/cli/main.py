@@ -4,7 +4,9 @@ Python trace instead. Data goes to stdout, progress to stderr."""
 
 from __future__ import annotations
 
+import signal
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -53,7 +55,7 @@ def model_preview(model: Path | None, out_file: Path, force: bool) -> None:
     from facemime.render.head_view import views_sheet
 
     check_image_suffix(out_file)
-    check_outputs([out_file], force)
+    check_outputs([out_file], force, inputs=[model])
     if model is None:
         head = generic_head()
     elif model.suffix.lower() == ".wfm":
@@ -96,7 +98,7 @@ def track(video: Path, init: Path | None, out_file: Path, overlay: Path | None, 
 @click.option("--points", "points_file", type=click.Path(path_type=Path),
               help="facemime.points/1 JSON with reference points marked by hand (default: found automatically).")
 @click.option("--out", "out_file", type=click.Path(path_type=Path), required=True,
-              help="NAME.actor to write; the preview goes to NAME.png.")
+              help="NAME.actor to write; the preview goes to NAME.preview.png.")
 @click.option("--force", is_flag=True, help="Overwrite existing output files.")
 def fit(source: Path, frame: int, points_file: Path | None, out_file: Path, force: bool) -> None:
     """Fit the generic head to the frontal face in IMAGE_OR_VIDEO: reference points, elastic
@@ -237,9 +239,33 @@ def view(source: Path, actor_file: Path | None, port: int, no_browser: bool) -> 
             server.server_close()
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM or SIGHUP: the command stops as on Ctrl-C, removing its unfinished outputs."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _terminate(signum: int, frame: object) -> None:
+    raise Terminated(signum)
+
+
 def main(argv: list[str] | None = None) -> None:
-    """Entry point: run the CLI, turning expected errors into one line on stderr."""
+    """Entry point: run the CLI, turning expected errors into one line on stderr; SIGTERM and
+    SIGHUP stop it cleanly (exit status 128 + the signal's number)."""
     argv = sys.argv[1:] if argv is None else argv
+    handlers = {}
+    if threading.current_thread() is threading.main_thread():
+        handlers = {sig: signal.signal(sig, _terminate) for sig in (signal.SIGTERM, signal.SIGHUP)}
+    try:
+        _run(argv)
+    finally:
+        for sig, handler in handlers.items():
+            signal.signal(sig, handler)
+
+
+def _run(argv: list[str]) -> None:
     try:
         cli.main(args=argv, prog_name="facemime", standalone_mode=False)
     except click.exceptions.Abort:
@@ -253,6 +279,18 @@ def main(argv: list[str] | None = None) -> None:
             raise
         click.echo(f"facemime: error: {e}", err=True)
         sys.exit(1)
+    except Terminated as e:
+        click.echo("facemime: terminated", err=True)
+        sys.exit(128 + e.signum)
     except KeyboardInterrupt:
         click.echo("facemime: interrupted", err=True)
         sys.exit(130)
+    except MemoryError:
+        click.echo("facemime: error: out of memory", err=True)
+        sys.exit(1)
+    except Exception as e:  # a defect: still one line, with the way to the trace
+        if "--traceback" in argv:
+            raise
+        click.echo(f"facemime: error: unexpected {type(e).__name__}: {e} (a bug in facemime; run again with "
+                   "--traceback and report it)", err=True)
+        sys.exit(2)

@@ -125,11 +125,9 @@ def encode_video(video: str | Path, out: str | Path, actor: str | Path | None = 
     out = Path(out)
     if out.suffix.lower() != SUFFIX:
         raise InvalidInputError(f"the stream must end in {SUFFIX}, got {out.name!r}")
-    if Path(video).exists() and out.exists() and out.resolve() == Path(video).resolve():
-        raise InvalidInputError("the stream would replace the input video")
     if rate is not None and not (np.isfinite(rate) and rate > 0):
         raise InvalidInputError(f"the target rate must be a positive number of kbit/s, got {rate}")
-    check_outputs([out], force)
+    check_outputs([out], force, inputs=[video, actor])
     given = load_actor(actor) if actor is not None else None
     carry = given is None if carry_actor is None else carry_actor
     clip = analyse(video, given)
@@ -189,9 +187,7 @@ def decode_stream(stream: str | Path, out: str | Path, actor: str | Path | None 
     out = Path(out)
     if out.suffix.lower() not in CODECS:
         raise InvalidInputError(f"the output video must end in .mp4 or .webm, got {out.name!r}")
-    if Path(stream).exists() and out.exists() and out.resolve() == Path(stream).resolve():
-        raise InvalidInputError("the video would replace the input stream")
-    check_outputs([out], force)
+    check_outputs([out], force, inputs=[stream, actor])
     t0 = time.perf_counter()
     data = read_stream(stream)
     decoder = MotionDecoder(load_actor(actor) if actor is not None else None, name=str(stream),

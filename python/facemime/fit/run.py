@@ -13,8 +13,8 @@ from facemime.fit.actor import Actor, smear_texture
 from facemime.fit.auto import auto_points
 from facemime.fit.placement import fit_model
 from facemime.fit.preview import preview_sheet
-from facemime.io.actor_file import save_actor
-from facemime.io.outputs import check_outputs, write_image
+from facemime.io.actor_file import actor_bytes
+from facemime.io.outputs import Outputs, write_bytes, write_image
 from facemime.io.photo import read_photo
 from facemime.io.points_json import read_points
 from facemime.model.head import HeadModel, generic_head
@@ -59,23 +59,24 @@ def fit_actor(photo: np.ndarray, name: str, points: dict | None = None, frame: i
 def fit_file(source: str | Path, out: str | Path, frame: int = 0, points_file: str | Path | None = None,
              force: bool = False) -> FitRun:
     """Fit an actor to ``source`` (an image, or frame ``frame`` of a video) and write ``out``
-    (``NAME.actor``) and its preview ``NAME.png``; existing files are refused unless ``force``."""
+    (``NAME.actor``) and its preview ``NAME.preview.png``, both or neither; existing files are
+    refused unless ``force``, an input always."""
     out = Path(out)
     if out.suffix.lower() != ".actor":
         raise InvalidInputError(f"the actor file name must end in .actor, got {out.name!r}")
-    preview = out.with_suffix(".png")
-    check_outputs([out, preview], force)
-    photo = read_photo(source, frame)
-    points = read_points(points_file, (photo.shape[1], photo.shape[0])) if points_file is not None else None
-    t0 = time.perf_counter()
-    try:
-        actor, warnings, residual = fit_actor(photo, str(source), points, frame)
-    except NoFaceError as e:
-        raise NoFaceError(f"{e}; mark the face by hand and pass the points with --points POINTS.json "
-                          "(format facemime.points/1)") from None
-    seconds = time.perf_counter() - t0
-    save_actor(out, actor, force)
-    write_image(preview, preview_sheet(actor, photo))
+    preview = out.with_suffix(".preview.png")
+    with Outputs([out, preview], force, inputs=[source, points_file]) as outputs:
+        photo = read_photo(source, frame)
+        points = read_points(points_file, (photo.shape[1], photo.shape[0])) if points_file is not None else None
+        t0 = time.perf_counter()
+        try:
+            actor, warnings, residual = fit_actor(photo, str(source), points, frame)
+        except NoFaceError as e:
+            raise NoFaceError(f"{e}; mark the face by hand and pass the points with --points POINTS.json "
+                              "(format facemime.points/1)") from None
+        seconds = time.perf_counter() - t0
+        write_bytes(outputs.stage(out), actor_bytes(actor))
+        write_image(outputs.stage(preview), preview_sheet(actor, photo))
     return FitRun(actor, [out, preview], warnings, seconds, residual)
 
 

@@ -28,6 +28,7 @@ import numpy as np
 
 from facemime.errors import FacemimeError, InputFileError, InvalidInputError, ModelFormatError
 from facemime.fit.actor import Actor
+from facemime.io.limits import image_size, parse_json
 from facemime.io.outputs import OutputFileError, check_outputs, write_bytes
 from facemime.model.head import head_document, head_from_document
 from facemime.render.projection import Pose
@@ -119,8 +120,8 @@ def actor_from_bytes(source: str | Path | bytes, where: str) -> Actor:
     except OSError as e:
         raise InputFileError(f"cannot read {where}: {e.strerror or e}") from None
     try:
-        doc = json.loads(text)
-    except (UnicodeDecodeError, json.JSONDecodeError) as e:
+        doc = parse_json(text, f"{where}: actor.json")
+    except (UnicodeDecodeError, ValueError) as e:
         raise ActorFileError(f"{where}: actor.json is not valid JSON ({e})") from None
     if not isinstance(doc, dict) or doc.get("format") != ACTOR_FORMAT:
         found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
@@ -144,24 +145,8 @@ def actor_from_bytes(source: str | Path | bytes, where: str) -> Actor:
         raise ActorFileError(f"{where}: malformed actor ({e})") from None
 
 
-def _image_size(data: bytes) -> tuple[int, int] | None:
-    """(width, height) from a PNG or WebP file's header, before decoding; None if it is neither."""
-    if len(data) >= 24 and data[:8] == b"\x89PNG\r\n\x1a\n":
-        return int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")  # the IHDR size
-    if len(data) >= 30 and data[:4] == b"RIFF" and data[8:12] == b"WEBP":
-        chunk = data[12:16]
-        if chunk == b"VP8X":  # 24-bit width - 1, height - 1
-            return int.from_bytes(data[24:27], "little") + 1, int.from_bytes(data[27:30], "little") + 1
-        if chunk == b"VP8 " and data[23:26] == b"\x9d\x01\x2a":  # lossy: 14-bit sizes after the start code
-            return int.from_bytes(data[26:28], "little") & 0x3FFF, int.from_bytes(data[28:30], "little") & 0x3FFF
-        if chunk == b"VP8L" and data[20] == 0x2F:  # lossless: 14-bit width - 1, height - 1
-            bits = int.from_bytes(data[21:25], "little")
-            return (bits & 0x3FFF) + 1, ((bits >> 14) & 0x3FFF) + 1
-    return None
-
-
 def _texture(data: bytes, member: str, meta: object, where: str) -> np.ndarray:
-    size = _image_size(data)
+    size = image_size(data)
     if size is None:
         raise ActorFileError(f"{where}: {member} is not a PNG or WebP image")
     w, h = size

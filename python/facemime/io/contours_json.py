@@ -31,7 +31,8 @@ from typing import Any
 
 import numpy as np
 
-from facemime.errors import FacemimeError, InputFileError
+from facemime.errors import FacemimeError
+from facemime.io.limits import parse_json, read_json_text
 from facemime.io.outputs import write_text
 from facemime.track.contours import CONTOUR_NAMES
 
@@ -47,15 +48,18 @@ class ContourFileError(FacemimeError, ValueError):
 
 
 def load_json(path: str | Path, what: str) -> Any:
+    """The JSON document of the ``what`` file at ``path`` (within the input policy's size, see
+    :mod:`facemime.io.limits`)."""
     p = Path(path)
-    if not p.is_file():
-        raise InputFileError(f"{what} file {p} does not exist" if not p.exists() else f"{what} file {p} is not a file")
+    data = read_json_text(p, what)
     try:
-        return json.loads(p.read_text(encoding="utf-8"))
+        return parse_json(data.decode("utf-8"), str(p))
     except UnicodeDecodeError:
         raise ContourFileError(f"{p} is not a JSON text file") from None
     except json.JSONDecodeError as e:
         raise ContourFileError(f"{p} is not valid JSON: {e.msg} at line {e.lineno} column {e.colno}") from None
+    except ValueError as e:
+        raise ContourFileError(str(e)) from None
 
 
 def load_document(path: str | Path, what: str, fmt: str) -> dict[str, Any]:

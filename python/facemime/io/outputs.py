@@ -1,4 +1,5 @@
-"""Output files: never overwrite what exists unless asked, never leave half-written files."""
+"""Output files: never overwrite what exists unless asked, never an input (``--force`` or not),
+never leave half-written files, and a command's several outputs all or none (:class:`Outputs`)."""
 
 from __future__ import annotations
 
@@ -32,10 +33,29 @@ def check_image_suffix(path: str | Path) -> None:
         raise InvalidInputError(f"cannot write image {path}: its name must end in one of {', '.join(IMAGE_SUFFIXES)}")
 
 
-def check_outputs(paths: Iterable[str | Path], force: bool) -> None:
-    """Refuse (with one message naming them) to overwrite existing files unless ``force``;
-    check that each parent folder can be created."""
+def _same(a: Path, b: Path) -> bool:
+    """Whether two paths name one file: the same real path (symbolic links followed), or, both
+    existing, the same file on disk (hard links)."""
+    if a.resolve() == b.resolve():
+        return True
+    try:
+        return a.exists() and b.exists() and os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+def check_outputs(paths: Iterable[str | Path], force: bool, inputs: Iterable[str | Path | None] = ()) -> None:
+    """Refuse (with one message naming them) an output that is one of the command's ``inputs``
+    or another of its outputs, whatever ``force`` says; existing files unless ``force``; and
+    outputs whose folder cannot be created."""
     paths = [Path(p) for p in paths]
+    for i, p in enumerate(paths):
+        for q in (Path(q) for q in inputs if q is not None):
+            if _same(p, q):
+                raise InvalidInputError(f"the output {p} would replace the input {q}; choose another name")
+        for q in paths[i + 1:]:
+            if _same(p, q):
+                raise InvalidInputError(f"two outputs are one file: {p} and {q}")
     existing = [str(p) for p in paths if p.exists()]
     if existing and not force:
         raise OutputExistsError(f"{', '.join(existing)} already exist{'s' if len(existing) == 1 else ''}; "
@@ -63,6 +83,50 @@ def temporary_sibling(path: Path) -> Path:
     os.umask(umask)
     os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; the final file gets the usual mode
     return Path(tmp)
+
+
+class Outputs:
+    """A command's output files, all or none: each is written to a temporary name beside it
+    (:meth:`stage`), and they are put in place together when the block ends without an error;
+    otherwise (an error, Ctrl-C, SIGTERM) none is, and the temporary files are removed.
+
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> with Outputs([folder / "a.txt", folder / "b.txt"], force=False) as out:
+    ...     _ = out.stage(folder / "a.txt").write_text("a")
+    ...     _ = out.stage(folder / "b.txt").write_text("b")
+    >>> sorted(p.name for p in folder.iterdir())
+    ['a.txt', 'b.txt']
+    """
+
+    def __init__(self, paths: Iterable[str | Path], force: bool, inputs: Iterable[str | Path | None] = ()):
+        self.paths = [Path(p) for p in paths]
+        check_outputs(self.paths, force, inputs)
+        self._staged: dict[Path, Path] = {}
+
+    def __enter__(self) -> "Outputs":
+        return self
+
+    def stage(self, path: str | Path) -> Path:
+        """The temporary file to write ``path`` (one of the outputs) to."""
+        path = Path(path)
+        if path not in self.paths:
+            raise ValueError(f"{path} is not one of the outputs")
+        if path not in self._staged:
+            self._staged[path] = temporary_sibling(path)
+        return self._staged[path]
+
+    def __exit__(self, exc_type: type | None, exc: BaseException | None, tb: object) -> None:
+        try:
+            if exc_type is None:
+                for final, tmp in self._staged.items():
+                    try:
+                        os.replace(tmp, final)
+                    except OSError as e:
+                        raise OutputFileError(f"cannot write {final}: {e.strerror or e}") from None
+        finally:
+            for tmp in self._staged.values():
+                tmp.unlink(missing_ok=True)
 
 
 @contextmanager

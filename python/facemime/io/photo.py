@@ -8,6 +8,7 @@ import cv2
 import numpy as np
 
 from facemime.errors import InputFileError, InvalidInputError
+from facemime.io.limits import check_image_file
 from facemime.io.video import VideoReader
 
 #: Still-image file types read with OpenCV; anything else is opened as a video.
@@ -29,6 +30,7 @@ def read_photo(path: str | Path, frame: int = 0) -> np.ndarray:
     if path.suffix.lower() in IMAGE_TYPES:
         if frame != 0:
             raise InvalidInputError(f"{path} is a still image; --frame applies to videos only")
+        check_image_file(path)
         bgr = cv2.imread(str(path), cv2.IMREAD_COLOR)
         if bgr is None:
             raise InputFileError(f"cannot read {path}: not an image, or a corrupt one")

@@ -1,6 +1,7 @@
 """Tracking a whole video file: read the init contours, run the :class:`Tracker` over every
 frame from the init frame on, write the ``facemime.track/1`` JSON and optionally an overlay video
-(H.264 MP4 or VP9 WebM) with the contours drawn. Outputs appear only when complete."""
+(H.264 MP4 or VP9 WebM) with the contours drawn. Outputs appear only when complete, both or
+neither."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ from pathlib import Path
 
 from facemime.errors import InputFileError, InvalidInputError, NoFaceError
 from facemime.io.contours_json import read_init, track_document, write_json
-from facemime.io.outputs import check_outputs
+from facemime.io.outputs import Outputs
 from facemime.io.video import CODECS, VideoReader, VideoWriter
 from facemime.progress import track as progress
 from facemime.track.contours import FEATURES
@@ -45,13 +46,14 @@ def track_video(video: str | Path, init: str | Path | None, out: str | Path, ove
     frame); the landmark model puts the contours right where they went astray
     (:class:`facemime.track.redetect.FaceTracker`)."""
     out = Path(out)
-    outputs = [out] + ([Path(overlay)] if overlay is not None else [])
+    if out.suffix.lower() != ".json":
+        raise InvalidInputError(f"the track file must end in .json, got {out.name!r}")
     if overlay is not None and Path(overlay).suffix.lower() not in CODECS:
         raise InvalidInputError(f"overlay video must end in .mp4 or .webm, got {Path(overlay).name!r}")
-    check_outputs(outputs, force)
-    with VideoReader(video) as reader:
+    paths = [out] + ([Path(overlay)] if overlay is not None else [])
+    with Outputs(paths, force, inputs=[video, init]) as outputs, VideoReader(video) as reader:
         start, contours = read_init(init, size=(reader.width, reader.height)) if init is not None else (0, None)
-        writer = VideoWriter(overlay, reader.fps) if overlay is not None else None
+        writer = VideoWriter(outputs.stage(overlay), reader.fps) if overlay is not None else None
         frames: list[dict] = []
         tracker: FaceTracker | None = None
         start_seconds, seconds, lost_frames, decoded = 0.0, 0.0, 0, 0
@@ -89,7 +91,7 @@ def track_video(video: str | Path, init: str | Path | None, out: str | Path, ove
             if tracker is None:
                 raise InvalidInputError(f"init frame {start} is beyond the last frame ({decoded - 1}) of {video}")
         info = {"width": reader.width, "height": reader.height, "fps": reader.fps, "frames": decoded}
-        write_json(out, track_document(info, frames, {"processing_seconds": round(start_seconds + seconds, 4), "frames_processed": len(frames)}))
+        write_json(outputs.stage(out), track_document(info, frames, {"processing_seconds": round(start_seconds + seconds, 4), "frames_processed": len(frames)}))
     first = "the first frame" if start == 0 else f"frame {start}"
     warnings = [f"{tracker.faces} faces found in {first} of {video}; tracking the largest"] if tracker.faces > 1 else []
     if init is None and start > 0:

@@ -1,0 +1,111 @@
+"""The input policy: the largest inputs facemime reads, each refused with one line before it
+is decoded or parsed. Every limit is generous for real use and can be raised by an environment
+variable (a whole number):
+
+- ``FACEMIME_MAX_IMAGE_PIXELS`` (default 100,000,000: a 12,000 × 8,000 photo): a still image's
+  width × height, read from its header before decoding (PNG, JPEG, WebP, BMP; OpenCV's own
+  guard, set to the same value, covers other types);
+- ``FACEMIME_MAX_JSON_BYTES`` (default 64 MiB): a JSON file (init, points, track, head model);
+  documents nested deeper than the parser's stack are refused too.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import struct
+from pathlib import Path
+from typing import Any
+
+from facemime.errors import InputFileError, InvalidInputError
+
+DEFAULTS = {"FACEMIME_MAX_IMAGE_PIXELS": 100_000_000, "FACEMIME_MAX_JSON_BYTES": 64 << 20}
+
+
+def limit(name: str) -> int:
+    """The limit ``name`` (a key of :data:`DEFAULTS`), from the environment when set there."""
+    value = os.environ.get(name)
+    if value is None:
+        return DEFAULTS[name]
+    try:
+        n = int(value)
+        if n <= 0:
+            raise ValueError
+    except ValueError:
+        raise InvalidInputError(f"{name} must be a positive whole number, got {value!r}") from None
+    return n
+
+
+# OpenCV's decoders check the same pixel limit for every image type (read once, at first use).
+os.environ.setdefault("OPENCV_IO_MAX_IMAGE_PIXELS", str(limit("FACEMIME_MAX_IMAGE_PIXELS")))
+
+
+def image_size(data: bytes) -> tuple[int, int] | None:
+    """(width, height) from the header of a PNG, JPEG, WebP or BMP file (its first bytes; a
+    JPEG's size may sit after its metadata, up to the first 256 KiB); None for other data."""
+    if len(data) >= 24 and data[:8] == b"\x89PNG\r\n\x1a\n":
+        return int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")  # the IHDR size
+    if len(data) >= 30 and data[:4] == b"RIFF" and data[8:12] == b"WEBP":
+        chunk = data[12:16]
+        if chunk == b"VP8X":  # 24-bit width - 1, height - 1
+            return int.from_bytes(data[24:27], "little") + 1, int.from_bytes(data[27:30], "little") + 1
+        if chunk == b"VP8 " and data[23:26] == b"\x9d\x01\x2a":  # lossy: 14-bit sizes after the start code
+            return int.from_bytes(data[26:28], "little") & 0x3FFF, int.from_bytes(data[28:30], "little") & 0x3FFF
+        if chunk == b"VP8L" and data[20] == 0x2F:  # lossless: 14-bit width - 1, height - 1
+            bits = int.from_bytes(data[21:25], "little")
+            return (bits & 0x3FFF) + 1, ((bits >> 14) & 0x3FFF) + 1
+        return None
+    if len(data) >= 26 and data[:2] == b"BM":
+        w, h = struct.unpack_from("<ii", data, 18)
+        return abs(w), abs(h)
+    if data[:2] == b"\xff\xd8":
+        at = 2
+        while at + 9 <= len(data):
+            if data[at] != 0xFF:
+                return None
+            marker = data[at + 1]
+            if marker in (0xD8, 0x01) or 0xD0 <= marker <= 0xD7:  # markers without a length
+                at += 2
+                continue
+            if 0xC0 <= marker <= 0xCF and marker not in (0xC4, 0xC8, 0xCC):  # a start of frame
+                h, w = struct.unpack_from(">HH", data, at + 5)
+                return w, h
+            at += 2 + int.from_bytes(data[at + 2:at + 4], "big")
+    return None
+
+
+def check_image_file(path: Path) -> None:
+    """Refuse an image file whose header declares more pixels than the policy allows."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(256 << 10)
+    except OSError as e:
+        raise InputFileError(f"cannot read {path}: {e.strerror or e}") from None
+    size = image_size(head)
+    most = limit("FACEMIME_MAX_IMAGE_PIXELS")
+    if size is not None and size[0] * size[1] > most:
+        raise InvalidInputError(f"{path} is {size[0]}x{size[1]} pixels, more than the {most} allowed "
+                                "(set FACEMIME_MAX_IMAGE_PIXELS to allow more)")
+
+
+def parse_json(text: str | bytes, where: str) -> Any:
+    """Parse JSON ``text``; a document nested too deeply for the parser is refused in one line
+    (``ValueError`` with the reason, like a malformed one)."""
+    try:
+        return json.loads(text)
+    except RecursionError:
+        raise ValueError(f"{where} is nested too deeply") from None
+
+
+def read_json_text(path: Path, what: str) -> bytes:
+    """The bytes of the JSON ``what`` file ``path``, refused when larger than the policy allows."""
+    if not path.is_file():
+        raise InputFileError(f"{what} file {path} does not exist" if not path.exists() else f"{what} file {path} is not a file")
+    size, most = path.stat().st_size, limit("FACEMIME_MAX_JSON_BYTES")
+    if size > most:
+        raise InvalidInputError(f"{what} file {path} is {size} bytes, more than the {most} allowed "
+                                "(set FACEMIME_MAX_JSON_BYTES to allow more)")
+    try:
+        return path.read_bytes()
+    except OSError as e:
+        raise InputFileError(f"cannot read {path}: {e.strerror or e}") from None

@@ -1,0 +1,203 @@
+"""Hostile input against every file-taking command: outputs that would replace an input, deeply
+nested or huge JSON, image bombs, damaged actor archives, mutated documents (hypothesis), and
+SIGTERM mid-run. Each must end in exit 1 with one ``facemime: error:`` line (or succeed), never a
+traceback, and leave no file behind."""
+
+import io
+import json
+import os
+import signal
+import struct
+import subprocess
+import sys
+import time
+import zipfile
+import zlib
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from facemime.io.actor_file import save_actor
+from facemime.io.contours_json import init_document, write_json
+from facemime.io.video import VideoWriter
+from facemime.track.synthetic import band_face
+
+from .test_cli import run
+
+DEEP = "[" * 100_000 + "]" * 100_000
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory, actor):
+    """A synthetic face video, its init, a photo, an actor file: the valid inputs."""
+    d = tmp_path_factory.mktemp("inputs")
+    with VideoWriter(d / "face.mp4", fps=25) as w:
+        for t in range(8):
+            w.write(band_face(shift=(0.5 * t, 0.0), opening=0.3 * t)[0])
+    write_json(d / "init.json", init_document(0, band_face()[1]))
+    save_actor(d / "a.actor", actor)
+    return d
+
+
+def one_line_error(code, out, err, message=""):
+    assert code == 1, err
+    assert out == "" and err.startswith("facemime: error:") and err.count("\n") == 1, err
+    assert "Traceback" not in err and message in err, err
+
+
+def listing(folder):
+    return sorted(p.name for p in folder.iterdir())
+
+
+def test_no_output_may_replace_an_input(files, tmp_path, capsys):
+    video, init, actor = files / "face.mp4", files / "init.json", files / "a.actor"
+    (tmp_path / "link.mp4").symlink_to(video)
+    (tmp_path / "link.json").symlink_to(init)
+    (tmp_path / "p.actor").symlink_to(init)
+    before = {p: p.read_bytes() for p in (video, init, actor)}
+    cases = [
+        (["track", str(video), "--init", str(init), "--out", str(video), "--force"], "must end in .json"),
+        (["track", str(video), "--init", str(init), "--out", str(tmp_path / "t.json"), "--overlay", str(video),
+          "--force"], "would replace the input"),
+        (["track", str(video), "--init", str(init), "--out", str(tmp_path / "link.json"), "--force"],
+         "would replace the input"),
+        (["track", str(video), "--out", str(tmp_path / "t.mp4"), "--overlay", str(tmp_path / "t.mp4")],
+         "must end in .json"),
+        (["run", str(video), "--out", str(video), "--force"], "would replace the input"),
+        (["run", str(video), "--out", str(tmp_path / "link.mp4"), "--force"], "would replace the input"),
+        (["run", str(video), "--actor", str(actor), "--out", str(tmp_path / "o.mp4"), "--track", str(actor),
+          "--force"], "must end in .json"),
+        (["run", str(video), "--actor", str(actor), "--out", str(tmp_path / "o.mp4"), "--track",
+          str(tmp_path / "o.json"), "--force"], ""),  # allowed: distinct files (the face is synthetic: an error)
+        (["encode", str(video), "--out", str(tmp_path / "link.mp4"), "--force"], "must end in .fmstream"),
+        (["fit", str(video), "--out", str(tmp_path / "p.actor"), "--points", str(tmp_path / "p.actor"), "--force"],
+         "would replace the input"),
+        (["model-preview", str(init), "--out", str(tmp_path / "link.json"), "--force"], "cannot write image"),
+    ]
+    for args, message in cases:
+        code, out, err = run(capsys, *args)
+        if code == 1:
+            one_line_error(code, out, err, message)
+        assert {p: p.read_bytes() for p in before} == before, args
+    (tmp_path / "s.fmstream").symlink_to(video)
+    code, out, err = run(capsys, "encode", str(video), "--out", str(tmp_path / "s.fmstream"), "--force")
+    one_line_error(code, out, err, "would replace the input")
+    assert {p: p.read_bytes() for p in before} == before
+
+
+def test_a_photos_preview_never_takes_its_name(tmp_path, capsys, astronaut):
+    photo = tmp_path / "face.png"
+    photo.write_bytes(astronaut.read_bytes())
+    code, out, err = run(capsys, "fit", str(photo), "--out", str(tmp_path / "face.actor"))
+    assert code == 0, err
+    assert out.split() == [str(tmp_path / "face.actor"), str(tmp_path / "face.preview.png")]
+    assert photo.read_bytes() == astronaut.read_bytes()
+
+
+def deep_actor(src, dst):
+    with zipfile.ZipFile(src) as z, zipfile.ZipFile(dst, "w") as out:
+        for info in z.infolist():
+            out.writestr(info.filename, DEEP if info.filename == "actor.json" else z.read(info))
+
+
+def crc_broken_actor(src, dst):
+    data = bytearray(src.read_bytes())
+    with zipfile.ZipFile(src) as z:
+        info = z.getinfo("actor.json")
+    start = info.header_offset + 30 + len(info.filename) + len(info.extra)
+    data[start + 10] ^= 0xFF  # inside the deflated actor.json: its CRC no longer matches
+    dst.write_bytes(bytes(data))
+
+
+def huge_png(path, side=30000):
+    ihdr = struct.pack(">IIBBBBB", side, side, 8, 2, 0, 0, 0)
+    chunk = b"IHDR" + ihdr
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + struct.pack(">I", 13) + chunk + struct.pack(">I", zlib.crc32(chunk))
+                     + b"\x00" * 100)
+
+
+def test_deep_huge_and_damaged_inputs_give_one_line(files, tmp_path, capsys, monkeypatch):
+    (tmp_path / "deep.json").write_text(DEEP)
+    deep_actor(files / "a.actor", tmp_path / "deep.actor")
+    crc_broken_actor(files / "a.actor", tmp_path / "crc.actor")
+    huge_png(tmp_path / "huge.png")
+    video, out = files / "face.mp4", tmp_path / "out"
+    out.mkdir()
+    cases = [
+        (["track", str(video), "--init", str(tmp_path / "deep.json"), "--out", str(out / "t.json")], "nested too deeply"),
+        (["fit", str(files / "face.mp4"), "--points", str(tmp_path / "deep.json"), "--out", str(out / "a.actor")],
+         "nested too deeply"),
+        (["model-preview", str(tmp_path / "deep.json"), "--out", str(out / "m.png")], ""),
+        (["run", str(video), "--actor", str(tmp_path / "deep.actor"), "--out", str(out / "o.mp4")], "nested too deeply"),
+        (["run", str(video), "--actor", str(tmp_path / "crc.actor"), "--out", str(out / "o.mp4")], "a.actor"[:0]),
+        (["fit", str(tmp_path / "huge.png"), "--out", str(out / "h.actor")], "30000x30000 pixels, more than"),
+    ]
+    for args, message in cases:
+        t0 = time.perf_counter()
+        one_line_error(*run(capsys, *args), message)
+        assert time.perf_counter() - t0 < 30, args  # refused, not worked through
+        assert listing(out) == [], args
+    monkeypatch.setenv("FACEMIME_MAX_JSON_BYTES", "100")
+    one_line_error(*run(capsys, "track", str(video), "--init", str(files / "init.json"), "--out", str(out / "t.json")),
+                   "more than the 100 allowed (set FACEMIME_MAX_JSON_BYTES")
+    assert listing(out) == []
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(st.data())
+def test_mutated_init_files_never_escape_as_a_traceback(files, tmp_path, capsys, data):
+    doc = json.loads((files / "init.json").read_text())
+    path = data.draw(st.sampled_from([["frame"], ["contours"], ["contours", "mouth_outer_upper"],
+                                      ["contours", "mouth_outer_upper", 0], ["format"], []]))
+    value = data.draw(st.one_of(st.none(), st.booleans(), st.integers(-10**12, 10**12), st.floats(allow_nan=True),
+                                st.text(max_size=5), st.lists(st.floats(), max_size=3), st.just({})))
+    target = doc
+    for key in path[:-1]:
+        target = target[key]
+    if path:
+        target[path[-1]] = value
+    else:
+        doc = value
+    init = tmp_path / "m.json"
+    init.write_text(json.dumps(doc))
+    out = tmp_path / "t.json"
+    out.unlink(missing_ok=True)
+    code, stdout, err = run(capsys, "track", str(files / "face.mp4"), "--init", str(init), "--out", str(out))
+    assert code in (0, 1) and "Traceback" not in err and "unexpected" not in err, err
+    if code == 1:
+        one_line_error(code, stdout, err) and not out.exists()
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(st.lists(st.tuples(st.integers(0, 10**7), st.integers(1, 255)), min_size=1, max_size=6))
+def test_mutated_actor_files_never_escape_as_a_traceback(files, tmp_path, capsys, edits):
+    data = bytearray((files / "a.actor").read_bytes())
+    for at, value in edits:
+        data[at % len(data)] ^= value
+    bad = tmp_path / "bad.actor"
+    bad.write_bytes(bytes(data))
+    out = tmp_path / "o.fmstream"
+    code, stdout, err = run(capsys, "decode", str(files / "none.fmstream"), "--actor", str(bad), "--out",
+                            str(tmp_path / "o.mp4"))
+    assert code == 1 and "Traceback" not in err and "unexpected" not in err and not out.exists(), err
+
+
+@pytest.mark.parametrize("command", ["run", "track"])
+def test_sigterm_stops_a_run_and_leaves_nothing(shared, tmp_path, command):
+    video = shared / "video" / "lp_d6.mp4"
+    out = tmp_path / ("o.mp4" if command == "run" else "t.json")
+    args = [sys.executable, "-m", "facemime", command, str(video), "--out", str(out)]
+    if command == "track":
+        args += ["--overlay", str(tmp_path / "o.mp4")]
+    proc = subprocess.Popen(args, stderr=subprocess.PIPE, text=True)
+    deadline = time.time() + 60
+    while not any(p.name.startswith(".") for p in tmp_path.iterdir()) and time.time() < deadline:
+        time.sleep(0.05)
+    time.sleep(0.5)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 128 + signal.SIGTERM, err
+    assert err.strip().endswith("facemime: terminated") and "Traceback" not in err
+    assert listing(tmp_path) == []
