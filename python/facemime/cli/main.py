@@ -239,8 +239,9 @@ def view(source: Path, actor_file: Path | None, port: int, no_browser: bool) -> 
             server.server_close()
 
 
-class Terminated(KeyboardInterrupt):
-    """SIGTERM or SIGHUP: the command stops as on Ctrl-C, removing its unfinished outputs."""
+class Terminated(BaseException):
+    """SIGTERM or SIGHUP: the command stops as on Ctrl-C, removing its unfinished outputs (a
+    BaseException, like KeyboardInterrupt, but not one: click would take it for Ctrl-C)."""
 
     def __init__(self, signum: int):
         super().__init__(signum)
