@@ -111,6 +111,18 @@ def crc_broken_actor(src, dst):
     dst.write_bytes(bytes(data))
 
 
+def bomb_actor(path, inflated=256 << 20):
+    """An actor whose actor.json says it holds 1000 bytes and inflates to ``inflated``."""
+    deflate = zlib.compressobj(9, zlib.DEFLATED, -15)
+    data = b"".join(deflate.compress(bytes(1 << 22)) for _ in range(inflated >> 22)) + deflate.flush()
+    name = b"actor.json"
+    local = struct.pack("<IHHHHHIIIHH", 0x04034B50, 20, 0, 8, 0, 0, 0, len(data), 1000, len(name), 0) + name
+    central = struct.pack("<IHHHHHHIIIHHHHHII", 0x02014B50, 20, 20, 0, 8, 0, 0, 0, len(data), 1000, len(name),
+                          0, 0, 0, 0, 0, 0) + name
+    end = struct.pack("<IHHHHIIH", 0x06054B50, 0, 0, 1, 1, len(central), len(local) + len(data), 0)
+    path.write_bytes(local + data + central + end)
+
+
 def huge_png(path, side=30000):
     ihdr = struct.pack(">IIBBBBB", side, side, 8, 2, 0, 0, 0)
     chunk = b"IHDR" + ihdr
@@ -123,6 +135,7 @@ def test_deep_huge_and_damaged_inputs_give_one_line(files, tmp_path, capsys, mon
     deep_actor(files / "a.actor", tmp_path / "deep.actor")
     crc_broken_actor(files / "a.actor", tmp_path / "crc.actor")
     huge_png(tmp_path / "huge.png")
+    bomb_actor(tmp_path / "bomb.actor")
     video, out = files / "face.mp4", tmp_path / "out"
     out.mkdir()
     cases = [
@@ -131,7 +144,8 @@ def test_deep_huge_and_damaged_inputs_give_one_line(files, tmp_path, capsys, mon
          "nested too deeply"),
         (["model-preview", str(tmp_path / "deep.json"), "--out", str(out / "m.png")], ""),
         (["run", str(video), "--actor", str(tmp_path / "deep.actor"), "--out", str(out / "o.mp4")], "nested too deeply"),
-        (["run", str(video), "--actor", str(tmp_path / "crc.actor"), "--out", str(out / "o.mp4")], "a.actor"[:0]),
+        (["run", str(video), "--actor", str(tmp_path / "crc.actor"), "--out", str(out / "o.mp4")], "crc.actor"),
+        (["run", str(video), "--actor", str(tmp_path / "bomb.actor"), "--out", str(out / "o.mp4")], "Bad CRC"),
         (["fit", str(tmp_path / "huge.png"), "--out", str(out / "h.actor")], "30000x30000 pixels, more than"),
     ]
     for args, message in cases:

@@ -84,13 +84,20 @@ def save_actor(path: str | Path, actor: Actor, force: bool = False) -> Path:
 
 
 def _member(z: zipfile.ZipFile, name: str, limit: int, where: str) -> bytes:
+    """The member ``name``, read in bounded pieces: one that says it is larger than ``limit``
+    is refused unread, and one that lies about its size (a bomb) is cut where it says it ends
+    (``ZipFile.read`` would inflate it whole first) and fails its checksum."""
     try:
         info = z.getinfo(name)
     except KeyError:
         raise ActorFileError(f"{where}: not a facemime actor (no {name} inside)") from None
     if info.file_size > limit:
         raise ActorFileError(f"{where}: {name} is {info.file_size} bytes, more than the {limit} allowed")
-    return z.read(info)
+    data = bytearray()
+    with z.open(info) as f:
+        while piece := f.read(1 << 16):
+            data += piece
+    return bytes(data)
 
 
 def load_actor(path: str | Path) -> Actor:
