@@ -215,3 +215,20 @@ def test_sigterm_stops_a_run_and_leaves_nothing(shared, tmp_path, command):
     assert proc.returncode == 128 + signal.SIGTERM, err
     assert err.strip().endswith("facemime: terminated") and "Traceback" not in err
     assert listing(tmp_path) == []
+
+
+def test_a_failed_demo_leaves_no_folder_it_made(tmp_path, capsys, monkeypatch):
+    import facemime.demo
+    from facemime.errors import InvalidInputError
+
+    def fail(*args, **kwargs):
+        raise InvalidInputError("stopped on purpose")
+
+    monkeypatch.setattr(facemime.demo, "Analysis", fail)
+    one_line_error(*run(capsys, "demo", "--out", str(tmp_path / "d")), "stopped on purpose")
+    assert listing(tmp_path) == []
+    (tmp_path / "kept").mkdir()
+    (tmp_path / "kept" / "mine.txt").write_text("mine")
+    one_line_error(*run(capsys, "demo", "--out", str(tmp_path / "kept")), "stopped on purpose")
+    assert listing(tmp_path / "kept") == ["mine.txt"]
+    one_line_error(*run(capsys, "demo", "--out", "/proc/facemime-demo"), "cannot write /proc/facemime-demo")
