@@ -3,9 +3,7 @@ nested or huge JSON, image bombs, damaged actor archives, mutated documents (hyp
 SIGTERM mid-run. Each must end in exit 1 with one ``facemime: error:`` line (or succeed), never a
 traceback, and leave no file behind."""
 
-import io
 import json
-import os
 import signal
 import struct
 import subprocess
@@ -14,7 +12,6 @@ import time
 import zipfile
 import zlib
 
-import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st

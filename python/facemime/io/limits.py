@@ -6,7 +6,11 @@ variable (a whole number):
   width × height, read from its header before decoding (PNG, JPEG, WebP, BMP; OpenCV's own
   guard, set to the same value, covers other types);
 - ``FACEMIME_MAX_JSON_BYTES`` (default 64 MiB): a JSON file (init, points, track, head model);
-  documents nested deeper than the parser's stack are refused too.
+  documents nested deeper than the parser's stack are refused too;
+- ``FACEMIME_MAX_VERTICES`` (200,000), ``FACEMIME_MAX_TRIANGLES`` (400,000),
+  ``FACEMIME_MAX_MODEL_BYTES`` (256 MiB) and ``FACEMIME_MAX_UNIT_VALUES`` (20,000,000:
+  deformation units × vertices): a head model (``.json``, ``.wfm``, the model inside an actor),
+  checked as its counts are read (:mod:`facemime.model.head`).
 """
 
 from __future__ import annotations
@@ -19,7 +23,9 @@ from typing import Any
 
 from facemime.errors import InputFileError, InvalidInputError
 
-DEFAULTS = {"FACEMIME_MAX_IMAGE_PIXELS": 100_000_000, "FACEMIME_MAX_JSON_BYTES": 64 << 20}
+DEFAULTS = {"FACEMIME_MAX_IMAGE_PIXELS": 100_000_000, "FACEMIME_MAX_JSON_BYTES": 64 << 20,
+            "FACEMIME_MAX_VERTICES": 200_000, "FACEMIME_MAX_TRIANGLES": 400_000, "FACEMIME_MAX_MODEL_BYTES": 256 << 20,
+            "FACEMIME_MAX_UNIT_VALUES": 20_000_000}
 
 
 def limit(name: str) -> int:
@@ -32,7 +38,7 @@ def limit(name: str) -> int:
         if n <= 0:
             raise ValueError
     except ValueError:
-        raise InvalidInputError(f"{name} must be a positive whole number, got {value!r}") from None
+        raise InvalidInputError(f"{name} must be a positive integer, got {value!r}") from None
     return n
 
 

@@ -3,11 +3,19 @@
 Coordinates are model space: right-handed, x to the subject's left, y up, z towards the camera.
 The generic head is in millimetres with its origin between the outer eye corners, which are
 90 mm apart. Triangles wind counter-clockwise seen from outside (normals point out of the face).
+
+Input policy (:mod:`facemime.io.limits`): every model loaded (``load_head``, ``load_wfm``, the
+model inside an actor file) may have at most 200,000 vertices, 400,000 triangles and 20,000,000
+deformation-unit values (units × vertices), and a model file at most 256 MiB; the variables
+``FACEMIME_MAX_VERTICES``, ``FACEMIME_MAX_TRIANGLES``, ``FACEMIME_MAX_UNIT_VALUES`` and
+``FACEMIME_MAX_MODEL_BYTES`` change them. A larger model is refused with
+:class:`ModelFormatError` before its arrays are built, a larger file before it is read.
 """
 
 from __future__ import annotations
 
 import json
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from importlib import resources
@@ -16,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from facemime.errors import InputFileError, InvalidInputError, ModelFormatError
+from facemime.io.limits import limit, parse_json
 
 HEAD_FORMAT = "facemime.head/1"
 
@@ -26,6 +35,43 @@ CONTOUR_GROUPS = (
 )
 #: Groups every facemime head file must have.
 REQUIRED_GROUPS = CONTOUR_GROUPS + ("eye_left", "eye_right", "nose", "face_outline")
+#: Default input limits, each overridden by its environment variable (see the module docstring).
+_COUNT_LIMITS = {"vertices": "FACEMIME_MAX_VERTICES", "triangles": "FACEMIME_MAX_TRIANGLES",
+                 "deformation unit values (units x vertices)": "FACEMIME_MAX_UNIT_VALUES"}
+
+
+def check_model_count(where: str, what: str, count: int) -> None:
+    """Refuse a model of more ``what`` (a key of ``_COUNT_LIMITS``) than the input policy allows
+    (:mod:`facemime.io.limits`) with a :class:`ModelFormatError` naming ``where``, the limit and
+    how to raise it."""
+    variable = _COUNT_LIMITS[what]
+    most = limit(variable)
+    if count > most:
+        raise ModelFormatError(f"{where}: the model has {count} {what}, more than the limit of {most}; "
+                               f"set {variable} to allow more")
+
+
+def read_model_file(path: Path) -> bytes:
+    """The bytes of a model file. A file over the byte limit is refused with
+    :class:`ModelFormatError` before it is read (or, when its size is unknown, after one byte
+    more than the limit); a missing or unreadable one with :class:`InputFileError`."""
+    most = limit("FACEMIME_MAX_MODEL_BYTES")
+    too_big = f"more than the limit of {most} bytes; set FACEMIME_MAX_MODEL_BYTES to allow more"
+    try:
+        with path.open("rb") as f:
+            size = os.fstat(f.fileno()).st_size
+            if size > most:
+                raise ModelFormatError(f"{path}: the model file has {size} bytes, {too_big}")
+            data = f.read(most + 1)
+    except FileNotFoundError:
+        raise InputFileError(f"{path}: no such model file") from None
+    except IsADirectoryError:
+        raise InputFileError(f"{path}: is a folder, expected a model file") from None
+    except OSError as e:
+        raise InputFileError(f"{path}: cannot read model file ({e.strerror})") from None
+    if len(data) > most:
+        raise ModelFormatError(f"{path}: the model file has {too_big}")
+    return data
 
 
 @dataclass(frozen=True, eq=False)
@@ -120,19 +166,13 @@ def load_head(path: str | Path) -> HeadModel:
     """Load and validate a ``facemime.head/1`` JSON model file.
 
     Raises :class:`InputFileError` if it cannot be read and :class:`ModelFormatError`, naming the
-    file and the problem, if it is not a valid model.
+    file and the problem, if it is not a valid model or is over a limit (see the module docstring).
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise InputFileError(f"{path}: no such model file") from None
+        text = read_model_file(path).decode("utf-8")
     except UnicodeDecodeError:
         raise ModelFormatError(f"{path}: not a text file; expected a {HEAD_FORMAT} JSON model") from None
-    except IsADirectoryError:
-        raise InputFileError(f"{path}: is a folder, expected a model file") from None
-    except OSError as e:
-        raise InputFileError(f"{path}: cannot read model file ({e.strerror})") from None
     return _parse_head(text, str(path))
 
 
@@ -144,9 +184,11 @@ def generic_head() -> HeadModel:
 
 def _parse_head(text: str, where: str) -> HeadModel:
     try:
-        doc = json.loads(text)
+        doc = parse_json(text, where)
     except json.JSONDecodeError as e:
         raise ModelFormatError(f"{where}: not valid JSON ({e.msg} at line {e.lineno})") from None
+    except ValueError as e:
+        raise ModelFormatError(str(e)) from None
     return head_from_document(doc, where)
 
 
@@ -173,10 +215,17 @@ def head_document(model: HeadModel) -> dict:
 
 def head_from_document(doc: object, where: str) -> HeadModel:
     """Validate a parsed ``facemime.head/1`` document and build the model; a
-    :class:`ModelFormatError` naming ``where`` and the problem otherwise."""
+    :class:`ModelFormatError` naming ``where`` and the problem otherwise (also for a model over
+    the vertex or triangle limit, checked on the lists' lengths before any array is built)."""
     if not isinstance(doc, dict) or doc.get("format") != HEAD_FORMAT:
         found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
         raise ModelFormatError(f"{where}: expected format {HEAD_FORMAT!r}, got {found!r}")
+    for what in ("vertices", "triangles"):
+        if isinstance(doc.get(what), list):
+            check_model_count(where, what, len(doc[what]))
+    if isinstance(doc.get("vertices"), list) and isinstance(doc.get("deformation_units"), dict):
+        check_model_count(where, "deformation unit values (units x vertices)",
+                          len(doc["vertices"]) * len(doc["deformation_units"]))
     try:
         vertices = np.asarray(doc["vertices"], dtype=np.float64)
         n = len(vertices)

@@ -11,19 +11,26 @@ the model follows facemime's right-handed convention (x to the subject's left, y
 the camera). The mirror also turns CANDIDE's face order (clockwise seen from outside) into
 facemime's outward, counter-clockwise winding. The unit stays CANDIDE's own (about 1 = half
 the face height).
+
+Models over the input limits (vertices, triangles, file bytes; ``FACEMIME_MAX_VERTICES``,
+``FACEMIME_MAX_TRIANGLES``, ``FACEMIME_MAX_MODEL_BYTES``, see :mod:`facemime.model.head`) are
+refused: a too-large file before it is read, a too-large vertex or face count as soon as its
+count line is read, before the rest of the file is split into lines.
 """
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import numpy as np
 
-from facemime.errors import InputFileError, InvalidInputError, ModelFormatError
-from facemime.model.head import HeadModel
+from facemime.errors import InvalidInputError, ModelFormatError
+from facemime.model.head import HeadModel, check_model_count, read_model_file
 
 _SECTIONS = ("VERTEX LIST", "FACE LIST", "ANIMATION UNITS LIST", "SHAPE UNITS LIST",
              "ANIMATION PARAMETERS", "SHAPE PARAMETERS", "TEXTURE", "END OF FILE")
+_COUNTED = {"VERTEX LIST": "vertices", "FACE LIST": "triangles"}  # sections whose count has a limit
 
 
 class _Lines:
@@ -52,6 +59,21 @@ class _Lines:
             self.pos -= 1
             raise self.fail(f"expected {count} {'integers' if kind is int else 'numbers'}, got {' '.join(parts)!r}") from None
 
+    def table(self, rows: int, columns: int, kind: type) -> np.ndarray:
+        """The next ``rows`` lines as a (rows, columns) float64 or int64 array (``kind`` float or
+        int): numpy's parser first, then line by line, naming the first bad line, if that fails."""
+        dtype = np.int64 if kind is int else np.float64
+        chunk = [line for _, line in self.lines[self.pos:self.pos + rows]]
+        if rows and len(chunk) == rows:
+            try:
+                table = np.loadtxt(io.StringIO("\n".join(chunk)), dtype=dtype, comments=None, ndmin=2)
+            except (ValueError, OverflowError):
+                table = None
+            if table is not None and table.shape == (rows, columns):
+                self.pos += rows
+                return table
+        return np.array([self.numbers(columns, kind) for _ in range(rows)], dtype=dtype).reshape(-1, columns)
+
     def count(self) -> int:
         (n,) = self.numbers(1, int)
         if n < 0:
@@ -64,46 +86,57 @@ def load_wfm(path: str | Path) -> HeadModel:
 
     Animation units become ``units``, shape units ``shape_units`` (each named as in the file);
     the file's texture coordinates become ``uv``. The model has no named vertex groups.
-    Raises :class:`InputFileError` or :class:`ModelFormatError` naming the file, section and line.
+    Raises :class:`InputFileError` or :class:`ModelFormatError` naming the file, section and line;
+    a model over an input limit (see the module docstring) is a :class:`ModelFormatError` too.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="latin-1")
-    except FileNotFoundError:
-        raise InputFileError(f"{path}: no such model file") from None
-    except OSError as e:
-        raise InputFileError(f"{path}: cannot read model file ({e.strerror})") from None
+    data = read_model_file(path)
+    if b"\n" not in data:
+        data = data.replace(b"\r", b"\n")  # classic Mac line ends
     where = str(path)
-    # Split at known section titles only: unit names are "# ..." lines inside their section.
+    # Split at known section titles only: unit names are "# ..." lines inside their section. The
+    # lines are taken one by one from the file's bytes (shared, not copied) so that a too-large
+    # count is refused before the rest is split.
     sections: dict[str, list[tuple[int, str]]] = {}
     current: list[tuple[int, str]] | None = None
-    for lineno, raw in enumerate(text.splitlines(), 1):
-        line = raw.strip()
+    for lineno, raw in enumerate(io.BytesIO(data), 1):
+        line = raw.decode("latin-1").strip()
         if not line:
             continue
         head = line.lstrip("#").strip().rstrip(":").upper()
         if line.startswith("#") and head in _SECTIONS:
-            current = sections.setdefault(head, [])
+            section, current = head, sections.setdefault(head, [])
         elif current is not None:
             current.append((lineno, line))
+            if len(current) == 1 and section in _COUNTED:  # the count line: refuse a too-large model now
+                try:
+                    declared = int(line)
+                except ValueError:
+                    declared = 0  # not a count: the section's parser names the problem
+                check_model_count(f"{where}: {section}, line {lineno}", _COUNTED[section], declared)
     for required in ("VERTEX LIST", "FACE LIST"):
         if required not in sections:
             raise ModelFormatError(f"{where}: no '# {required}:' section; is this a CANDIDE .wfm file?")
 
     s = _Lines(where, "VERTEX LIST", sections["VERTEX LIST"])
-    vertices = np.array([s.numbers(3, float) for _ in range(s.count())], dtype=np.float64).reshape(-1, 3)
+    vertices = s.table(s.count(), 3, float)
     n = len(vertices)
     s = _Lines(where, "FACE LIST", sections["FACE LIST"])
-    faces = np.array([s.numbers(3, int) for _ in range(s.count())], dtype=np.int64).reshape(-1, 3)
+    faces = s.table(s.count(), 3, int)
     if faces.size and (faces.min() < 0 or faces.max() >= n):
         raise ModelFormatError(f"{where}: FACE LIST uses vertex {int(faces.max() if faces.max() >= n else faces.min())}, but there are {n} vertices")
+
+    total = [0]  # deformation units so far, both sections
 
     def units(section: str) -> dict[str, np.ndarray]:
         s = _Lines(where, section, sections.get(section, []))
         if not s.lines:
             return {}
         out: dict[str, np.ndarray] = {}
-        for k in range(s.count()):
+        count = s.count()
+        total[0] += count
+        check_model_count(f"{where}: {section}", "deformation unit values (units x vertices)", total[0] * n)
+        for k in range(count):
             name = s.next()
             if not name.startswith("#"):
                 s.pos -= 1
@@ -122,7 +155,7 @@ def load_wfm(path: str | Path) -> HeadModel:
     uv = None
     if sections.get("TEXTURE"):
         s = _Lines(where, "TEXTURE", sections["TEXTURE"])
-        uv = np.array([s.numbers(2, float) for _ in range(n)], dtype=np.float64)
+        uv = s.table(n, 2, float)
     model_units = units("ANIMATION UNITS LIST")
     shape_units = units("SHAPE UNITS LIST")
     try:  # the model's own validation names what is wrong (degenerate triangle, ...)

@@ -1,4 +1,5 @@
-"""Pictures of a head model: textured (the Rust rasteriser), flat-shaded and wireframe views.
+"""Pictures of a head model: textured and flat-shaded (both by the Rust rasteriser) and
+wireframe views.
 
 Poses and coordinates as in :mod:`facemime.render.projection`.
 """
@@ -38,34 +39,44 @@ def render_head(
 
 def render_shaded(model: HeadModel, pose: Pose, size: tuple[int, int], *, vertices: np.ndarray | None = None,
                   colour: tuple[int, int, int] = (205, 180, 160), background: int = 255) -> np.ndarray:
-    """Flat Lambert shading of the front faces, far to near: an (H, W, 3) preview image."""
+    """Flat Lambert shading of the front faces, far to near: an (H, W, 3) preview image of
+    ``size`` = (width, height) pixels, drawn by the Rust rasteriser.
+
+    Each face gets its own three corners, all on the texel of its colour in a one-row palette
+    texture, so the nearest-texel fill paints the face in one flat colour. Edges are not
+    anti-aliased (a wireframe drawn on top covers them).
+    """
     v = model.vertices if vertices is None else vertices
     points, depth = project(v, pose)
-    w, h = size
-    img = np.full((h, w, 3), background, np.uint8)
     t = model.triangles
     a, b, c = v[t[:, 0]], v[t[:, 1]], v[t[:, 2]]
     normals = np.cross(b - a, c - a)
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)
     view_normals = normals @ rotation_matrix(pose.yaw, pose.pitch, pose.roll).T
     light = 0.25 + 0.75 * np.clip(view_normals @ LIGHT, 0, 1)
-    order = np.argsort(depth[t].mean(axis=1))
-    for f in order:
-        if view_normals[f, 2] <= 0:
-            continue  # back face
-        poly = np.round(points[t[f]] * 16).astype(np.int32)
-        cv2.fillConvexPoly(img, poly, tuple(float(light[f] * ch) for ch in colour), cv2.LINE_AA, 4)
-    return img
+    shades = np.clip(np.round(light[:, None] * np.asarray(colour, np.float64)), 0, 255).astype(np.int64)
+    palette_keys, face_texel = np.unique(shades @ [1 << 16, 1 << 8, 1], return_inverse=True)  # RGB as one int
+    palette = ((palette_keys[:, None] >> [16, 8, 0]) & 255).astype(np.uint8)[None]
+    uv = np.empty((len(t), 2))
+    uv[:, 0] = (face_texel + 0.5) / len(palette_keys)
+    uv[:, 1] = 0.5
+    corners = t.ravel()
+    return render_mesh(palette, np.repeat(uv, 3, axis=0), points[corners], depth[corners],
+                       np.arange(len(corners)).reshape(-1, 3), size, background=background, filter="nearest")
 
 
 def draw_wireframe(image: np.ndarray, points: np.ndarray, triangles: np.ndarray,
                    colour: tuple[int, int, int] = (40, 220, 90), thickness: int = 1) -> np.ndarray:
     """Draw every triangle edge of a projected mesh (``points`` (N, 2) pixels) onto ``image``
     in place and return it."""
-    edges = np.sort(np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]]), axis=1)
-    for i, j in np.unique(edges, axis=0):
-        p, q = (np.round(points[[i, j]] * 16).astype(int)).tolist()
-        cv2.line(image, tuple(p), tuple(q), colour, thickness, cv2.LINE_AA, 4)
+    n = len(points)
+    t = np.asarray(triangles, np.int64)
+    following = np.roll(t, -1, axis=1)  # edges 0-1, 1-2, 2-0 of each triangle
+    keys = np.sort((np.minimum(t, following) * n + np.maximum(t, following)).ravel())
+    keys = keys[np.diff(keys, prepend=-1) != 0]  # each edge once, lowest vertex pair first
+    ends = np.round(np.asarray(points) * 16).astype(np.int32)  # 4 fractional bits (shift=4)
+    segments = np.stack([ends[keys // n], ends[keys % n]], axis=1)
+    cv2.polylines(image, list(segments), False, colour, thickness, cv2.LINE_AA, 4)
     return image
 
 
