@@ -229,3 +229,39 @@ def test_a_failed_demo_leaves_no_folder_it_made(tmp_path, capsys, monkeypatch):
     one_line_error(*run(capsys, "demo", "--out", str(tmp_path / "kept")), "stopped on purpose")
     assert listing(tmp_path / "kept") == ["mine.txt"]
     one_line_error(*run(capsys, "demo", "--out", "/proc/facemime-demo"), "cannot write /proc/facemime-demo")
+
+
+def mutate(doc, data):
+    """``doc`` with one value somewhere in it replaced by an odd one (hypothesis draws both)."""
+    paths, stack = [[]], [([], doc)]
+    while stack:
+        path, node = stack.pop()
+        items = node.items() if isinstance(node, dict) else enumerate(node) if isinstance(node, list) else []
+        for key, child in list(items)[:6]:
+            paths.append(path + [key])
+            stack.append((path + [key], child))
+    path = data.draw(st.sampled_from(paths))
+    value = data.draw(st.one_of(st.none(), st.booleans(), st.integers(-10**12, 10**12), st.floats(allow_nan=True),
+                                st.text(max_size=5), st.lists(st.floats(), max_size=3), st.just({}), st.just([[]])))
+    if not path:
+        return value
+    target = doc
+    for key in path[:-1]:
+        target = target[key]
+    target[path[-1]] = value
+    return doc
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(st.data())
+def test_mutated_points_and_head_models_never_escape_as_a_traceback(tmp_path, capsys, astronaut, data):
+    from facemime.model import generic_head
+    from facemime.model.head import head_document
+
+    head = tmp_path / "head.json"
+    head.write_text(json.dumps(mutate(head_document(generic_head()), data)))
+    out = tmp_path / "h.png"
+    out.unlink(missing_ok=True)
+    code, stdout, err = run(capsys, "model-preview", str(head), "--out", str(out))
+    assert code in (0, 1) and "Traceback" not in err and "unexpected" not in err, err
+    assert code == 0 or not out.exists()
