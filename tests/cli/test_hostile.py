@@ -12,6 +12,7 @@ import time
 import zipfile
 import zlib
 
+import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -265,3 +266,29 @@ def test_mutated_points_and_head_models_never_escape_as_a_traceback(tmp_path, ca
     code, stdout, err = run(capsys, "model-preview", str(head), "--out", str(out))
     assert code in (0, 1) and "Traceback" not in err and "unexpected" not in err, err
     assert code == 0 or not out.exists()
+
+
+@pytest.fixture(scope="module")
+def bad_videos(tmp_path_factory, files):
+    """Videos that cannot be tracked: missing, empty, random bytes, a text file, a zero-frame
+    MP4 (its header only), a blank picture (no face)."""
+    d = tmp_path_factory.mktemp("bad")
+    (d / "empty.mp4").write_bytes(b"")
+    (d / "random.mp4").write_bytes(np.random.default_rng(0).integers(0, 256, 50_000, dtype=np.uint8).tobytes())
+    (d / "text.mp4").write_text("not a video\n" * 100)
+    (d / "header.mp4").write_bytes((files / "face.mp4").read_bytes()[:48])
+    with VideoWriter(d / "blank.mp4", fps=25) as w:
+        for _ in range(5):
+            w.write(np.full((128, 128, 3), 90, np.uint8))
+    return d
+
+
+@pytest.mark.parametrize("name", ["missing.mp4", "empty.mp4", "random.mp4", "text.mp4", "header.mp4", "blank.mp4"])
+def test_bad_videos_give_one_line_to_every_command(bad_videos, tmp_path, capsys, name):
+    video = str(bad_videos / name)
+    for args in (["track", video, "--out", str(tmp_path / "t.json"), "--overlay", str(tmp_path / "o.mp4")],
+                 ["run", video, "--out", str(tmp_path / "o.mp4")],
+                 ["encode", video, "--out", str(tmp_path / "s.fmstream")],
+                 ["fit", video, "--out", str(tmp_path / "a.actor")]):
+        one_line_error(*run(capsys, *args))
+        assert listing(tmp_path) == [], args
