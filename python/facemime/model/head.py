@@ -36,6 +36,9 @@ CONTOUR_GROUPS = (
 #: Groups every facemime head file must have.
 REQUIRED_GROUPS = CONTOUR_GROUPS + ("eye_left", "eye_right", "nose", "face_outline")
 #: Default input limits, each overridden by its environment variable (see the module docstring).
+#: Largest vertex coordinate, model units (a face is some hundreds of millimetres; a farther vertex
+#: is a broken file, and would overflow the pixel arithmetic of previews).
+MAX_COORDINATE = 1e6
 _COUNT_LIMITS = {"vertices": "FACEMIME_MAX_VERTICES", "triangles": "FACEMIME_MAX_TRIANGLES",
                  "deformation unit values (units x vertices)": "FACEMIME_MAX_UNIT_VALUES"}
 
@@ -141,6 +144,8 @@ def _first_problem(
     n = len(v)
     if not np.isfinite(v).all():
         return "vertices hold NaN or inf"
+    if np.abs(v).max() > MAX_COORDINATE:
+        return f"a vertex lies {np.abs(v).max():.3g} from the origin, beyond the {MAX_COORDINATE:g} model units allowed"
     if not (isinstance(t, np.ndarray) and t.ndim == 2 and t.shape[1] == 3 and len(t) >= 1):
         return f"triangles must have shape (F, 3) with F >= 1, got {getattr(t, 'shape', type(t).__name__)}"
     if t.min() < 0 or t.max() >= n:
