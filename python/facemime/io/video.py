@@ -1,8 +1,11 @@
-"""Video input (any FFmpeg-readable file, decoded to RGB) and video output that browsers play: H.264 in MP4 (``.mp4``) or VP9 in WebM (``.webm``),
-4:2:0 chroma, encoded by FFmpeg through PyAV. Frames are RGB uint8 (H, W, 3)."""
+"""Video input (any FFmpeg-readable file, decoded to RGB, turned upright as its container says) and video output that
+browsers play: H.264 in MP4 (``.mp4``) or VP9 in WebM (``.webm``), 4:2:0 chroma, encoded by FFmpeg through PyAV.
+Frames are RGB uint8 (H, W, 3)."""
 
 from __future__ import annotations
 
+import itertools
+import math
 import os
 import queue
 import threading
@@ -19,8 +22,18 @@ from av.video.reformatter import VideoReformatter
 from facemime.errors import InputFileError, InvalidInputError, OutputFileError
 from facemime.io.outputs import temporary_sibling
 
+# VP9 in real time makes no use of frames held back ("lag"): a video of the same size (0.1 % apart), without 25 raw
+# frames held (0.7 GB at 7680x2160).
 CODECS = {".mp4": ("libx264", {"crf": "20", "preset": "veryfast", "movflags": "+faststart"}),
-          ".webm": ("libvpx-vp9", {"crf": "32", "b": "0", "deadline": "realtime", "cpu-used": "8"})}
+          ".webm": ("libvpx-vp9", {"crf": "32", "b": "0", "deadline": "realtime", "cpu-used": "8",
+                                   "lag-in-frames": "0"})}
+#: Frames of more pixels than 4K UHD's are encoded by x264 without B-frames and look-ahead
+#: ("zerolatency"): 0.9 GB less memory at 7680x2160 (a 4K video beside its synthesis), files
+#: somewhat larger.
+LARGE_FRAME = 3840 * 2160
+#: Frames of more pixels than 1920x1080 are decoded by 2 threads (each holds a frame: 25 MB at 3840x2160), not
+#: FFmpeg's one more than the cores: 2 decode 3840x2160 H.264 at 60 frames/s, the tracker takes 12.
+LARGE_DECODE = 1920 * 1080
 
 
 class VideoWriter:
@@ -28,10 +41,11 @@ class VideoWriter:
     writer closes without an error (a failed run leaves nothing behind).
 
     Frame sizes must be even (4:2:0); odd sizes are padded by one pixel of the edge colour.
-    Frames are encoded on a thread of the writer's own, beside the caller's work: :meth:`write`
-    converts a frame to the encoder's 4:2:0 layout (so the caller may reuse its buffer at once)
-    and waits only while :data:`QUEUED` frames are still to be encoded. An encoding error is
-    raised by the next :meth:`write` or on closing.
+    ``fps`` is any positive, finite frame rate (frames per second). Frames are encoded on a thread
+    of the writer's own, beside the caller's work: :meth:`write` converts a frame to the
+    encoder's 4:2:0 layout (so the caller may reuse its buffer at once) and waits only while
+    :data:`QUEUED` frames, or as many as fit in :data:`QUEUED_BYTES`, are still to be encoded.
+    An encoding error is raised by the next :meth:`write` or on closing.
 
     >>> import tempfile, pathlib
     >>> out = pathlib.Path(tempfile.mkdtemp()) / "clip.mp4"
@@ -44,18 +58,20 @@ class VideoWriter:
 
     #: Frames converted and waiting for the encoder at most.
     QUEUED = 4
+    #: Bytes of converted frames waiting for the encoder at most (but one frame at least).
+    QUEUED_BYTES = 32 * 2**20
 
     def __init__(self, path: str | Path, fps: float):
         self.path = Path(path)
         if self.path.suffix.lower() not in CODECS:
             raise InvalidInputError(f"video output must end in .mp4 or .webm, got {self.path.name!r}")
-        if not (0 < fps <= 240):
-            raise InvalidInputError(f"fps must be in (0, 240], got {fps}")
+        if not (0 < fps < math.inf):
+            raise InvalidInputError(f"fps must be positive and finite, got {fps}")
         self.fps = Fraction(fps).limit_denominator(1001)
         self._tmp: Path | None = None
         self._container = None
         self._stream = None
-        self._queue: queue.Queue[np.ndarray | None] = queue.Queue(self.QUEUED)
+        self._queue: queue.Queue[np.ndarray | None] | None = None
         self._encoder: threading.Thread | None = None
         self._error: BaseException | None = None
         self._cancelled = False
@@ -81,11 +97,16 @@ class VideoWriter:
             self._stream = self._container.add_stream(codec, rate=self.fps)
             self._stream.width, self._stream.height = frame.shape[1], frame.shape[0]
             self._stream.pix_fmt = "yuv420p"
-            self._stream.options = {k: v for k, v in options.items() if k != "movflags"}
+            pixels = frame.shape[0] * frame.shape[1]
+            large = {"tune": "zerolatency"} if codec == "libx264" and pixels > LARGE_FRAME else {}
+            self._stream.options = {k: v for k, v in options.items() if k != "movflags"} | large
+            i420_bytes = pixels * 3 // 2
+            self._queue = queue.Queue(max(1, min(self.QUEUED, self.QUEUED_BYTES // i420_bytes)))
             self._encoder = threading.Thread(target=self._encode, name=f"encoder {self.path.name}", daemon=True)
             self._encoder.start()
         elif (frame.shape[1], frame.shape[0]) != (self._stream.width, self._stream.height):
-            raise InvalidInputError(f"video frame size changed from {self._stream.width}x{self._stream.height} to {w}x{h}")
+            raise InvalidInputError(f"video frame size changed from {self._stream.width}x{self._stream.height} "
+                                    f"to {w}x{h}")
         # OpenCV's RGB -> I420 (BT.601, limited range, as FFmpeg's default) takes a tenth of
         # the time of the encoder's own conversion.
         self._queue.put(cv2.cvtColor(np.ascontiguousarray(frame), cv2.COLOR_RGB2YUV_I420))
@@ -134,21 +155,34 @@ class VideoWriter:
 
 
 class VideoReader:
-    """Decode a video file into RGB uint8 (H, W, 3) frames, in order.
+    """Decode a video file into RGB uint8 (H, W, 3) frames, in order, the right way up.
 
-    ``width``, ``height`` (pixels), ``fps`` and ``frames`` (the container's frame count, 0 when
-    unknown) are known after opening. A missing or unreadable file, or a file with no video
-    stream, raises :class:`InputFileError` with one line naming it.
+    ``width``, ``height`` (pixels, as displayed), ``fps`` (frames per second), ``frames`` (the
+    container's frame count, 0 when unknown) and ``rotation`` (degrees counter-clockwise that
+    every frame is turned by: the container's display rotation, as phones write it, or its
+    ``rotate`` tag, in quarter turns) are known after opening, which decodes the first frame.
+    A missing or unreadable file, a file with no video stream or none of whose frames decodes,
+    raises :class:`InputFileError` with one line naming it.
 
-    Frames are decoded on a thread of the reader's own, at most :data:`AHEAD` ahead of the
-    caller, so that decoding runs beside the caller's work on the frames already given; a
-    decoding error is raised, as :class:`InputFileError`, where the caller's iteration reaches
-    it. Stopping early (``break``, or :meth:`close`) stops the decoding.
+    Frames are decoded on a thread of the reader's own, at most :data:`AHEAD` (and no more than
+    :data:`AHEAD_BYTES`) ahead of the caller, so that decoding runs beside the caller's work on
+    the frames already given; an error of the file or of the conversion to RGB is raised, as
+    :class:`InputFileError`, where the caller's iteration reaches it. A damaged packet that does
+    not decode is skipped, as players do. Stopping early (``break``, or :meth:`close`) stops the
+    decoding. ``decoded`` counts the frames given; ``warnings`` lists, one line each, what was
+    wrong with the file once an iteration has reached its end: fewer frames than the container
+    declares (a truncated file), damaged packets skipped.
     """
 
     #: Frames decoded and waiting for the caller at most (2, 4 and 8 gave the same speed to
     #: ``facemime track``; fewer frames hold less memory on large videos).
     AHEAD = 4
+    #: Bytes of frames decoded and waiting for the caller at most (but one frame at least):
+    #: 4 frames to 1920x1080, 1 of 3840x2160.
+    AHEAD_BYTES = 32 * 2**20
+    #: Frames fewer than the container declares that pass without a warning (counts that
+    #: containers round).
+    SHORT_OK = 2
 
     def __init__(self, path: str | Path):
         self.path = Path(path)
@@ -165,20 +199,54 @@ class VideoReader:
             raise InputFileError(f"cannot read video {self.path}: it has no video stream")
         self._stream = self._container.streams.video[0]
         self._stream.thread_type = "AUTO"
-        self.width, self.height = self._stream.codec_context.width, self._stream.codec_context.height
+        codec = self._stream.codec_context
+        if codec.width * codec.height > LARGE_DECODE:
+            codec.thread_count = 2
+        self.damaged = 0
+        self._source = self._packets_decoded()
+        try:
+            self._first: av.VideoFrame | None = next(self._source, None)
+        except (av.FFmpegError, OSError) as e:
+            self._container.close()
+            raise InputFileError(f"cannot read video {self.path}: {_reason(e)}") from None
+        if self._first is None:
+            self._container.close()
+            raise InputFileError(f"video {self.path} has no decodable frames")
+        quarters = round(self._first.rotation / 90) or round(-_rotate_tag(self._stream.metadata) / 90)
+        self.rotation = 90 * (quarters % 4)
+        self._turn = {90: cv2.ROTATE_90_COUNTERCLOCKWISE, 180: cv2.ROTATE_180,
+                      270: cv2.ROTATE_90_CLOCKWISE}.get(self.rotation)
+        self.width, self.height = self._first.width, self._first.height
+        if self.rotation in (90, 270):
+            self.width, self.height = self.height, self.width
         rate = self._stream.average_rate or self._stream.guessed_rate
-        self.fps = float(rate) if rate else 25.0
+        self.fps = float(rate) if rate and 0 < float(rate) < math.inf else 25.0
         self.frames = int(self._stream.frames or 0)
+        self.decoded = 0
+        self.warnings: list[str] = []
+        self._ahead = max(1, min(self.AHEAD, self.AHEAD_BYTES // (self.width * self.height * 3)))
         # One converter for all frames: ``VideoFrame.to_ndarray`` sets up a new one per frame.
         self._to_rgb = VideoReformatter()
         self._decoding: tuple[threading.Thread, threading.Event, queue.Queue] | None = None
-        if self.width <= 0 or self.height <= 0:
-            self._container.close()
-            raise InputFileError(f"cannot read video {self.path}: no frame size in its stream")
+
+    def _packets_decoded(self) -> Iterator[av.VideoFrame]:
+        """The stream's frames. A packet the demuxer marks corrupt (as the last one of a truncated
+        file: decoded, it costs the frames being decoded beside it) or the decoder refuses is
+        counted in ``damaged`` and skipped."""
+        for packet in self._container.demux(self._stream):
+            if packet.is_corrupt:
+                self.damaged += 1
+                continue
+            try:
+                frames = self._stream.decode(packet)
+            except av.FFmpegError:
+                self.damaged += 1
+                continue
+            yield from frames
 
     def __iter__(self) -> Iterator[np.ndarray]:
         self._stop_decoding()
-        frames: queue.Queue[np.ndarray | BaseException | None] = queue.Queue(self.AHEAD)
+        frames: queue.Queue[np.ndarray | BaseException | object | None] = queue.Queue(self._ahead)
         stop = threading.Event()
         decoder = threading.Thread(target=self._decode, args=(frames, stop), name=f"decoder {self.path.name}",
                                    daemon=True)
@@ -186,27 +254,44 @@ class VideoReader:
         decoder.start()
         try:
             while (item := frames.get()) is not None:
+                if item is _END:
+                    self._check_end()
+                    break
                 if isinstance(item, BaseException):
                     raise item
+                self.decoded += 1
                 yield item
         finally:
             self._stop_decoding()
 
     def _decode(self, frames: queue.Queue, stop: threading.Event) -> None:
-        """The decoder thread: queues each frame, then None at the end or the error that ended
-        it; returns once ``stop`` is set."""
+        """The decoder thread: queues each frame, then :data:`_END` at the end of the file or
+        the error that ended it; returns once ``stop`` is set."""
         try:
-            for frame in self._container.decode(self._stream):
+            source = self._source if self._first is None else itertools.chain([self._first], self._source)
+            self._first = None
+            for frame in source:
                 # One thread: FFmpeg's threaded conversion costs twice the time on a small frame.
-                frames.put(self._to_rgb.reformat(frame, format="rgb24", threads=1).to_ndarray())
+                rgb = self._to_rgb.reformat(frame, format="rgb24", threads=1).to_ndarray()
+                frames.put(rgb if self._turn is None else cv2.rotate(rgb, self._turn))
                 if stop.is_set():
                     return
-            end: BaseException | None = None
+            end: BaseException | object = _END
         except (av.FFmpegError, OSError) as e:
             end = InputFileError(f"cannot decode video {self.path}: {_reason(e)}")
         except BaseException as e:  # noqa: BLE001 (an unexpected error, raised as it is in the caller's thread)
             end = e
         frames.put(end)
+
+    def _check_end(self) -> None:
+        """Set ``warnings`` once the file's end is reached."""
+        self.warnings = []
+        if self.frames - self.decoded > self.SHORT_OK:
+            self.warnings.append(f"video {self.path} ended after {self.decoded} of the {self.frames} frames its "
+                                 "container declares (a truncated file?)")
+        if self.damaged:
+            self.warnings.append(f"{self.damaged} damaged packet(s) of video {self.path} did not decode and were "
+                                 "skipped")
 
     def _stop_decoding(self) -> None:
         """Stops the decoder thread, if any, taking the frames it still queues."""
@@ -234,6 +319,19 @@ class VideoReader:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+#: What the decoder thread queues at the end of the file.
+_END = object()
+
+
+def _rotate_tag(metadata: dict[str, str]) -> float:
+    """A stream's ``rotate`` tag (any case): degrees clockwise, 0 when absent or not a number."""
+    tag = next((v for k, v in metadata.items() if k.lower() == "rotate"), "0")
+    try:
+        return float(tag)
+    except ValueError:
+        return 0.0
 
 
 def _reason(e: BaseException) -> str:
