@@ -20,7 +20,7 @@ from facemime.errors import InputFileError, InvalidInputError, NoFaceError
 from facemime.fit.actor import Actor
 from facemime.fit.placement import model_iod
 from facemime.io.actor_file import load_actor
-from facemime.io.contours_json import track_document, write_json
+from facemime.io.contours_json import TrackWriter
 from facemime.io.outputs import Outputs
 from facemime.io.video import CODECS, VideoReader, VideoWriter
 from facemime.progress import track as progress
@@ -75,14 +75,18 @@ class SideBySide:
 
     ``frames``: RGB uint8 (H, W, 3) frames of one size; ``name`` names the video in messages;
     ``target``: the actor to drive (default: the actor fitted on the first frame). While it
-    runs, ``records`` gathers the track file's per-frame entries and ``seconds`` the time per
-    stage (``decode``: waiting for the next frame; ``track``, ``pose``, ``fit``; ``synth``;
-    ``compose``). ``analysis`` is None until the first frame."""
+    runs, the track file's per-frame entries are appended to ``records`` (a list, or a
+    :class:`facemime.io.contours_json.TrackWriter` that writes them out as they come), ``frames``
+    counts them, and ``seconds`` holds the time per stage (``decode``: waiting for the next
+    frame; ``track``, ``pose``, ``fit``; ``synth``; ``compose``). ``analysis`` is None until the
+    first frame."""
 
     def __init__(self, frames: Iterable[np.ndarray], name: str, target: Actor | None = None,
-                 user: UserMotion = UserMotion(), params: TrackerParams | None = None):
+                 user: UserMotion = UserMotion(), params: TrackerParams | None = None,
+                 records: list[dict] | TrackWriter | None = None):
         self._frames, self._name, self._target, self._user, self._params = frames, name, target, user, params
-        self.records: list[dict] = []
+        self.records = [] if records is None else records
+        self.frames = 0
         self.seconds = dict.fromkeys(("decode", "track", "pose", "synth", "compose"), 0.0)
         self.analysis: Analysis | None = None
 
@@ -118,9 +122,10 @@ class SideBySide:
             else:
                 canvas[:, :w] = frame
             canvas[:, w:] = synth if motion.face else (synth * NO_FACE_DIM).astype(np.uint8)
-            self.records.append({"index": len(self.records), "contours": motion.contours, "confidence": motion.confidence,
+            self.records.append({"index": self.frames, "contours": motion.contours, "confidence": motion.confidence,
                                  "lost": motion.lost, "redetected": motion.redetected, "face": motion.face,
                                  "pose": pose_dict(motion.pose), "offsets": motion.offsets})
+            self.frames += 1
             seconds["synth"] += t2 - t1
             seconds["compose"] += time.perf_counter() - t2
             yield canvas
@@ -133,7 +138,7 @@ class SideBySide:
         spent encoding)."""
         if self.analysis is None:
             raise InputFileError(f"video {self._name} has no frames")
-        return RunResult(len(self.records), self.analysis.frames_without_face, files, list(self.analysis.warnings),
+        return RunResult(self.frames, self.analysis.frames_without_face, files, list(self.analysis.warnings),
                          {**self.seconds, "encode": encode_seconds})
 
 
@@ -154,16 +159,18 @@ def run_video(video: str | Path, out: str | Path, actor: str | Path | Actor | No
     with Outputs([out, track], force, inputs=[video, actor_path]) as outputs:
         target = load_actor(actor_path) if actor_path is not None else actor
         encode = 0.0
-        with VideoReader(video) as reader, VideoWriter(outputs.stage(out), reader.fps) as writer:
-            work = SideBySide(progress(reader, reader.frames or None, "running"), str(video), target, user, params)
+        with (VideoReader(video) as reader, VideoWriter(outputs.stage(out), reader.fps) as writer,
+              TrackWriter(outputs.stage(track)) as records):
+            work = SideBySide(progress(reader, reader.frames or None, "running"), str(video), target, user, params,
+                              records)
             for canvas in work:
                 t0 = time.perf_counter()
                 writer.write(canvas)
                 encode += time.perf_counter() - t0
             result = work.result([out, track], encode)
+            result.warnings.extend(reader.warnings)
+            busy = sum(v for k, v in result.seconds.items() if k not in ("encode", "fit", "decode"))
             info = {"width": reader.width, "height": reader.height, "fps": reader.fps, "frames": result.frames}
-        busy = sum(v for k, v in result.seconds.items() if k not in ("encode", "fit", "decode"))
-        write_json(outputs.stage(track), track_document(info, work.records, {"processing_seconds": round(busy, 4),
-                                                                             "frames_processed": result.frames},
-                                                        work.analysis.model_block))
+            records.close(info, {"processing_seconds": round(busy, 4), "frames_processed": result.frames},
+                          work.analysis.model_block)
     return result

@@ -92,7 +92,7 @@ def analyse(video: str | Path, actor: Actor | None = None) -> Clip:
         if analysis is None:
             raise InputFileError(f"video {video} has no frames")
         return Clip(actor or analysis.actor, reader.fps, (reader.width, reader.height), motion,
-                    list(analysis.warnings), time.perf_counter() - t0)
+                    list(analysis.warnings) + list(reader.warnings), time.perf_counter() - t0)
 
 
 def encode_clip(clip: Clip, settings: Settings, carry_actor: bool,

@@ -122,31 +122,67 @@ def track_document(video: Mapping[str, Any], frames: Sequence[Mapping[str, Any]]
     features), ``redetected`` (bool: the face landmark model put the contours right on this
     frame), ``face`` (bool), ``pose`` (mapping) and ``offsets`` ((K, 2) array); ``model``
     describes the knots the offsets belong to (see the module docstring)."""
-    out_frames = []
-    for f in frames:
-        entry: dict[str, Any] = {"index": int(f["index"]),
-                                 "contours": {n: np.round(np.asarray(c, float), 3).tolist() for n, c in f["contours"].items()}}
-        if "confidence" in f:
-            entry["confidence"] = {k: round(float(v), 4) for k, v in f["confidence"].items()}
-        if "lost" in f:
-            entry["lost"] = list(f["lost"])
-        if "redetected" in f:
-            entry["redetected"] = bool(f["redetected"])
-        if "face" in f:
-            entry["face"] = bool(f["face"])
-        if "pose" in f:
-            entry["pose"] = {k: round(float(v), 4) for k, v in f["pose"].items()}
-        if "offsets" in f:
-            entry["offsets"] = np.round(np.asarray(f["offsets"], float), 3).tolist()
-        out_frames.append(entry)
-    doc: dict[str, Any] = {"format": TRACK_FORMAT,
-                           "video": {k: video[k] for k in ("width", "height", "fps", "frames")},
-                           "frames": out_frames}
+    doc: dict[str, Any] = {"format": TRACK_FORMAT, "frames": [track_entry(f) for f in frames]}
+    return {**doc, **_closing(video, timing, model)}
+
+
+def _closing(video: Mapping[str, Any], timing: Mapping[str, float] | None,
+             model: Mapping[str, Any] | None) -> dict[str, Any]:
+    """A track document's entries after its frames."""
+    out: dict[str, Any] = {"video": {k: video[k] for k in ("width", "height", "fps", "frames")}}
     if model is not None:
-        doc["model"] = dict(model)
+        out["model"] = dict(model)
     if timing is not None:
-        doc["timing"] = dict(timing)
-    return doc
+        out["timing"] = dict(timing)
+    return out
+
+
+def track_entry(f: Mapping[str, Any]) -> dict[str, Any]:
+    """One frame's entry of a track document (see :func:`track_document`), rounded to what the
+    format keeps."""
+    entry: dict[str, Any] = {"index": int(f["index"]),
+                             "contours": {n: np.round(np.asarray(c, float), 3).tolist() for n, c in f["contours"].items()}}
+    if "confidence" in f:
+        entry["confidence"] = {k: round(float(v), 4) for k, v in f["confidence"].items()}
+    if "lost" in f:
+        entry["lost"] = list(f["lost"])
+    if "redetected" in f:
+        entry["redetected"] = bool(f["redetected"])
+    if "face" in f:
+        entry["face"] = bool(f["face"])
+    if "pose" in f:
+        entry["pose"] = {k: round(float(v), 4) for k, v in f["pose"].items()}
+    if "offsets" in f:
+        entry["offsets"] = np.round(np.asarray(f["offsets"], float), 3).tolist()
+    return entry
+
+
+class TrackWriter:
+    """Writes a ``facemime.track/1`` document frame by frame to ``path`` (a file that the caller
+    puts in place when complete, :class:`facemime.io.outputs.Outputs`), so that a long video's
+    track is not held in memory: :meth:`append` each frame (as for :func:`track_document`), then
+    :meth:`close` with what comes after the frames."""
+
+    def __init__(self, path: Path):
+        self._file = open(path, "w", encoding="utf-8")
+        self._file.write(f'{{"format": {json.dumps(TRACK_FORMAT)}, "frames": [')
+        self.frames = 0
+
+    def append(self, frame: Mapping[str, Any]) -> None:
+        self._file.write(("," if self.frames else "") + "\n" + json.dumps(track_entry(frame)))
+        self.frames += 1
+
+    def close(self, video: Mapping[str, Any], timing: Mapping[str, float] | None = None,
+              model: Mapping[str, Any] | None = None) -> None:
+        rest = json.dumps(_closing(video, timing, model))
+        self._file.write("\n], " + rest[1:])
+        self._file.close()
+
+    def __enter__(self) -> "TrackWriter":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._file.close()
 
 
 def write_json(path: str | Path, doc: Mapping[str, Any]) -> Path:

@@ -93,7 +93,9 @@ def track_video(video: str | Path, init: str | Path | None, out: str | Path, ove
         info = {"width": reader.width, "height": reader.height, "fps": reader.fps, "frames": decoded}
         write_json(outputs.stage(out), track_document(info, frames, {"processing_seconds": round(start_seconds + seconds, 4), "frames_processed": len(frames)}))
     first = "the first frame" if start == 0 else f"frame {start}"
-    warnings = [f"{tracker.faces} faces found in {first} of {video}; tracking the largest"] if tracker.faces > 1 else []
+    warnings = list(reader.warnings)
+    if tracker.faces > 1:
+        warnings.append(f"{tracker.faces} faces found in {first} of {video}; tracking the largest")
     if init is None and start > 0:
         warnings.append(f"no face in frames 0-{start - 1} of {video}; tracking from frame {start}")
     return TrackRun(len(frames), start_seconds, seconds, lost_frames, [f["index"] for f in frames if f["redetected"]],
