@@ -292,3 +292,19 @@ def test_bad_videos_give_one_line_to_every_command(bad_videos, tmp_path, capsys,
                  ["fit", video, "--out", str(tmp_path / "a.actor")]):
         one_line_error(*run(capsys, *args))
         assert listing(tmp_path) == [], args
+
+
+@pytest.mark.parametrize("command", ["run", "track"])
+def test_a_full_disk_gives_one_line_and_leaves_nothing(shared, tmp_path, command):
+    import resource
+
+    def small_files():  # writes beyond 150 kB fail as on a full disk
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (150_000, 150_000))
+
+    args = [sys.executable, "-m", "facemime", command, str(shared / "video" / "lp_d3.mp4")]
+    args += ["--out", str(tmp_path / "o.mp4")] if command == "run" else ["--out", str(tmp_path / "t.json"), "--overlay",
+                                                                          str(tmp_path / "o.mp4")]
+    proc = subprocess.run(args, preexec_fn=small_files, capture_output=True, text=True, timeout=300)
+    one_line_error(proc.returncode, proc.stdout, proc.stderr, "cannot write")
+    assert listing(tmp_path) == []

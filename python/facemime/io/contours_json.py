@@ -33,7 +33,7 @@ import numpy as np
 
 from facemime.errors import FacemimeError
 from facemime.io.limits import parse_json, read_json_text
-from facemime.io.outputs import write_text
+from facemime.io.outputs import OutputFileError, write_text
 from facemime.track.contours import CONTOUR_NAMES
 
 INIT_FORMAT = "facemime.init/1"
@@ -164,25 +164,38 @@ class TrackWriter:
     :meth:`close` with what comes after the frames."""
 
     def __init__(self, path: Path):
-        self._file = open(path, "w", encoding="utf-8")
-        self._file.write(f'{{"format": {json.dumps(TRACK_FORMAT)}, "frames": [')
+        self._path = path
+        self._file = self._io(lambda: open(path, "w", encoding="utf-8"))
+        self._write(f'{{"format": {json.dumps(TRACK_FORMAT)}, "frames": [')
         self.frames = 0
 
+    def _io(self, act: Any) -> Any:
+        try:
+            return act()
+        except OSError as e:  # a full disk, a file too large: one line
+            raise OutputFileError(f"cannot write {self._path}: {e.strerror or e}") from None
+
+    def _write(self, text: str) -> None:
+        self._io(lambda: self._file.write(text))
+
     def append(self, frame: Mapping[str, Any]) -> None:
-        self._file.write(("," if self.frames else "") + "\n" + json.dumps(track_entry(frame)))
+        self._write(("," if self.frames else "") + "\n" + json.dumps(track_entry(frame)))
         self.frames += 1
 
     def close(self, video: Mapping[str, Any], timing: Mapping[str, float] | None = None,
               model: Mapping[str, Any] | None = None) -> None:
-        rest = json.dumps(_closing(video, timing, model))
-        self._file.write("\n], " + rest[1:])
-        self._file.close()
+        self._write("\n], " + json.dumps(_closing(video, timing, model))[1:])
+        self._io(self._file.close)
 
     def __enter__(self) -> "TrackWriter":
         return self
 
-    def __exit__(self, *exc: object) -> None:
-        self._file.close()
+    def __exit__(self, exc_type: type | None, *exc: object) -> None:
+        try:
+            self._io(self._file.close)
+        except OutputFileError:
+            if exc_type is None:
+                raise
 
 
 def write_json(path: str | Path, doc: Mapping[str, Any]) -> Path:

@@ -143,7 +143,10 @@ class VideoWriter:
                 self._queue.put(None)
                 self._encoder.join()
             if self._container is not None:
-                self._container.close()
+                try:
+                    self._container.close()
+                except (av.FFmpegError, OSError) as e:  # the file's end cannot be written (a full disk)
+                    self._error = self._error or OutputFileError(f"cannot write video {self.path}: {_reason(e)}")
             if exc_type is None:
                 self._raise_error()
                 if self.frames == 0:
