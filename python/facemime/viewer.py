@@ -6,18 +6,37 @@ paper's keyboard did: arrows turn and tilt the head, ``q``/``e`` roll it, ``+``/
 ``x``/``z`` exaggerate or calm the mouth and brow motion, ``r`` resets, space pauses.
 
 The page shows an MJPEG stream (``/stream``); ``/key?k=NAME`` applies a key and answers the new
-state as JSON; ``/frame.jpg`` is the current frame. The server listens on 127.0.0.1 only.
+state as JSON; ``/frame.jpg`` is the next frame. The server listens on 127.0.0.1 only, answers
+only requests addressed to this machine by name (``Host``, and ``Origin`` where sent: 403
+otherwise, against DNS rebinding), of at most :data:`MAX_HEAD` bytes and without a body, and
+serves at most ``max_clients`` connections at once (503 beyond), each dropped after ``timeout``
+seconds without progress.
+
+Every client sees the same frames: one thread plays the viewer at its frame rate while anyone
+watches (:class:`Broadcast`), encodes each frame once and keeps the last :attr:`Broadcast.KEEP`;
+each client sends them in order from its own frame number on, waiting for the next one, and one
+that falls further behind skips to the newest. An error of the source (a video that changes its
+frame size, an undecodable one) ends playing: it is written to stderr as one line, and every
+stream ends with an image of the message.
 """
 
 from __future__ import annotations
 
 import json
+import re
+import reprlib
+import sys
+import textwrap
 import threading
 import time
+from collections import deque
 from collections.abc import Iterator
+from contextlib import closing
 from http import HTTPStatus
+from http.client import LineTooLong
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
+from typing import Any
 from urllib.parse import parse_qs, urlparse
 
 import cv2
@@ -25,10 +44,11 @@ import numpy as np
 
 from facemime.animate.analysis import Analysis
 from facemime.animate.synth import BACKGROUND, Puppet, UserMotion
-from facemime.errors import InputFileError, InvalidInputError, NoFaceError
+from facemime.errors import FacemimeError, InputFileError, InvalidInputError, NoFaceError
 from facemime.fit.actor import Actor, generic_actor
 from facemime.fit.placement import model_iod
-from facemime.io.contours_json import read_motion
+from facemime.io.contours_json import ContourFileError, read_motion
+from facemime.io.limits import limit
 from facemime.io.video import VideoReader
 from facemime.render.projection import Pose
 from facemime.render.texture_map import fill
@@ -41,6 +61,43 @@ KEYS = {
     "x": {"gain": 1.25}, "z": {"gain": 0.8},
 }
 HELP = "arrows: turn and tilt · q/e: roll · +/-: zoom · x/z: more/less motion · r: reset · space: pause"
+#: The largest frame side of a track file's ``video`` block, pixels.
+MAX_SIDE = 16384
+#: The frame rates the viewer plays at (a video's own beyond them is clamped; a track's refused).
+FPS_RANGE = (0.1, 1000.0)
+#: The most bytes of a request's line and headers together.
+MAX_HEAD = 8192
+#: ``Host`` values (any port) and ``Origin`` values the server answers: this machine's own names.
+LOOPBACK = r"(?:127\.0\.0\.1|localhost|\[::1\])(?::\d{1,5})?"
+LOOPBACK_HOST = re.compile(LOOPBACK, re.IGNORECASE)
+LOOPBACK_ORIGIN = re.compile(rf"https?://{LOOPBACK}", re.IGNORECASE)
+
+
+def _track_settings(where: str, video: Any, model: dict) -> tuple[tuple[int, int], float, np.ndarray, float | None]:
+    """(width, height), fps, feature sizes and iod (None: absent) of a track file's ``video``
+    and ``model`` blocks, checked: :class:`ContourFileError` names the first wrong field."""
+    if not isinstance(video, dict):
+        raise ContourFileError(f"{where}: 'video' must be an object (width, height, fps), got {reprlib.repr(video)}")
+
+    def number(block: dict, key: str, default: float | None, ok: Any, expected: str) -> Any:
+        value = block.get(key, default)
+        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float)) or not ok(value)):
+            raise ContourFileError(f"{where}: {key!r} must be {expected}, got {reprlib.repr(value)}")
+        return value
+
+    side = (lambda v: isinstance(v, int) and 0 < v <= MAX_SIDE, f"a whole number from 1 to {MAX_SIDE}")
+    size = (number(video, "width", 512, *side), number(video, "height", 512, *side))
+    if size[0] * size[1] > limit("FACEMIME_MAX_IMAGE_PIXELS"):
+        raise ContourFileError(f"{where}: a {size[0]}x{size[1]} frame is over the limit of "
+                               f"{limit('FACEMIME_MAX_IMAGE_PIXELS')} pixels (FACEMIME_MAX_IMAGE_PIXELS)")
+    fps = float(number(video, "fps", 25.0, lambda v: FPS_RANGE[0] <= v <= FPS_RANGE[1],
+                       f"a number from {FPS_RANGE[0]:g} to {FPS_RANGE[1]:g}"))
+    iod = number(model, "iod", None, lambda v: 0 < v < float("inf"), "a positive number")
+    sizes = model["feature_sizes"]
+    if (len(sizes) != len(model["knots"]) or any(isinstance(s, bool) or not isinstance(s, (int, float)) for s in sizes)
+            or not all(0 < s < float("inf") for s in sizes)):
+        raise ContourFileError(f"{where}: 'feature_sizes' must be {len(model['knots'])} positive numbers, one per knot")
+    return size, fps, np.asarray(sizes, np.float64), None if iod is None else float(iod)
 
 
 class Viewer:
@@ -64,14 +121,12 @@ class Viewer:
         self._is_track = self.source.suffix.lower() == ".json"
         if self._is_track:
             video, model, self._motions = read_motion(self.source)
-            self.size = (int(video.get("width", 512)), int(video.get("height", 512)))
-            self.fps = float(video.get("fps", 25.0))
+            self.size, self.fps, sizes, iod = _track_settings(str(self.source), video, model)
             driven = actor or generic_actor()
-            iod = model.get("iod", model_iod(driven.model))
-            self._puppet = Puppet(driven, np.asarray(model["feature_sizes"], float), float(iod))
+            self._puppet = Puppet(driven, sizes, model_iod(driven.model) if iod is None else iod)
         else:
             with VideoReader(self.source) as r:
-                self.size, self.fps = (r.width, r.height), r.fps
+                self.size, self.fps = (r.width, r.height), min(max(r.fps, FPS_RANGE[0]), FPS_RANGE[1])
         self._frames = self._play()
         self._shown = next(self._frames)
 
@@ -84,7 +139,11 @@ class Viewer:
                 continue
             analysis = None
             with VideoReader(self.source) as reader:
-                for frame in reader:
+                for n, frame in enumerate(reader):
+                    if frame.shape[:2] != self.size[::-1]:
+                        raise InputFileError(f"video {self.source} changes its frame size from {self.size[0]}x"
+                                             f"{self.size[1]} to {frame.shape[1]}x{frame.shape[0]} at frame {n}; "
+                                             "the viewer plays one frame size")
                     if analysis is None:
                         try:
                             analysis = Analysis(frame, str(self.source))
@@ -139,8 +198,8 @@ class Viewer:
     def state(self) -> dict:
         """The user motion and whether playback is paused, as a JSON-ready dict."""
         u = self.user
-        return {"yaw": u.yaw, "pitch": u.pitch, "roll": u.roll, "zoom": round(u.zoom, 4), "exaggerate": round(u.gain, 4),
-                "paused": self.paused}
+        return {"yaw": u.yaw, "pitch": u.pitch, "roll": u.roll, "zoom": round(u.zoom, 4),
+                "exaggerate": round(u.gain, 4), "paused": self.paused}
 
 
 PAGE = """<!doctype html><html lang="en"><head><meta charset="utf-8"><title>facemime view</title>
@@ -157,13 +216,193 @@ def jpeg(frame: np.ndarray) -> bytes:
     return cv2.imencode(".jpg", cv2.cvtColor(frame, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, 85])[1].tobytes()
 
 
-def make_server(viewer: Viewer, port: int = 8765) -> ThreadingHTTPServer:
-    """The web server of ``viewer`` on 127.0.0.1:``port`` (0: any free port); not yet serving."""
+def describe(e: BaseException) -> str:
+    """An error as one line: its message, or for an unexpected one its type too."""
+    text = str(e) if isinstance(e, FacemimeError) else f"unexpected {type(e).__name__}: {e} (a bug in facemime)"
+    return " ".join(text.split())
+
+
+def report(e: BaseException) -> None:
+    """Tell an error of the server's threads on stderr, in one line."""
+    print(f"facemime: error: {describe(e)}", file=sys.stderr, flush=True)
+
+
+def message_image(text: str) -> np.ndarray:
+    """An RGB image of ``text`` (ASCII, wrapped), light red on the page's dark grey."""
+    lines = textwrap.wrap(text.encode("ascii", "replace").decode(), 64) or [""]
+    image = np.full((24 + 28 * len(lines), 760, 3), 34, np.uint8)
+    for i, line in enumerate(lines):
+        cv2.putText(image, line, (16, 34 + 28 * i), cv2.FONT_HERSHEY_SIMPLEX, 0.6, (255, 140, 140), 1, cv2.LINE_AA)
+    return image
+
+
+class Broadcast:
+    """The viewer's frames, as JPEG, for every client at once: one thread plays the viewer at its
+    frame rate while anyone watches (:meth:`frames`) and keeps the last :data:`KEEP` frames; an
+    error of the viewer's stops playing for good, with ``error`` its one-line message, reported on
+    stderr once."""
+
+    #: Frames kept for clients that fall behind; one further behind skips to the newest frame.
+    KEEP = 16
+
+    def __init__(self, viewer: Viewer):
+        self.viewer = viewer
+        self.error: str | None = None
+        self._recent: deque[bytes] = deque(maxlen=self.KEEP)
+        self._played = 0  # the number of the newest frame in _recent
+        self._watchers = 0
+        self._player: threading.Thread | None = None
+        self._closed = False
+        self._changed = threading.Condition()
+
+    def frames(self) -> Iterator[tuple[int, bytes]]:
+        """(number, JPEG) of each frame played from now on, in order, until playing stops (an
+        error, or :meth:`close`)."""
+        with self._changed:
+            self._watchers += 1
+            if self._player is None and not self._closed and self.error is None:
+                self._player = threading.Thread(target=self._play, name="viewer player", daemon=True)
+                self._player.start()
+            want = self._played + 1
+        try:
+            while True:
+                with self._changed:
+                    self._changed.wait_for(lambda: self._played >= want or self._closed or self.error is not None)
+                    if self._closed or self._played < want:
+                        return
+                    oldest = self._played - len(self._recent) + 1
+                    if want < oldest:  # too far behind: on with the newest
+                        want = self._played
+                    body = self._recent[want - oldest]
+                yield want, body
+                want += 1
+        finally:
+            with self._changed:
+                self._watchers -= 1
+
+    def _play(self) -> None:
+        """The player thread: a frame every 1/fps seconds until no one watches or playing stops."""
+        while True:
+            start = time.monotonic()
+            try:
+                body = jpeg(self.viewer.frame())
+            except Exception as e:  # noqa: BLE001 (any error of the source stops playing, told in one line)
+                with self._changed:
+                    self.error, self._player = describe(e), None
+                    self._changed.notify_all()
+                report(e)
+                return
+            with self._changed:
+                self._recent.append(body)
+                self._played += 1
+                self._changed.notify_all()
+                self._changed.wait_for(lambda: self._closed, 1 / self.viewer.fps - (time.monotonic() - start))
+                if self._closed or not self._watchers:
+                    self._player = None
+                    return
+
+    def close(self) -> None:
+        """Stop playing, for good: streams end, and the player thread has ended on return."""
+        with self._changed:
+            self._closed = True
+            self._changed.notify_all()
+            player = self._player
+        if player is not None:
+            player.join()
+
+
+class _Head:
+    """A request's reader that gives at most :data:`MAX_HEAD` bytes, in lines (the request line
+    and headers): beyond, it raises :class:`LineTooLong`."""
+
+    def __init__(self, rfile: Any):
+        self._rfile, self._left = rfile, MAX_HEAD
+
+    def readline(self, size: int = -1) -> bytes:
+        line = self._rfile.readline(self._left + 1 if size < 0 else min(size, self._left + 1))
+        self._left -= len(line)
+        if self._left < 0:
+            raise LineTooLong(f"request line and headers over {MAX_HEAD} bytes")
+        return line
+
+    def close(self) -> None:
+        self._rfile.close()
+
+
+class ViewerServer(ThreadingHTTPServer):
+    """The viewer's web server (see :func:`make_server`): at most ``max_clients`` connections at
+    once, more are answered 503; closing it stops the broadcast."""
+
+    def __init__(self, port: int, handler: type[BaseHTTPRequestHandler], broadcast: Broadcast, max_clients: int):
+        super().__init__(("127.0.0.1", port), handler)
+        self.broadcast = broadcast
+        self._slots = threading.BoundedSemaphore(max_clients)
+
+    def process_request(self, request: Any, client_address: Any) -> None:
+        if not self._slots.acquire(blocking=False):
+            try:
+                request.sendall(b"HTTP/1.0 503 Service Unavailable\r\nContent-Type: text/plain\r\n"
+                                b"Content-Length: 33\r\nConnection: close\r\n\r\ntoo many clients; try again later")
+            except OSError:
+                pass
+            self.shutdown_request(request)
+            return
+        super().process_request(request, client_address)
+
+    def process_request_thread(self, request: Any, client_address: Any) -> None:
+        try:
+            super().process_request_thread(request, client_address)
+        finally:
+            self._slots.release()
+
+    def handle_error(self, request: Any, client_address: Any) -> None:
+        """A request's error in one line on stderr, none for a client gone or too slow."""
+        e = sys.exc_info()[1]
+        if not isinstance(e, (ConnectionError, TimeoutError)):
+            report(e)
+
+    def server_close(self) -> None:
+        super().server_close()
+        self.broadcast.close()
+
+
+def make_server(viewer: Viewer, port: int = 8765, timeout: float = 10.0, max_clients: int = 16) -> ViewerServer:
+    """The web server of ``viewer`` on 127.0.0.1:``port`` (0: any free port); not yet serving.
+    A connection is dropped after ``timeout`` seconds without progress; beyond ``max_clients``
+    connections at once, one is answered 503."""
+    if isinstance(port, bool) or not isinstance(port, int) or not 0 <= port <= 65535:
+        raise InvalidInputError(f"port must be a whole number from 0 to 65535 (0: any free port), got {port!r}")
     keys = json.dumps(sorted(KEYS) + ["r", " "])
+    broadcast = Broadcast(viewer)
 
     class Handler(BaseHTTPRequestHandler):
         def log_message(self, *args: object) -> None:  # quiet: progress goes nowhere
             pass
+
+        def setup(self) -> None:
+            super().setup()
+            self.rfile = _Head(self.rfile)
+
+        def handle_one_request(self) -> None:
+            try:
+                super().handle_one_request()
+            except LineTooLong:  # in the request line (parse_request answers an overlong header itself)
+                self.requestline, self.request_version, self.command = "", "", ""
+                self.send_error(HTTPStatus.REQUEST_HEADER_FIELDS_TOO_LARGE, f"over {MAX_HEAD} bytes")
+
+        def parse_request(self) -> bool:
+            """Refuse requests not addressed to this machine by name (403) and requests with a body (413)."""
+            if not super().parse_request():
+                return False
+            hosts, origin = self.headers.get_all("Host", []), self.headers.get("Origin")
+            if len(hosts) != 1 or not LOOPBACK_HOST.fullmatch(hosts[0]) or (
+                    origin is not None and not LOOPBACK_ORIGIN.fullmatch(origin)):
+                self.send_error(HTTPStatus.FORBIDDEN, "only pages of this machine may use the viewer")
+                return False
+            if self.headers.get("Content-Length", "0").strip() != "0" or "Transfer-Encoding" in self.headers:
+                self.send_error(HTTPStatus.REQUEST_ENTITY_TOO_LARGE, "requests with a body are not accepted")
+                return False
+            return True
 
         def _send(self, body: bytes, kind: str, status: HTTPStatus = HTTPStatus.OK) -> None:
             self.send_response(status)
@@ -173,12 +412,21 @@ def make_server(viewer: Viewer, port: int = 8765) -> ThreadingHTTPServer:
             self.end_headers()
             self.wfile.write(body)
 
+        def _stopped(self) -> str:
+            return broadcast.error or "the viewer has stopped"
+
         def do_GET(self) -> None:  # noqa: N802 (http.server's name)
             url = urlparse(self.path)
             if url.path == "/":
                 self._send((PAGE % (HELP, keys)).encode(), "text/html; charset=utf-8")
             elif url.path == "/frame.jpg":
-                self._send(jpeg(viewer.frame()), "image/jpeg")
+                with closing(broadcast.frames()) as frames:
+                    frame = next(frames, None)
+                if frame is None:
+                    self._send(self._stopped().encode(), "text/plain; charset=utf-8",
+                               HTTPStatus.SERVICE_UNAVAILABLE)
+                else:
+                    self._send(frame[1], "image/jpeg")
             elif url.path == "/key":
                 try:
                     state = viewer.key(parse_qs(url.query).get("k", [""])[0])
@@ -187,21 +435,32 @@ def make_server(viewer: Viewer, port: int = 8765) -> ThreadingHTTPServer:
                     return
                 self._send(json.dumps(state).encode(), "application/json")
             elif url.path == "/stream":
-                self.send_response(HTTPStatus.OK)
-                self.send_header("Content-Type", "multipart/x-mixed-replace; boundary=frame")
-                self.end_headers()
-                try:
-                    while True:
-                        t0 = time.perf_counter()
-                        body = jpeg(viewer.frame())
-                        self.wfile.write(b"--frame\r\nContent-Type: image/jpeg\r\nContent-Length: %d\r\n\r\n" % len(body) + body + b"\r\n")
-                        time.sleep(max(0.0, 1.0 / viewer.fps - (time.perf_counter() - t0)))
-                except (BrokenPipeError, ConnectionResetError):
-                    return
+                self._stream()
             else:
                 self._send(b"not found", "text/plain", HTTPStatus.NOT_FOUND)
 
+        def _stream(self) -> None:
+            """The frames as they play, each a part with its number (``X-Frame``); when an error
+            stops playing, a last part with an image of its message (``X-Error``: the text)."""
+            self.send_response(HTTPStatus.OK)
+            self.send_header("Content-Type", "multipart/x-mixed-replace; boundary=frame")
+            self.send_header("Cache-Control", "no-store")
+            self.end_headers()
+            part = b"--frame\r\nContent-Type: image/jpeg\r\nContent-Length: %d\r\n%s\r\n%s\r\n"
+            try:
+                with closing(broadcast.frames()) as frames:
+                    for number, body in frames:
+                        self.wfile.write(part % (len(body), b"X-Frame: %d\r\n" % number, body))
+                if broadcast.error is not None:
+                    body = jpeg(message_image(f"facemime: {broadcast.error}"))
+                    self.wfile.write(part % (len(body), b"X-Error: %s\r\n" % broadcast.error.encode("ascii", "replace"),
+                                             body))
+                self.wfile.write(b"--frame--\r\n")
+            except (ConnectionError, TimeoutError):  # the client has gone, or is too slow
+                return
+
+    Handler.timeout = timeout
     try:
-        return ThreadingHTTPServer(("127.0.0.1", port), Handler)
+        return ViewerServer(port, Handler, broadcast, max_clients)
     except OSError as e:
         raise InvalidInputError(f"cannot listen on port {port}: {e.strerror or e}; pick another with --port") from None
