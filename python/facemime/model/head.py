@@ -157,6 +157,8 @@ def _first_problem(
         return f"triangle {int(np.argmax(area <= 1e-9 * scale**2))} is degenerate (zero area)"
     if uv is not None and (uv.shape != (n, 2) or not np.isfinite(uv).all()):
         return f"uv must have shape ({n}, 2) and be finite, got {uv.shape}"
+    if uv is not None and (uv.min() < -1 or uv.max() > 2):
+        return "texture coordinates (uv) must lie near 0..1 (within -1..2)"
     for name, g in groups.items():
         if g.ndim != 1 or len(g) == 0 or g.min() < 0 or g.max() >= n:
             return f"group {name!r} must list vertex indices in 0..{n - 1}"
