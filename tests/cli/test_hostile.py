@@ -137,11 +137,13 @@ def test_deep_huge_and_damaged_inputs_give_one_line(files, tmp_path, capsys, mon
     video, out = files / "face.mp4", tmp_path / "out"
     out.mkdir()
     cases = [
-        (["track", str(video), "--init", str(tmp_path / "deep.json"), "--out", str(out / "t.json")], "nested too deeply"),
+        (["track", str(video), "--init", str(tmp_path / "deep.json"), "--out", str(out / "t.json")],
+         "nested too deeply"),
         (["fit", str(files / "face.mp4"), "--points", str(tmp_path / "deep.json"), "--out", str(out / "a.actor")],
          "nested too deeply"),
         (["model-preview", str(tmp_path / "deep.json"), "--out", str(out / "m.png")], ""),
-        (["run", str(video), "--actor", str(tmp_path / "deep.actor"), "--out", str(out / "o.mp4")], "nested too deeply"),
+        (["run", str(video), "--actor", str(tmp_path / "deep.actor"), "--out", str(out / "o.mp4")],
+         "nested too deeply"),
         (["run", str(video), "--actor", str(tmp_path / "crc.actor"), "--out", str(out / "o.mp4")], "crc.actor"),
         (["run", str(video), "--actor", str(tmp_path / "bomb.actor"), "--out", str(out / "o.mp4")], "Bad CRC"),
         (["fit", str(tmp_path / "huge.png"), "--out", str(out / "h.actor")], "30000x30000 pixels, more than"),
@@ -307,4 +309,6 @@ def test_a_full_disk_gives_one_line_and_leaves_nothing(shared, tmp_path, command
                                                                           str(tmp_path / "o.mp4")]
     proc = subprocess.run(args, preexec_fn=small_files, capture_output=True, text=True, timeout=300)
     one_line_error(proc.returncode, proc.stdout, proc.stderr, "cannot write")
+    outputs = ("o.mp4", "o.json") if command == "run" else ("t.json", "o.mp4")
+    assert ".part" not in proc.stderr and any(f"{tmp_path / name}:" in proc.stderr for name in outputs), proc.stderr
     assert listing(tmp_path) == []

@@ -4,6 +4,7 @@ never leave half-written files, and a command's several outputs all or none (:cl
 from __future__ import annotations
 
 import os
+import re
 import tempfile
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
@@ -117,6 +118,13 @@ class Outputs:
         return self._staged[path]
 
     def __exit__(self, exc_type: type | None, exc: BaseException | None, tb: object) -> None:
+        if isinstance(exc, FacemimeError) and exc.args:  # name the output, not its temporary file
+            message = str(exc.args[0])
+            for final in self.paths:
+                temporary = (re.escape(str(final.parent / f".{final.stem}.")) + r"\S*?"
+                             + re.escape(f".part{final.suffix}"))
+                message = re.sub(temporary, str(final).replace("\\", "\\\\"), message)
+            exc.args = (message, *exc.args[1:])
         try:
             if exc_type is None:
                 for final, tmp in self._staged.items():
