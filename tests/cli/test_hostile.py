@@ -312,3 +312,13 @@ def test_a_full_disk_gives_one_line_and_leaves_nothing(shared, tmp_path, command
     outputs = ("o.mp4", "o.json") if command == "run" else ("t.json", "o.mp4")
     assert ".part" not in proc.stderr and any(f"{tmp_path / name}:" in proc.stderr for name in outputs), proc.stderr
     assert listing(tmp_path) == []
+
+
+def test_numbers_too_large_for_a_float_give_one_line(files, tmp_path, capsys):
+    huge = "1" + "0" * 400  # valid JSON, but no float holds it
+    doc = json.loads((files / "init.json").read_text())
+    text = json.dumps(doc).replace(str(doc["contours"]["mouth_outer_upper"][0][0]), huge, 1)
+    (tmp_path / "init.json").write_text(text)
+    one_line_error(*run(capsys, "track", str(files / "face.mp4"), "--init", str(tmp_path / "init.json"),
+                        "--out", str(tmp_path / "t.json")), "mouth_outer_upper")
+    assert listing(tmp_path) == ["init.json"]

@@ -133,3 +133,10 @@ def test_many_deformation_units_on_many_vertices_are_refused(tmp_path, monkeypat
     monkeypatch.setenv("FACEMIME_MAX_UNIT_VALUES", "47")
     with pytest.raises(ModelFormatError, match="48 deformation unit values"):
         load_wfm(tmp_path / "units.wfm")
+
+
+def test_indices_too_large_for_an_integer_are_a_malformed_model():
+    doc = head_document(generic_head())
+    doc["triangles"][5][0] = 9.223372036854776e18
+    with pytest.raises(ModelFormatError, match="malformed model"):
+        head_from_document(doc, "huge index")

@@ -69,7 +69,7 @@ def check_points(points: Mapping[str, object], width: int, height: int, where: s
     for name, raw in points.items():
         try:
             arr = np.atleast_2d(np.asarray(raw, dtype=np.float64))
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             arr = np.empty((0, 0))
         if arr.ndim != 2 or arr.shape[1] != 2 or len(arr) == 0 or not np.isfinite(arr).all():
             raise InvalidInputError(f"{where}: {name} must be [x, y] numbers or a list of them")

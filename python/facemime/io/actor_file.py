@@ -148,7 +148,7 @@ def actor_from_bytes(source: str | Path | bytes, where: str) -> Actor:
         if not isinstance(source, dict) or not np.isfinite(list(pose.__dict__.values())).all() or pose.scale <= 0:
             raise ValueError("bad pose or source")
         return Actor(model, texture, pose, source, points)
-    except (KeyError, TypeError, ValueError, AttributeError, InvalidInputError) as e:
+    except (KeyError, TypeError, ValueError, AttributeError, OverflowError, InvalidInputError) as e:
         raise ActorFileError(f"{where}: malformed actor ({e})") from None
 
 

@@ -82,7 +82,7 @@ def _contours(doc: Mapping[str, Any], where: str, size: tuple[int, int] | None, 
     for name, pts in raw.items():
         try:
             arr = np.asarray(pts, dtype=np.float64)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise ContourFileError(f"{where}: contour {name} must be a list of [x, y] numbers") from None
         if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 2:
             raise ContourFileError(f"{where}: contour {name} must have at least 2 [x, y] points, got shape {arr.shape}")
@@ -238,7 +238,7 @@ def read_motion(path: str | Path) -> tuple[dict[str, Any], dict[str, Any], list[
         try:
             values = {key: float(pose[key]) for key in POSE_KEYS}
             arr = np.asarray(offsets, dtype=np.float64)
-        except (TypeError, KeyError, ValueError):
+        except (TypeError, KeyError, ValueError, OverflowError):
             raise ContourFileError(f"{where}: frame entry {n} needs a 'pose' with {', '.join(POSE_KEYS)} and 'offsets'") from None
         if arr.shape != (k, 2) or not np.isfinite(arr).all() or not all(np.isfinite(list(values.values()))) or values["scale"] <= 0:
             raise ContourFileError(f"{where}: frame entry {n} has malformed 'offsets' or 'pose'")

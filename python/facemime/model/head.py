@@ -253,7 +253,7 @@ def head_from_document(doc: object, where: str) -> HeadModel:
         raise
     except KeyError as e:
         raise ModelFormatError(f"{where}: missing field {e.args[0]!r}") from None
-    except (TypeError, ValueError, AttributeError) as e:
+    except (TypeError, ValueError, AttributeError, OverflowError) as e:
         raise ModelFormatError(f"{where}: malformed model ({e})") from None
     missing = [g for g in REQUIRED_GROUPS if g not in groups]
     if missing:
