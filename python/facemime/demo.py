@@ -6,8 +6,9 @@
    brows, turns and tilts the head) into a video whose true contours and pose are known.
 3. Track that video back (automatic start, no ground truth used) and measure the tracking error
    against the truth (NME, as in the shared data README) and the pose error.
-4. Re-synthesise the tracked motion on the astronaut and on a second face (the generic head with
-   its painted texture): a three-panel video.
+4. Re-synthesise the tracked motion on the astronaut, in her photo (her scene: the photo warped
+   to follow the head), and on a second face (the generic head with its painted texture, alone
+   on the backdrop): a three-panel video.
 5. Write ``report.html`` with stills, the errors and the timings.
 """
 
@@ -16,7 +17,7 @@ from __future__ import annotations
 import html
 import shutil
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from importlib import resources
 from pathlib import Path
 
@@ -25,7 +26,7 @@ import numpy as np
 
 from facemime.animate.analysis import Analysis
 from facemime.animate.run import pose_dict
-from facemime.animate.synth import Puppet, synthesize
+from facemime.animate.synth import Puppet, scene_mesh, synthesize
 from facemime.fit.actor import generic_actor
 from facemime.fit.placement import model_iod
 from facemime.fit.preview import preview_sheet
@@ -37,15 +38,15 @@ from facemime.io.contours_json import track_document, write_json
 from facemime.io.outputs import write_text
 from facemime.metrics import group_nme, summarize
 from facemime.progress import track
-from facemime.render import Pose
 from facemime.render.projection import project
 from facemime.track.contours import CONTOUR_NAMES, GROUPS
 from facemime.track.overlay import draw_contours
 
 FPS = 25
 SIZE = (512, 512)
-#: On-screen distance between the outer eye corners in the performance, pixels.
-IOD = 170.0
+#: The part of the astronaut photo the demo shows, (x, y, side) pixels: her head and shoulders,
+#: enlarged to :data:`SIZE` (the distance between her outer eye corners becomes about 130 px).
+FRAMING = (105, 10, 240)
 FILES = ("astronaut.actor", "astronaut.png", "performance.mp4", "resynthesis.mp4", "track.json", "stills.png", "report.html")
 
 
@@ -113,23 +114,26 @@ def _demo(files: list[Path], paths: list[Path], seconds: float) -> DemoResult:
     # 1. The actor.
     photo = cv2.cvtColor(cv2.imdecode(np.frombuffer(resources.files("facemime.data").joinpath("astronaut.jpg").read_bytes(),
                                                     np.uint8), cv2.IMREAD_COLOR), cv2.COLOR_BGR2RGB)
+    x0, y0, side = FRAMING
+    photo = cv2.resize(photo[y0:y0 + side, x0:x0 + side], SIZE, interpolation=cv2.INTER_CUBIC)
     t0 = time.perf_counter()
     actor = fit_actor(photo, "astronaut.jpg")[0]
     timing["fit"] = time.perf_counter() - t0
     write_bytes(paths[0], actor_bytes(actor))
     write_image(paths[1], preview_sheet(actor, photo))
 
-    # 2. The scripted performance, with its true contours and pose.
+    # 2. The scripted performance in her photo, with its true contours and pose.
     count = int(seconds * FPS)
     backdrop = _backdrop(SIZE)
-    scale = IOD / model_iod(actor.model)
+    scene = scene_mesh(actor)
     frames, truth, truth_poses = [], [], []
     t0 = time.perf_counter()
     for i in range(count):
         units, angles = performance(i / FPS)
-        pose = Pose(scale=scale, tx=(SIZE[0] - 1) / 2, ty=SIZE[1] * 0.40, **angles)
+        rest = actor.pose
+        pose = replace(rest, yaw=rest.yaw + angles["yaw"], pitch=rest.pitch + angles["pitch"], roll=rest.roll + angles["roll"])
         vertices = actor.model.deform(units)
-        frames.append(synthesize(actor, vertices, pose, SIZE, out=backdrop.copy()))
+        frames.append(synthesize(actor, vertices, pose, SIZE, scene=scene, key=actor.scene))
         pts = project(vertices, pose)[0]
         truth.append({n: pts[actor.model.groups[n]] for n in CONTOUR_NAMES})
         truth_poses.append(pose)
@@ -148,12 +152,14 @@ def _demo(files: list[Path], paths: list[Path], seconds: float) -> DemoResult:
             per_frame.append(group_nme(m.contours, ref, names, float(np.linalg.norm(corners[1] - corners[0]))))
         nme[group] = summarize(np.array(per_frame))
     first = analysis.actor.pose
-    pose_error = {k: float(np.mean([abs((getattr(m.pose, k) - getattr(first, k)) - getattr(p, k)) for m, p in zip(motions, truth_poses)]))
-                  for k in ("yaw", "pitch", "roll")}
+    rest = actor.pose
+    pose_error = {k: float(np.mean([abs((getattr(m.pose, k) - getattr(first, k)) - (getattr(p, k) - getattr(rest, k)))
+                                    for m, p in zip(motions, truth_poses)])) for k in ("yaw", "pitch", "roll")}
 
     # 4. Re-synthesise on the astronaut and on the second face.
     sizes, iod = analysis.deformer.feature_sizes(), model_iod(analysis.actor.model)
-    puppets = [Puppet(actor, sizes, iod), Puppet(generic_actor(SIZE), sizes, iod)]
+    # the astronaut in her own photo, moved as the tracked face moves from its first pose
+    puppets = [Puppet(actor, sizes, iod, analysis.actor.pose), Puppet(generic_actor(SIZE), sizes, iod)]
     stills, shown = [], {int(count * f) for f in (0.2, 0.43, 0.6, 0.87)}
     t0 = time.perf_counter()
     synth_seconds = 0.0
@@ -197,8 +203,8 @@ td:first-child,th:first-child{{text-align:left}}video,img{{max-width:100%}}</sty
 <a href="performance.mp4">performance.mp4</a>. That video was tracked back from an automatic start, and the
 tracked motion was re-synthesised on the astronaut and on a second face.</p>
 <h2>Re-synthesis</h2>
-<p>Left: the performance with the tracked contours. Middle: the motion re-synthesised on the astronaut.
-Right: the same motion on the generic head.</p>
+<p>Left: the performance with the tracked contours. Middle: the motion re-synthesised on the astronaut,
+in her photo. Right: the same motion on the generic head.</p>
 <video src="resynthesis.mp4" controls loop muted autoplay></video>
 <h2>Stills (frames {", ".join(map(str, shown))})</h2>
 <img src="stills.png" alt="stills of the re-synthesis">

@@ -1,7 +1,8 @@
 """``facemime view``: the interactive viewer, served to a web browser on this machine.
 
-A video is analysed live as it plays (original with contours | synthesised face); a track file
-written by ``facemime run`` replays its recorded motion. Keys in the browser add motion, as the
+A video is analysed live as it plays (original with contours | synthesised picture: the face in
+its actor's scene, or alone with ``mask_only``); a track file written by ``facemime run`` replays
+its recorded motion (on an actor with a scene, relative to the track's first pose). Keys in the browser add motion, as the
 paper's keyboard did: arrows turn and tilt the head, ``q``/``e`` roll it, ``+``/``-`` zoom,
 ``x``/``z`` exaggerate or calm the mouth and brow motion, ``r`` resets, space pauses.
 
@@ -110,8 +111,9 @@ class Viewer:
     reader's while the viewer plays it: :meth:`close` (or leaving a ``with`` block) stops it.
     """
 
-    def __init__(self, source: str | Path, actor: Actor | None = None):
+    def __init__(self, source: str | Path, actor: Actor | None = None, mask_only: bool = False):
         self.source = Path(source)
+        self._mask_only = mask_only
         if not self.source.exists():
             raise InputFileError(f"{self.source} does not exist")
         self.user = UserMotion()
@@ -123,7 +125,8 @@ class Viewer:
             video, model, self._motions = read_motion(self.source)
             self.size, self.fps, sizes, iod = _track_settings(str(self.source), video, model)
             driven = actor or generic_actor()
-            self._puppet = Puppet(driven, sizes, model_iod(driven.model) if iod is None else iod)
+            key = Pose(**self._motions[0]["pose"]) if self._motions else None
+            self._puppet = Puppet(driven, sizes, model_iod(driven.model) if iod is None else iod, key, mask_only)
         else:
             with VideoReader(self.source) as r:
                 self.size, self.fps = (r.width, r.height), min(max(r.fps, FPS_RANGE[0]), FPS_RANGE[1])
@@ -150,7 +153,7 @@ class Viewer:
                         except NoFaceError as e:
                             raise NoFaceError(f"{e}; the video must start with a frontal face") from None
                         puppet = Puppet(self._actor or analysis.actor, analysis.deformer.feature_sizes(),
-                                        model_iod(analysis.actor.model))
+                                        model_iod(analysis.actor.model), analysis.actor.pose, self._mask_only)
                         m = analysis.last
                     else:
                         m = analysis.update(frame)
@@ -160,7 +163,9 @@ class Viewer:
 
     def _render(self) -> np.ndarray:
         left, pose, offsets, puppet = self._shown
-        synth = fill(np.empty((self.size[1], self.size[0], 3), np.uint8), BACKGROUND)
+        synth = np.empty((self.size[1], self.size[0], 3), np.uint8)
+        if puppet.scene is None:
+            fill(synth, BACKGROUND)
         puppet.render(pose, offsets, self.size, self.user, out=synth)
         return synth if left is None else np.hstack([left, synth])
 

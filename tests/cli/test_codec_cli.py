@@ -33,13 +33,22 @@ def stream(clip, tmp_path_factory):
     return out
 
 
-def test_encode_then_decode_gives_the_synthesised_face_at_the_videos_size(stream, tmp_path, capsys):
+def test_encode_then_decode_gives_the_synthesised_picture_at_the_videos_size(stream, clip, tmp_path, capsys):
     code, out, err = run(capsys, "decode", str(stream), "--out", str(tmp_path / "face.mp4"))
     assert code == 0, err
     assert out.split() == [str(tmp_path / "face.mp4")]
     assert f"decoded {FRAMES} frames" in err
     frames = list(VideoReader(tmp_path / "face.mp4"))
     assert len(frames) == FRAMES and frames[0].shape == (512, 512, 3)
+    real = list(VideoReader(clip))[25]
+    mse = np.mean((frames[25].astype(float) - real) ** 2)
+    assert 10 * np.log10(255 ** 2 / mse) > 24  # the face in its scene: the whole picture resembles the video's
+
+
+def test_decode_mask_only_shows_the_face_alone_mid_picture(stream, tmp_path, capsys):
+    code, _, err = run(capsys, "decode", str(stream), "--mask-only", "--out", str(tmp_path / "face.mp4"))
+    assert code == 0, err
+    frames = list(VideoReader(tmp_path / "face.mp4"))
     face = np.abs(frames[25].astype(int) - BACKGROUND).sum(axis=2) > 30
     ys, xs = np.nonzero(face)
     assert 0.1 < face.mean() < 0.5 and 150 < xs.mean() < 360 and 150 < ys.mean() < 360  # a face, mid-picture
@@ -48,8 +57,9 @@ def test_encode_then_decode_gives_the_synthesised_face_at_the_videos_size(stream
 def test_encode_reports_the_motions_rate_and_the_actors_bytes(clip, tmp_path, capsys):
     code, _, err = run(capsys, "encode", str(clip), "--rate", "1", "--out", str(tmp_path / "s.fmstream"))
     assert code == 0, err
-    m = re.search(r"motion ([\d.]+) kbit/s .* header (\d+) bytes, the actor (\d+) bytes once", err)
-    assert m and float(m[1]) <= 1.0 and int(m[3]) > 5000
+    m = re.search(r"motion ([\d.]+) kbit/s .* header (\d+) bytes, the actor (\d+) bytes once, its scene (\d+) of them",
+                  err)
+    assert m and float(m[1]) <= 1.0 and int(m[3]) > int(m[4]) > 5000
 
 
 def test_a_stream_naming_its_actor_decodes_only_with_that_actor(clip, shared, tmp_path, capsys):

@@ -86,8 +86,8 @@ class Analysis:
         self.timings = Timings()
         t0 = time.perf_counter()
         self.actor, self.warnings, _ = fit_actor(frame, name, model=None if actor is None else actor.model)
-        if actor is not None:
-            self.actor = replace(actor, pose=self.actor.pose)
+        if actor is not None:  # placed on this frame, in this frame's scene
+            self.actor = replace(actor, pose=self.actor.pose, source=self.actor.source, scene=self.actor.scene)
         self.timings.fit += time.perf_counter() - t0
         self.deformer = Deformer(self.actor.model)
         contours = init_contours(self.actor)

@@ -1,8 +1,12 @@
 """``facemime run``: analyse a face video and re-synthesise it on an actor, frame by frame.
 
-Writes a side-by-side video (the original with the tracked contours | the synthesised face) that
-browsers play, and the ``facemime.track/1`` JSON with contours, head pose and knot offsets per
-frame. Outputs appear only when complete.
+Writes a side-by-side video (the original with the tracked contours | the synthesised picture:
+the face in the driven actor's scene, or alone with ``mask_only``) that browsers play, and the
+``facemime.track/1`` JSON with contours, head pose and knot offsets per frame; when the face is
+synthesised in its own scene, also how far each frame departs from that synthesis around the
+face (:mod:`facemime.animate.departure`): per frame ``scene_departure`` (0..1) and
+``scene_departs`` (bool), and top-level ``scene_departs`` (the [first, last] frame ranges
+reported). Outputs appear only when complete.
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from facemime.animate.analysis import Analysis
+from facemime.animate.departure import DEPARTS_AT, departure
 from facemime.animate.synth import BACKGROUND, Puppet, UserMotion
 from facemime.errors import InputFileError, InvalidInputError, NoFaceError
 from facemime.fit.actor import Actor
@@ -24,7 +29,7 @@ from facemime.io.contours_json import TrackWriter
 from facemime.io.outputs import Outputs
 from facemime.io.video import CODECS, VideoReader, VideoWriter
 from facemime.progress import track as progress
-from facemime.render.projection import Pose
+from facemime.render.projection import Pose, project
 from facemime.render.texture_map import fill
 from facemime.track.overlay import draw_contours
 from facemime.track.tracker import TrackerParams
@@ -37,7 +42,8 @@ NO_FACE_DIM = 0.45
 @dataclass
 class RunResult:
     """What :func:`run_video` did: frames, frames without a face, the files written, warnings,
-    and seconds per stage (``decode``, ``track``, ``pose``, ``synth``, ``compose``, ``fit``,
+    the [first, last] ranges of frames that depart from their synthesis around the face, and
+    seconds per stage (``decode``, ``track``, ``pose``, ``synth``, ``compose``, ``fit``,
     ``encode``: handing frames to the encoder, which encodes them on its own thread)."""
 
     frames: int
@@ -45,6 +51,7 @@ class RunResult:
     files: list[Path]
     warnings: list[str] = field(default_factory=list)
     seconds: dict[str, float] = field(default_factory=dict)
+    departs: list[list[int]] = field(default_factory=list)
 
     @property
     def _busy(self) -> float:
@@ -77,15 +84,19 @@ class SideBySide:
     ``target``: the actor to drive (default: the actor fitted on the first frame). While it
     runs, the track file's per-frame entries are appended to ``records`` (a list, or a
     :class:`facemime.io.contours_json.TrackWriter` that writes them out as they come), ``frames``
-    counts them, and ``seconds`` holds the time per stage (``decode``: waiting for the next
-    frame; ``track``, ``pose``, ``fit``; ``synth``; ``compose``). ``analysis`` is None until the
-    first frame."""
+    counts them, ``departs`` holds the ranges of frames that depart from their synthesis (only
+    measured when the video's own face is synthesised in its own scene), and ``seconds`` the
+    time per stage (``decode``: waiting for the next frame; ``track``, ``pose``, ``fit``;
+    ``synth``, the departure measure included; ``compose``). ``analysis`` is None until the
+    first frame. ``mask_only``: show the face alone on a plain backdrop, not in its scene."""
 
     def __init__(self, frames: Iterable[np.ndarray], name: str, target: Actor | None = None,
                  user: UserMotion = UserMotion(), params: TrackerParams | None = None,
-                 records: list[dict] | TrackWriter | None = None):
+                 records: list[dict] | TrackWriter | None = None, mask_only: bool = False):
         self._frames, self._name, self._target, self._user, self._params = frames, name, target, user, params
+        self._mask_only = mask_only
         self.records = [] if records is None else records
+        self.departs: list[list[int]] = []
         self.frames = 0
         self.seconds = dict.fromkeys(("decode", "track", "pose", "synth", "compose"), 0.0)
         self.analysis: Analysis | None = None
@@ -107,24 +118,39 @@ class SideBySide:
                     raise NoFaceError(f"{e}; the video must start with a frontal face") from None
                 actor = self.analysis.actor
                 driven = actor if self._target is None else self._target
-                puppet = Puppet(driven, self.analysis.deformer.feature_sizes(), model_iod(actor.model))
+                puppet = Puppet(driven, self.analysis.deformer.feature_sizes(), model_iod(actor.model), actor.pose,
+                                self._mask_only)
+                # the surround is compared only where the synthesis is of this very picture
+                compare = puppet.scene is not None and self._target is None
+                outline = actor.model.groups["face_outline"]
                 canvas = np.empty((h, 2 * w, 3), np.uint8)
                 synth = np.empty((h, w, 3), np.uint8)
                 motion = self.analysis.last
             else:
                 motion = self.analysis.update(frame)
             t1 = time.perf_counter()
-            fill(synth, BACKGROUND)
+            if puppet.scene is None:
+                fill(synth, BACKGROUND)
             puppet.render(motion.pose, motion.offsets, (w, h), self._user, out=synth)
+            record = {"index": self.frames, "contours": motion.contours, "confidence": motion.confidence,
+                      "lost": motion.lost, "redetected": motion.redetected, "face": motion.face,
+                      "pose": pose_dict(motion.pose), "offsets": motion.offsets}
+            if compare and motion.face:
+                vertices, shown = puppet.shown
+                share = departure(frame, synth, project(vertices[outline], shown)[0])
+                record.update(scene_departure=share, scene_departs=share > DEPARTS_AT)
+                if share > DEPARTS_AT:
+                    if self.departs and self.departs[-1][1] == self.frames - 1:
+                        self.departs[-1][1] = self.frames
+                    else:
+                        self.departs.append([self.frames, self.frames])
             t2 = time.perf_counter()
             if motion.face:
                 draw_contours(frame, motion.contours, motion.lost, out=canvas[:, :w])
             else:
                 canvas[:, :w] = frame
             canvas[:, w:] = synth if motion.face else (synth * NO_FACE_DIM).astype(np.uint8)
-            self.records.append({"index": self.frames, "contours": motion.contours, "confidence": motion.confidence,
-                                 "lost": motion.lost, "redetected": motion.redetected, "face": motion.face,
-                                 "pose": pose_dict(motion.pose), "offsets": motion.offsets})
+            self.records.append(record)
             self.frames += 1
             seconds["synth"] += t2 - t1
             seconds["compose"] += time.perf_counter() - t2
@@ -139,16 +165,17 @@ class SideBySide:
         if self.analysis is None:
             raise InputFileError(f"video {self._name} has no frames")
         return RunResult(self.frames, self.analysis.frames_without_face, files, list(self.analysis.warnings),
-                         {**self.seconds, "encode": encode_seconds})
+                         {**self.seconds, "encode": encode_seconds}, [list(r) for r in self.departs])
 
 
 def run_video(video: str | Path, out: str | Path, actor: str | Path | Actor | None = None,
               track: str | Path | None = None, user: UserMotion = UserMotion(), force: bool = False,
-              params: TrackerParams | None = None) -> RunResult:
+              params: TrackerParams | None = None, mask_only: bool = False) -> RunResult:
     """Analyse ``video`` and write ``out`` (.mp4 or .webm, side by side) and ``track`` (default:
     ``out`` with the suffix ``.json``). ``actor``: an ``.actor`` file or an :class:`Actor` to
-    drive (default: the actor fitted on the first frame). Both outputs or neither are written;
-    existing ones are refused unless ``force``, an input always."""
+    drive (default: the actor fitted on the first frame), shown in its own scene unless
+    ``mask_only`` (or it has none). Both outputs or neither are written; existing ones are
+    refused unless ``force``, an input always."""
     out = Path(out)
     if out.suffix.lower() not in CODECS:
         raise InvalidInputError(f"the output video must end in .mp4 or .webm, got {out.name!r}")
@@ -162,7 +189,7 @@ def run_video(video: str | Path, out: str | Path, actor: str | Path | Actor | No
         with (VideoReader(video) as reader, VideoWriter(outputs.stage(out), reader.fps) as writer,
               TrackWriter(outputs.stage(track)) as records):
             work = SideBySide(progress(reader, reader.frames or None, "running"), str(video), target, user, params,
-                              records)
+                              records, mask_only)
             for canvas in work:
                 t0 = time.perf_counter()
                 writer.write(canvas)
@@ -172,5 +199,5 @@ def run_video(video: str | Path, out: str | Path, actor: str | Path | Actor | No
             busy = sum(v for k, v in result.seconds.items() if k not in ("encode", "fit", "decode"))
             info = {"width": reader.width, "height": reader.height, "fps": reader.fps, "frames": result.frames}
             records.close(info, {"processing_seconds": round(busy, 4), "frames_processed": result.frames},
-                          work.analysis.model_block)
+                          work.analysis.model_block, {"scene_departs": result.departs} if result.departs else None)
     return result

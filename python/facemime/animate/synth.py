@@ -19,6 +19,7 @@ from facemime.errors import InvalidInputError
 from facemime.fit.actor import Actor
 from facemime.fit.placement import model_iod
 from facemime.render.projection import Pose, project
+from facemime.render.scene import SceneMesh
 from facemime.render.texture_map import fill, render_mesh_into
 
 BACKGROUND = (38, 40, 46)
@@ -114,19 +115,43 @@ def draw_mouth_interior(out: np.ndarray, upper: np.ndarray, lower: np.ndarray, u
     roi[:] = roi + alpha * (paint * shade - roi)
 
 
+def scene_mesh(actor: Actor) -> SceneMesh | None:
+    """The warp mesh of ``actor``'s scene (its source picture, at that picture's size), or None
+    when the actor has no scene."""
+    if actor.scene is None:
+        return None
+    anchors = actor.model.groups["face_outline"]
+    outline = project(actor.model.vertices[anchors], actor.pose)[0]
+    return SceneMesh.build((actor.source["width"], actor.source["height"]), anchors, outline)
+
+
+def key_frame(actor: Actor, scene: SceneMesh) -> np.ndarray:
+    """``actor``'s scene image at the size of its ``scene`` mesh (stored smaller when large)."""
+    w, h = scene.size
+    if actor.scene.shape[:2] == (h, w):
+        return actor.scene
+    return cv2.resize(actor.scene, (w, h), interpolation=cv2.INTER_LINEAR)
+
+
 def synthesize(actor: Actor, vertices: np.ndarray, pose: Pose, size: tuple[int, int],
-               background: np.ndarray | tuple[int, int, int] = BACKGROUND, out: np.ndarray | None = None) -> np.ndarray:
+               background: np.ndarray | tuple[int, int, int] = BACKGROUND, out: np.ndarray | None = None,
+               scene: SceneMesh | None = None, key: np.ndarray | None = None) -> np.ndarray:
     """The actor with ``vertices`` (its model's, deformed) seen in ``pose``: an (H, W, 3) image
     of ``size`` = (width, height) over ``background`` (a colour or an image of that size), or
-    drawn into ``out`` when given (the background is then what ``out`` holds)."""
+    drawn into ``out`` when given (the background is then what ``out`` holds). With ``scene``
+    (the actor's :func:`scene_mesh`, of this ``size``) and ``key`` (its scene image at that size,
+    :func:`key_frame`), the face is drawn in the actor's scene warped to follow it, and the
+    background is not used."""
     w, h = size
     if out is None:
         out = np.empty((h, w, 3), np.uint8)
-        if np.ndim(background) == 1:
+        if scene is None and np.ndim(background) == 1:
             fill(out, background)
-        else:
+        elif scene is None:
             out[...] = background
     points, depth = project(vertices, pose)
+    if scene is not None:
+        scene.draw(out, key, points[scene.anchors])
     g = actor.model.groups
     spread = mouth_width(actor.model, vertices) / max(mouth_width(actor.model, actor.model.vertices), 1e-9)
     draw_mouth_interior(out, points[g["mouth_inner_upper"]], points[g["mouth_inner_lower"]], teeth_uncovered(spread))
@@ -172,13 +197,24 @@ class Puppet:
 
     ``source_sizes``: the feature size of each knot on the measured face (see
     :meth:`Deformer.feature_sizes`) and ``source_iod`` its eye-corner distance, model units;
-    offsets are scaled per feature by the ratio of the two faces' sizes, and the measured
-    pose's scale by the ratio of the eye distances, so the driven face keeps the measured face's
-    size on screen.
+    offsets are scaled per feature by the ratio of the two faces' sizes.
+
+    In its scene (the actor has one and ``mask_only`` is False) the actor appears in its own
+    picture, moved from where it sits there by the measured motion relative to ``source_pose``
+    (the measured face's pose on its key frame): turns and tilts add, shifts and zoom scale
+    with the two faces' sizes on screen. Otherwise the face is shown alone where the measured
+    face is, the measured pose's scale multiplied by the ratio of the eye distances so that it
+    keeps the measured face's size on screen.
     """
 
-    def __init__(self, actor: Actor, source_sizes: np.ndarray, source_iod: float):
+    def __init__(self, actor: Actor, source_sizes: np.ndarray, source_iod: float, source_pose: Pose | None = None,
+                 mask_only: bool = False):
         self.actor = actor
+        self.source_pose = source_pose
+        self.scene = None if mask_only else scene_mesh(actor)
+        self._picture = None if self.scene is None else np.empty((self.scene.size[1], self.scene.size[0], 3), np.uint8)
+        self._key = None if self.scene is None else key_frame(actor, self.scene)
+        self.shown: tuple[np.ndarray, Pose] | None = None
         self.deformer = Deformer(actor.model)
         sizes = np.asarray(source_sizes, np.float64)
         if sizes.shape != (len(self.deformer.knots),) or not np.isfinite(sizes).all() or (sizes <= 0).any():
@@ -189,8 +225,17 @@ class Puppet:
 
     def pose(self, measured: Pose, user: UserMotion = UserMotion()) -> Pose:
         """The pose to show the actor in for a ``measured`` pose of the source face."""
-        return Pose(yaw=measured.yaw + user.yaw, pitch=measured.pitch + user.pitch, roll=measured.roll + user.roll,
-                    scale=measured.scale * self._scale * user.zoom, tx=measured.tx, ty=measured.ty)
+        if self.scene is None or self.source_pose is None:
+            base, scale, tx, ty = measured, measured.scale * self._scale, measured.tx, measured.ty
+        else:
+            rest, key = self.actor.pose, self.source_pose
+            ratio = rest.scale / self._scale / key.scale  # target pixels per source pixel
+            base = Pose(yaw=rest.yaw + measured.yaw - key.yaw, pitch=rest.pitch + measured.pitch - key.pitch,
+                        roll=rest.roll + measured.roll - key.roll)
+            scale = rest.scale * measured.scale / key.scale
+            tx, ty = rest.tx + ratio * (measured.tx - key.tx), rest.ty + ratio * (measured.ty - key.ty)
+        return Pose(yaw=base.yaw + user.yaw, pitch=base.pitch + user.pitch, roll=base.roll + user.roll,
+                    scale=scale * user.zoom, tx=tx, ty=ty)
 
     def vertices(self, offsets: np.ndarray, user: UserMotion = UserMotion()) -> np.ndarray:
         """The actor's vertices moved by the source's knot ``offsets`` (K, 2), lips all but
@@ -200,5 +245,29 @@ class Puppet:
     def render(self, measured: Pose, offsets: np.ndarray, size: tuple[int, int], user: UserMotion = UserMotion(),
                out: np.ndarray | None = None) -> np.ndarray:
         """The synthesised frame, (H, W, 3) of ``size`` = (width, height), drawn into ``out``
-        when given."""
-        return synthesize(self.actor, self.vertices(offsets, user), self.pose(measured, user), size, out=out)
+        when given. A scene of another size is drawn at its own and fitted into ``size``
+        (its aspect kept, the rest :data:`BACKGROUND`); without a scene the face is drawn over
+        what ``out`` holds (or :data:`BACKGROUND`). The vertices and pose drawn are left in
+        :attr:`shown`."""
+        vertices, pose = self.vertices(offsets, user), self.pose(measured, user)
+        self.shown = (vertices, pose)
+        if self.scene is None:
+            return synthesize(self.actor, vertices, pose, size, out=out)
+        if out is None:
+            out = np.empty((size[1], size[0], 3), np.uint8)
+        if tuple(size) == self.scene.size:
+            return synthesize(self.actor, vertices, pose, size, out=out, scene=self.scene, key=self._key)
+        synthesize(self.actor, vertices, pose, self.scene.size, out=self._picture, scene=self.scene, key=self._key)
+        return letterbox(self._picture, out)
+
+
+def letterbox(image: np.ndarray, out: np.ndarray) -> np.ndarray:
+    """``image`` scaled to fit ``out`` ((H, W, 3) uint8) whole and centred, the margins
+    :data:`BACKGROUND`; returns ``out``."""
+    h, w = out.shape[:2]
+    f = min(w / image.shape[1], h / image.shape[0])
+    sw, sh = max(1, round(image.shape[1] * f)), max(1, round(image.shape[0] * f))
+    x0, y0 = (w - sw) // 2, (h - sh) // 2
+    fill(out, BACKGROUND)
+    out[y0:y0 + sh, x0:x0 + sw] = cv2.resize(image, (sw, sh), interpolation=cv2.INTER_AREA if f < 1 else cv2.INTER_LINEAR)
+    return out

@@ -136,16 +136,18 @@ def user_motion_options(f):
 @click.option("--track", "track_file", type=click.Path(path_type=Path),
               help="facemime.track/1 JSON to write: contours, head pose and motion per frame (default: OUT with .json).")
 @user_motion_options
+@click.option("--mask-only", is_flag=True, help="Show the synthesised face alone on a plain backdrop, not in its scene.")
 @click.option("--force", is_flag=True, help="Overwrite existing output files.")
 def run(video: Path, actor_file: Path | None, out_file: Path, track_file: Path | None, yaw: float, pitch: float,
-        roll: float, zoom: float, gain: float, force: bool) -> None:
-    """Analyse the face in VIDEO (fit, track, head pose) and re-synthesise every frame on an actor."""
+        roll: float, zoom: float, gain: float, mask_only: bool, force: bool) -> None:
+    """Analyse the face in VIDEO (fit, track, head pose) and re-synthesise every frame on an actor,
+    in the actor's own scene (the picture it was fitted on)."""
     from facemime.animate.run import run_video
     from facemime.animate.synth import UserMotion
 
     user = UserMotion(yaw=yaw, pitch=pitch, roll=roll, zoom=zoom, gain=gain)
     t0 = time.perf_counter()
-    result = run_video(video, out_file, actor_file, track_file, user, force)
+    result = run_video(video, out_file, actor_file, track_file, user, force, mask_only=mask_only)
     wall = time.perf_counter() - t0
     for w in result.warnings:
         click.echo(f"facemime: warning: {w}", err=True)
@@ -153,6 +155,12 @@ def run(video: Path, actor_file: Path | None, out_file: Path, track_file: Path |
         click.echo(str(f))
     shares = ", ".join(f"{k} {100 * v:.0f}%" for k, v in result.shares.items())
     missing = f"; no face in {result.frames_without_face} frames" if result.frames_without_face else ""
+    if result.departs:
+        ranges = ", ".join(f"{a}" if a == b else f"{a}-{b}" for a, b in result.departs[:8])
+        more = f" and {len(result.departs) - 8} more ranges" if len(result.departs) > 8 else ""
+        click.echo(f"facemime: note: frames {ranges}{more} depart from the synthesis around the face (something passes "
+                   "in front, or the body moves more than one key frame can show); they are marked in the track file",
+                   err=True)
     click.echo(f"ran {result.frames} frames in {wall:.1f} s ({result.frames / wall:.0f} frames/s; the per-frame work "
                f"beside the encoder {result.fps:.0f} frames/s: {shares}){missing}", err=True)
 
@@ -186,7 +194,8 @@ def encode(video: Path, actor_file: Path | None, quality: int | None, rate: floa
     for w in result.warnings:
         click.echo(f"facemime: warning: {w}", err=True)
     click.echo(str(out_file))
-    actor = (f"the actor {result.actor_bytes} bytes once" if result.actor_bytes else f"the actor named ({actor_file})")
+    scene = f", its scene {result.scene_bytes} of them" if result.scene_bytes else ""
+    actor = (f"the actor {result.actor_bytes} bytes once{scene}" if result.actor_bytes else f"the actor named ({actor_file})")
     click.echo(f"encoded {result.frames} frames at quality {result.quality}: motion {result.motion_kbit_s:.2f} kbit/s "
                f"({result.motion_bytes} bytes), header {result.header_bytes} bytes, {actor}", err=True)
 
@@ -197,12 +206,13 @@ def encode(video: Path, actor_file: Path | None, quality: int | None, rate: floa
               help="NAME.actor the stream names, when the stream does not carry its actor.")
 @click.option("--out", "out_file", type=click.Path(path_type=Path), required=True,
               help="Video of the synthesised face to write (.mp4 or .webm).")
+@click.option("--mask-only", is_flag=True, help="Show the face alone on a plain backdrop, not in its actor's scene.")
 @click.option("--force", is_flag=True, help="Overwrite an existing output file.")
-def decode(stream: Path, actor_file: Path | None, out_file: Path, force: bool) -> None:
+def decode(stream: Path, actor_file: Path | None, out_file: Path, mask_only: bool, force: bool) -> None:
     """Synthesise the face of a facemime STREAM into a video, with no access to the source video."""
     from facemime.codec.files import decode_stream
 
-    result = decode_stream(stream, out_file, actor_file, force)
+    result = decode_stream(stream, out_file, actor_file, force, mask_only)
     click.echo(str(out_file))
     s = result.stats
     damage = (f"; {result.concealed} frames concealed ({s['lost_packets']} packets lost, {s['damaged_bytes']} bytes "
@@ -216,7 +226,8 @@ def decode(stream: Path, actor_file: Path | None, out_file: Path, force: bool) -
               help="NAME.actor to drive (default: the video's own face, or the generic head for a track file).")
 @click.option("--port", default=8765, show_default=True, help="Local port of the viewer's web page (0: any free port).")
 @click.option("--no-browser", is_flag=True, help="Do not open a browser; print the address only.")
-def view(source: Path, actor_file: Path | None, port: int, no_browser: bool) -> None:
+@click.option("--mask-only", is_flag=True, help="Show the synthesised face alone on a plain backdrop, not in its scene.")
+def view(source: Path, actor_file: Path | None, port: int, no_browser: bool, mask_only: bool) -> None:
     """Play VIDEO (analysed live) or a TRACK.json from facemime run in the interactive viewer, a
     page in your web browser: keys turn, tilt, roll, zoom and exaggerate the synthesised face.
     Stop with Ctrl-C."""
@@ -226,7 +237,7 @@ def view(source: Path, actor_file: Path | None, port: int, no_browser: bool) -> 
     from facemime.viewer import HELP, Viewer, make_server
 
     actor = load_actor(actor_file) if actor_file is not None else None
-    with Viewer(source, actor) as viewer:
+    with Viewer(source, actor, mask_only) as viewer:
         server = make_server(viewer, port)
         url = f"http://127.0.0.1:{server.server_address[1]}/"
         click.echo(url)

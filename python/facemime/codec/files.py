@@ -10,7 +10,9 @@ does not carry it, the actor.
 
 from __future__ import annotations
 
+import io
 import time
+import zipfile
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -45,8 +47,8 @@ MAX_COEFFICIENTS = max(m for _, m in LADDER)
 @dataclass
 class EncodeResult:
     """What :func:`encode_video` wrote: frames, the quality used, bytes of the header (with the
-    basis), of the actor (0 when only named), of the motion (packets), and seconds (analysis,
-    coding)."""
+    basis), of the actor (0 when only named; its scene's image ``scene_bytes`` of them), of the
+    motion (packets), and seconds (analysis, coding)."""
 
     frames: int
     fps: float
@@ -56,6 +58,7 @@ class EncodeResult:
     motion_bytes: int
     seconds: dict[str, float] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
+    scene_bytes: int = 0
 
     @property
     def motion_kbit_s(self) -> float:
@@ -151,7 +154,19 @@ def encode_video(video: str | Path, out: str | Path, actor: str | Path | None = 
     write_bytes(out, header + actor_chunk + b"".join(packets))
     seconds = {"analysis": clip.seconds, "coding": time.perf_counter() - t0}
     return EncodeResult(len(clip.motion), clip.fps, chosen.quality, len(header), len(actor_chunk),
-                        sum(map(len, packets)), seconds, warnings)
+                        sum(map(len, packets)), seconds, warnings, scene_bytes(actor_chunk))
+
+
+def scene_bytes(actor_chunk: bytes) -> int:
+    """Bytes of the scene image inside a stream's actor chunk (``docs/bitstream.md``: tag, seq,
+    LEB128 length, payload = the actor file, CRC-32); 0 without a chunk or a scene."""
+    if not actor_chunk:
+        return 0
+    at = 3
+    while actor_chunk[at] & 0x80:  # the length's bytes
+        at += 1
+    with zipfile.ZipFile(io.BytesIO(actor_chunk[at + 1:-4])) as z:
+        return sum(i.compress_size for i in z.infolist() if i.filename.startswith("scene."))
 
 
 @dataclass
@@ -180,10 +195,12 @@ def read_stream(path: str | Path) -> bytes:
 
 
 def decode_stream(stream: str | Path, out: str | Path, actor: str | Path | None = None,
-                  force: bool = False) -> DecodeResult:
-    """Decode ``stream`` and write the synthesised face to ``out`` (.mp4 or .webm) at the stream's
-    frame rate and size. ``actor``: the ``.actor`` file the stream names when it does not carry
-    it. Frames without a face show the last face dimmed; lost frames repeat the last good one."""
+                  force: bool = False, mask_only: bool = False) -> DecodeResult:
+    """Decode ``stream`` and write the synthesised picture to ``out`` (.mp4 or .webm) at the
+    stream's frame rate and size: the face in its actor's scene, or alone with ``mask_only`` (or
+    when the actor has no scene). ``actor``: the ``.actor`` file the stream names when it does
+    not carry it. Frames without a face show the last face dimmed; lost frames repeat the last
+    good one."""
     out = Path(out)
     if out.suffix.lower() not in CODECS:
         raise InvalidInputError(f"the output video must end in .mp4 or .webm, got {out.name!r}")
@@ -196,13 +213,15 @@ def decode_stream(stream: str | Path, out: str | Path, actor: str | Path | None 
     if decoder.stats["frames"] == 0:
         raise StreamError(f"{stream}: no frame could be decoded ({decoder.stats['damaged_bytes']} damaged bytes)")
     info, target = decoder.info, decoder.actor
-    puppet = Puppet(target, Deformer(target.model).feature_sizes(), model_iod(target.model))
+    puppet = Puppet(target, Deformer(target.model).feature_sizes(), model_iod(target.model), decoder.reference(),
+                    mask_only)
     w, h = info.size
     image, shown = np.empty((h, w, 3), np.uint8), np.empty((h, w, 3), np.uint8)
     with VideoWriter(out, info.fps) as writer:
         for f in progress(frames, len(frames), "decoding"):
             if not f.concealed:
-                fill(image, BACKGROUND)
+                if puppet.scene is None:
+                    fill(image, BACKGROUND)
                 puppet.render(f.pose, f.offsets, (w, h), out=image)
                 shown[:] = image if f.face else (image * NO_FACE_DIM).astype(np.uint8)
             writer.write(shown)

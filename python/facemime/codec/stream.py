@@ -258,12 +258,14 @@ class MotionDecoder:
             for k in range(count):
                 last = self._last
                 if last is None:
-                    frames.append(DecodedFrame(first + k, False, list(FEATURES), self._reference(), self._rest(), True))
+                    frames.append(DecodedFrame(first + k, False, list(FEATURES), self.reference(), self._rest(), True))
                 else:
                     frames.append(DecodedFrame(first + k, last.face, last.lost, last.pose, last.offsets, True))
         return frames
 
-    def _reference(self) -> Pose:
+    def reference(self) -> Pose:
+        """The pose the stream's motion starts from (its header's reference, quantised): the
+        source face's pose on its key frame."""
         h = self._core.header()
         return pose_from_vector(np.array(h["references"][:POSE_PARAMETERS]) * np.array(h["steps"][:POSE_PARAMETERS]))
 

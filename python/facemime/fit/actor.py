@@ -23,6 +23,8 @@ from facemime.render.projection import Pose, project
 #: and shrunk, if needed, to at most this many pixels on its longer side.
 TEXTURE_MARGIN = 0.08
 TEXTURE_MAX_SIDE = 1024
+#: The scene (the whole source photo) is shrunk, if needed, to at most this many pixels a side.
+SCENE_MAX_SIDE = 2048
 
 
 @dataclass(frozen=True, eq=False)
@@ -41,6 +43,10 @@ class Actor:
         Where the face came from: ``file`` (name only), ``frame``, ``width``, ``height``.
     points : dict of str -> (K, 2) float64 array
         The reference points the model was fitted to, pixels of the source photo.
+    scene : (Hs, Ws, 3) uint8 array or None
+        RGB, the whole source photo (shrunk to at most :data:`SCENE_MAX_SIDE` pixels a side):
+        the picture the face is synthesised in (:mod:`facemime.render.scene`); None for an
+        actor without one (the face is then shown alone).
     """
 
     model: HeadModel
@@ -48,11 +54,17 @@ class Actor:
     pose: Pose
     source: dict = field(default_factory=dict)
     points: ReferencePoints = field(default_factory=dict)
+    scene: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        t = self.texture
-        if not (isinstance(t, np.ndarray) and t.dtype == np.uint8 and t.ndim == 3 and t.shape[2] == 3 and min(t.shape[:2]) >= 1):
-            raise InvalidInputError(f"actor texture must be an (H, W, 3) uint8 image, got {getattr(t, 'shape', type(t).__name__)}")
+        for name, t in (("texture", self.texture), ("scene", self.scene)):
+            if t is None and name == "scene":
+                continue
+            if not (isinstance(t, np.ndarray) and t.dtype == np.uint8 and t.ndim == 3 and t.shape[2] == 3 and min(t.shape[:2]) >= 1):
+                raise InvalidInputError(f"actor {name} must be an (H, W, 3) uint8 image, got {getattr(t, 'shape', type(t).__name__)}")
+        if self.scene is not None and not all(isinstance(self.source.get(k), int) and self.source[k] > 0
+                                              for k in ("width", "height")):
+            raise InvalidInputError("an actor with a scene needs its source picture's width and height")
         if self.model.uv is None:
             raise InvalidInputError("actor model needs texture coordinates (uv)")
 
@@ -68,14 +80,20 @@ def smear_texture(model: HeadModel, photo: np.ndarray, fit: Fit, points: Referen
     x1, y1 = (int(np.clip(np.ceil(v), 1, n)) for v, n in zip(hi + pad, (w, h)))
     if x1 - x0 < 8 or y1 - y0 < 8:
         raise InvalidInputError(f"the fitted face covers only {x1 - x0}x{y1 - y0} pixels of the image")
-    crop = photo[y0:y1, x0:x1]
-    shrink = min(1.0, TEXTURE_MAX_SIDE / max(crop.shape[:2]))
-    if shrink < 1.0:
-        crop = cv2.resize(crop, (max(1, round(crop.shape[1] * shrink)), max(1, round(crop.shape[0] * shrink))),
-                          interpolation=cv2.INTER_AREA)
+    crop = _shrunk(photo[y0:y1, x0:x1], TEXTURE_MAX_SIDE)
     uv = np.clip((px - [x0, y0] + 0.5) / [x1 - x0, y1 - y0], 0.0, 1.0)
     adjusted = replace(model, vertices=fit.vertices, uv=uv, name=f"{source.get('file', 'photo')} actor")
-    return Actor(adjusted, np.ascontiguousarray(crop), fit.pose, dict(source), {k: np.asarray(v, float) for k, v in points.items()})
+    return Actor(adjusted, np.ascontiguousarray(crop), fit.pose, dict(source), {k: np.asarray(v, float) for k, v in points.items()},
+                 _shrunk(photo, SCENE_MAX_SIDE))
+
+
+def _shrunk(image: np.ndarray, side: int) -> np.ndarray:
+    """``image``, or a copy shrunk to at most ``side`` pixels on its longer side."""
+    f = side / max(image.shape[:2])
+    if f >= 1.0:
+        return np.ascontiguousarray(image).copy()
+    return cv2.resize(image, (max(1, round(image.shape[1] * f)), max(1, round(image.shape[0] * f))),
+                      interpolation=cv2.INTER_AREA)
 
 
 def generic_actor(size: tuple[int, int] = (512, 512)) -> Actor:

@@ -1,15 +1,19 @@
 """``.actor`` files: one fitted, textured head in one file that is safe to open from anywhere.
 
-The file is a ZIP archive with exactly two members and nothing executable:
+The file is a ZIP archive of two or three members and nothing executable:
 
 - ``actor.json``: ``{"format": "facemime.actor/1", "model": <a facemime.head/1 document: the
   adjusted vertices, triangles, uv, groups, deformation units>, "pose": {"yaw", "pitch", "roll",
   "scale", "tx", "ty"} (the frontal pose onto the source photo), "source": {"file", "frame",
   "width", "height"}, "points": {name: [[x, y], ...]}, "texture": {"width", "height"}}``;
 - ``texture.png`` (or ``texture.webp``: the smaller form a stream carries, see
-  :func:`actor_bytes`): the RGB texture.
+  :func:`actor_bytes`): the RGB texture;
+- optionally ``scene.png`` (or ``scene.webp``), with ``"scene": {"width", "height"}`` in
+  ``actor.json``: the whole source picture the face is synthesised in
+  (:mod:`facemime.render.scene`). Files written before scenes existed have none, and their face
+  is shown alone.
 
-Loading reads only those two members, refuses oversized ones before reading them, parses JSON
+Loading reads only those members, refuses oversized ones before reading them, parses JSON
 and PNG (no pickle, no code) and validates every array, so a corrupt, truncated, foreign or
 hostile file gives an :class:`ActorFileError` naming the file and the problem.
 """
@@ -46,6 +50,8 @@ class ActorFileError(FacemimeError, ValueError):
 
 #: Texture members a file may hold, and how each is written.
 TEXTURES = {"png": ("texture.png", []), "webp": ("texture.webp", [cv2.IMWRITE_WEBP_QUALITY])}
+#: The scene member's names, in the order looked for.
+SCENES = ("scene.png", "scene.webp")
 
 
 def actor_json(actor: Actor) -> bytes:
@@ -59,21 +65,30 @@ def actor_json(actor: Actor) -> bytes:
         "points": {k: np.asarray(v).tolist() for k, v in actor.points.items()},
         "texture": {"width": int(actor.texture.shape[1]), "height": int(actor.texture.shape[0])},
     }
+    if actor.scene is not None:
+        doc["scene"] = {"width": int(actor.scene.shape[1]), "height": int(actor.scene.shape[0])}
     return json.dumps(doc).encode()
 
 
 def actor_bytes(actor: Actor, texture: str = "png", quality: int = 90) -> bytes:
-    """``actor`` as the bytes of an actor file, its texture as PNG or WebP (``quality`` 1-100)."""
-    name, params = TEXTURES[texture]
-    ok, image = cv2.imencode("." + texture, cv2.cvtColor(actor.texture, cv2.COLOR_RGB2BGR),
-                             [p for flag in params for p in (flag, int(quality))])
-    if not ok:
-        raise OutputFileError(f"cannot encode the texture as {texture}")
+    """``actor`` as the bytes of an actor file, its texture and scene as PNG or WebP (``quality``
+    1-100)."""
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
         z.writestr("actor.json", actor_json(actor))
-        z.writestr(zipfile.ZipInfo(name), image.tobytes(), zipfile.ZIP_STORED)
+        for what, image in (("texture", actor.texture), ("scene", actor.scene)):
+            if image is not None:
+                z.writestr(zipfile.ZipInfo(f"{what}.{texture}"), _encoded(image, what, texture, quality), zipfile.ZIP_STORED)
     return buf.getvalue()
+
+
+def _encoded(image: np.ndarray, what: str, kind: str, quality: int) -> bytes:
+    """The RGB ``image`` encoded as ``kind`` (a key of :data:`TEXTURES`)."""
+    ok, data = cv2.imencode("." + kind, cv2.cvtColor(image, cv2.COLOR_RGB2BGR),
+                            [p for flag in TEXTURES[kind][1] for p in (flag, int(quality))])
+    if not ok:
+        raise OutputFileError(f"cannot encode the {what} as {kind}")
+    return data.tobytes()
 
 
 def save_actor(path: str | Path, actor: Actor, force: bool = False) -> Path:
@@ -122,6 +137,8 @@ def actor_from_bytes(source: str | Path | bytes, where: str) -> Actor:
             names = set(z.namelist())
             member = next((name for name, _ in TEXTURES.values() if name in names), "texture.png")
             image = _member(z, member, MAX_TEXTURE_BYTES, where)
+            scene_member = next((name for name in SCENES if name in names), None)
+            scene = None if scene_member is None else _member(z, scene_member, MAX_TEXTURE_BYTES, where)
     except (zipfile.BadZipFile, EOFError, zipfile.LargeZipFile, NotImplementedError, zlib.error) as e:
         raise ActorFileError(f"{where}: not a facemime actor file, or truncated ({e})") from None
     except OSError as e:
@@ -135,6 +152,9 @@ def actor_from_bytes(source: str | Path | bytes, where: str) -> Actor:
         raise ActorFileError(f"{where}: expected format {ACTOR_FORMAT!r}, got {found!r}"
                              + (" (a newer facemime wrote it?)" if isinstance(found, str) and found.startswith("facemime.actor/") else ""))
     texture = _texture(image, member, doc.get("texture"), where)
+    if (scene is None) != ("scene" not in doc):
+        raise ActorFileError(f"{where}: actor.json and the file's members disagree on whether it has a scene")
+    scene = None if scene is None else _texture(scene, scene_member, doc["scene"], where, "scene")
     try:
         model = head_from_document(doc.get("model"), f"{where}: model")
     except ModelFormatError as e:
@@ -147,21 +167,23 @@ def actor_from_bytes(source: str | Path | bytes, where: str) -> Actor:
         points = {str(k): np.asarray(v, dtype=np.float64).reshape(-1, 2) for k, v in doc.get("points", {}).items()}
         if not isinstance(source, dict) or not np.isfinite(list(pose.__dict__.values())).all() or pose.scale <= 0:
             raise ValueError("bad pose or source")
-        return Actor(model, texture, pose, source, points)
+        return Actor(model, texture, pose, source, points, scene)
     except (KeyError, TypeError, ValueError, AttributeError, OverflowError, InvalidInputError) as e:
         raise ActorFileError(f"{where}: malformed actor ({e})") from None
 
 
-def _texture(data: bytes, member: str, meta: object, where: str) -> np.ndarray:
+def _texture(data: bytes, member: str, meta: object, where: str, what: str = "texture") -> np.ndarray:
+    """The RGB image of ``member`` (``what``: texture or scene), checked against its size in
+    actor.json (``meta``)."""
     size = image_size(data)
     if size is None:
         raise ActorFileError(f"{where}: {member} is not a PNG or WebP image")
     w, h = size
     if not (1 <= w <= MAX_TEXTURE_SIDE and 1 <= h <= MAX_TEXTURE_SIDE):
-        raise ActorFileError(f"{where}: texture is {w}x{h}; at most {MAX_TEXTURE_SIDE} pixels a side are allowed")
+        raise ActorFileError(f"{where}: {what} is {w}x{h}; at most {MAX_TEXTURE_SIDE} pixels a side are allowed")
     img = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
     if img is None or img.shape[:2] != (h, w):
         raise ActorFileError(f"{where}: {member} is corrupt")
     if not isinstance(meta, dict) or [meta.get("width"), meta.get("height")] != [img.shape[1], img.shape[0]]:
-        raise ActorFileError(f"{where}: texture is {img.shape[1]}x{img.shape[0]}, but actor.json says {meta}")
+        raise ActorFileError(f"{where}: {what} is {img.shape[1]}x{img.shape[0]}, but actor.json says {meta}")
     return np.ascontiguousarray(cv2.cvtColor(img, cv2.COLOR_BGR2RGB))

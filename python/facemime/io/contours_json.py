@@ -19,7 +19,10 @@ extends ``facemime.track/1`` compatibly with per-frame keys:
 and a top-level ``model``: ``unit`` (of the offsets and of the model), ``knots`` (the K model
 vertex indices the offsets belong to), ``feature_sizes`` (K widths of each knot's feature,
 model units) and ``iod`` (distance between the outer eye corners, model units): what carrying
-the motion to another face needs.
+the motion to another face needs. ``facemime run`` adds, when it synthesises the face in its
+own scene, per frame ``scene_departure`` (share 0..1 of the pixels around the face that differ
+from the synthesis, :mod:`facemime.animate.departure`) and ``scene_departs`` (bool: reported),
+and a top-level ``scene_departs``: the [first, last] ranges of reported frames.
 """
 
 from __future__ import annotations
@@ -127,9 +130,9 @@ def track_document(video: Mapping[str, Any], frames: Sequence[Mapping[str, Any]]
 
 
 def _closing(video: Mapping[str, Any], timing: Mapping[str, float] | None,
-             model: Mapping[str, Any] | None) -> dict[str, Any]:
-    """A track document's entries after its frames."""
-    out: dict[str, Any] = {"video": {k: video[k] for k in ("width", "height", "fps", "frames")}}
+             model: Mapping[str, Any] | None, extra: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """A track document's entries after its frames (``extra``: more top-level entries)."""
+    out: dict[str, Any] = {"video": {k: video[k] for k in ("width", "height", "fps", "frames")}, **(extra or {})}
     if model is not None:
         out["model"] = dict(model)
     if timing is not None:
@@ -154,6 +157,9 @@ def track_entry(f: Mapping[str, Any]) -> dict[str, Any]:
         entry["pose"] = {k: round(float(v), 4) for k, v in f["pose"].items()}
     if "offsets" in f:
         entry["offsets"] = np.round(np.asarray(f["offsets"], float), 3).tolist()
+    if "scene_departure" in f:
+        entry["scene_departure"] = round(float(f["scene_departure"]), 4)
+        entry["scene_departs"] = bool(f["scene_departs"])
     return entry
 
 
@@ -183,8 +189,8 @@ class TrackWriter:
         self.frames += 1
 
     def close(self, video: Mapping[str, Any], timing: Mapping[str, float] | None = None,
-              model: Mapping[str, Any] | None = None) -> None:
-        self._write("\n], " + json.dumps(_closing(video, timing, model))[1:])
+              model: Mapping[str, Any] | None = None, extra: Mapping[str, Any] | None = None) -> None:
+        self._write("\n], " + json.dumps(_closing(video, timing, model, extra))[1:])
         self._io(self._file.close)
 
     def __enter__(self) -> "TrackWriter":

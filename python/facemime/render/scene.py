@@ -1,0 +1,157 @@
+"""The scene around the face: the key frame (the picture an actor was fitted on) as a 2-D mesh
+that the head's motion warps, so that a synthesised face appears in its own picture with hair,
+ears, neck, shoulders and room instead of on a blank backdrop.
+
+The mesh's vertices are, in order: the **anchors**, the model's ``face_outline`` vertices
+(their image positions each frame are the projections of the posed, deformed model, so the scene
+meets the 3-D face exactly); **rings** around the face, the outline scaled about its centre by
+:data:`RINGS`, each following a share of the head's motion (the least-squares affine map of the
+anchors from the key frame to now); and the **border**, vertices on the picture's edges that never
+move. Everything inside the outline is triangulated too: it is drawn under the face and shows
+only where the face mesh does not cover (a turned head's culled side), never as a hole.
+
+Where the head moves away from what the key frame showed, the uncovered part is filled by
+stretching the surround (the hair and background between the head and the fixed border). Measured
+against inpainting the head out of the key frame and compositing (``benchmarks/synthesis.py``),
+see the ``--inpaint`` figures there.
+
+Pixels: (x, y), x right, y down, (0, 0) the centre of the top-left pixel; the border lies on the
+picture's outer pixel edges (-0.5 and W - 0.5).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from facemime.errors import InvalidInputError
+from facemime.render.texture_map import render_mesh_into
+
+#: (distance from the face's centre as a multiple of the outline's, share of the head's motion
+#: followed) per ring: the first reaches over the hair, ears and chin and moves with the head;
+#: the next two reach the neck and shoulders and follow less and less of it.
+RINGS = ((1.45, 1.0), (2.1, 0.55), (3.0, 0.2))
+#: Ring vertices nearer the picture's edge than this fraction of its shorter side (or outside it)
+#: are left out: the border holds the picture there.
+EDGE_MARGIN = 0.04
+#: Border vertices per side (corners included).
+BORDER_STEPS = 9
+#: Triangles whose vertices all moved less than STILL pixels show the key frame as it is; those
+#: that moved less than SLOW are sampled nearest (half the work of bilinear; a shift under a
+#: pixel does not show), the rest bilinear.
+STILL = 0.05
+SLOW = 1.0
+
+
+@dataclass(frozen=True, eq=False)
+class SceneMesh:
+    """The scene's warp mesh for one picture.
+
+    Attributes
+    ----------
+    size : (width, height)
+        The picture, pixels.
+    anchors : (A,) int array
+        Model vertex indices whose projections are the first A mesh vertices.
+    rest : (N, 2) float array
+        Every vertex in the key frame, pixels (the texture coordinates).
+    follow : (N,) float array
+        Share of the head's motion each vertex follows: 1 for anchors and the first ring, 0 on
+        the border.
+    triangles : (F, 3) int array
+        Wound counter-clockwise as seen in the image (x right, y down); together they cover the
+        picture once at rest.
+    """
+
+    size: tuple[int, int]
+    anchors: np.ndarray
+    rest: np.ndarray
+    follow: np.ndarray
+    triangles: np.ndarray
+
+    @classmethod
+    def build(cls, size: tuple[int, int], anchors: np.ndarray, outline: np.ndarray) -> "SceneMesh":
+        """The mesh of a picture of ``size`` = (width, height) whose face outline lies at
+        ``outline`` ((A, 2) pixels, the projections of model vertices ``anchors``)."""
+        w, h = size
+        outline = np.asarray(outline, np.float64)
+        if outline.ndim != 2 or outline.shape[1] != 2 or len(outline) < 3 or not np.isfinite(outline).all():
+            raise InvalidInputError("the scene needs a face outline of at least three finite points")
+        centre = outline.mean(axis=0)
+        lo, hi = np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5])
+        margin = EDGE_MARGIN * min(w, h)
+        points, follow = [outline], [np.ones(len(outline))]
+        for reach, share in RINGS:
+            ring = centre + reach * (outline - centre)
+            inside = ((ring > lo + margin) & (ring < hi - margin)).all(axis=1)
+            points.append(ring[inside])
+            follow.append(np.full(inside.sum(), share))
+        t = np.linspace(0.0, 1.0, BORDER_STEPS)[:-1]
+        corners = np.array([lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]])
+        border = np.concatenate([a + t[:, None] * (b - a) for a, b in zip(corners, np.roll(corners, -1, axis=0))])
+        points.append(border)
+        follow.append(np.zeros(len(border)))
+        rest = np.concatenate(points)
+        return cls((int(w), int(h)), np.asarray(anchors, np.int64), rest, np.concatenate(follow),
+                   _delaunay(rest, (w, h)))
+
+    def points(self, outline: np.ndarray) -> np.ndarray:
+        """Every vertex now, (N, 2) pixels, for the face outline now at ``outline`` ((A, 2)
+        pixels): the anchors there, the rings moved by their share of the outline's affine
+        motion, the border where it was; all kept inside the picture."""
+        a = len(self.anchors)
+        src = np.hstack([self.rest[:a], np.ones((a, 1))])
+        affine, *_ = np.linalg.lstsq(src, outline, rcond=None)  # (3, 2): [x y 1] @ affine
+        moved = np.hstack([self.rest, np.ones((len(self.rest), 1))]) @ affine
+        out = self.rest + self.follow[:, None] * (moved - self.rest)
+        out[:a] = outline
+        w, h = self.size
+        np.clip(out[a:], [-0.5, -0.5], [w - 0.5, h - 0.5], out=out[a:])
+        return out
+
+    def draw(self, out: np.ndarray, key: np.ndarray, outline: np.ndarray) -> None:
+        """Draw the scene into ``out`` ((H, W, 3) uint8 of :attr:`size`) for the face outline now
+        at ``outline``, textured by ``key`` (the key frame at :attr:`size`). Every pixel is
+        written: the key frame is copied and only the triangles that moved are drawn again,
+        those that moved less than :data:`SLOW` pixels sampled nearest, the others bilinear."""
+        if key.shape != out.shape:
+            raise InvalidInputError(f"the key frame is {key.shape[1]}x{key.shape[0]}, the picture {out.shape[1]}x{out.shape[0]}")
+        w, h = self.size
+        points = self.points(outline)
+        moved = np.abs(points - self.rest).max(axis=1)[self.triangles].max(axis=1)
+        out[...] = key
+        uv = (self.rest + 0.5) / [w, h]
+        depth = np.zeros(len(points))
+        for tris, sampling in ((self.triangles[(moved > STILL) & (moved < SLOW)], "nearest"),
+                               (self.triangles[moved >= SLOW], "bilinear")):
+            if len(tris):  # no culling: a triangle the motion folds over shows as a fold, never a hole
+                render_mesh_into(out, key, uv, points, depth, tris, filter=sampling, cull=False)
+
+
+def _delaunay(points: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """The Delaunay triangles of ``points`` ((N, 2), distinct, within the picture of ``size``
+    and its outer pixel edges), as vertex indices wound counter-clockwise in the image."""
+    w, h = size
+    subdiv = cv2.Subdiv2D((-2, -2, w + 4, h + 4))
+    index = {}
+    for i, p in enumerate(points.astype(np.float32)):
+        key = (float(p[0]), float(p[1]))
+        if key in index:
+            raise InvalidInputError("the scene's mesh has two vertices at one place")
+        index[key] = i
+        subdiv.insert(key)
+    tris = []
+    for x0, y0, x1, y1, x2, y2 in subdiv.getTriangleList():
+        try:
+            tris.append([index[(float(x0), float(y0))], index[(float(x1), float(y1))], index[(float(x2), float(y2))]])
+        except KeyError:  # a triangle on Subdiv2D's virtual outer vertices
+            continue
+    tris = np.array(tris, np.int64).reshape(-1, 3)
+    a, b, c = (points[tris[:, k]] for k in range(3))
+    cross = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    tris = tris[np.abs(cross) > 1e-9]
+    flip = cross[np.abs(cross) > 1e-9] > 0  # y down: counter-clockwise in the image has a negative cross
+    tris[flip] = tris[flip][:, [0, 2, 1]]
+    return tris
