@@ -149,3 +149,36 @@ def test_bad_input_gives_one_line_and_leaves_nothing(clip, tmp_path, capsys, mon
     assert left == {"exists": ["o.mp4"], "junk": ["junk.actor"], "text": ["notvideo.mp4"]}.get(setup, [])
     if setup == "exists":
         assert (tmp_path / "o.mp4").read_bytes() == b"mine"
+
+
+CORNERS = [(slice(0, 24), slice(0, 24)), (slice(0, 24), slice(-24, None)), (slice(-24, None), slice(0, 24)),
+           (slice(-24, None), slice(-24, None))]
+
+
+def test_run_synthesises_the_face_in_its_scene_and_measures_each_frame_against_it(own, clip):
+    code, folder = own
+    assert code == 0
+    doc = json.loads((folder / "out.json").read_text())
+    shares = [f["scene_departure"] for f in doc["frames"]]
+    assert len(shares) == FRAMES and all(0.0 <= s <= 1.0 for s in shares)
+    assert not any(f["scene_departs"] for f in doc["frames"])  # nothing passes in front: nothing reported
+    assert doc.get("scene_departs", []) == []
+    first = next(iter(VideoReader(clip))).astype(int)
+    synth = face_half(folder / "out.mp4")[0].astype(int)
+    for corner in CORNERS:  # the picture's corners are the video's own (its key frame)
+        assert np.abs(synth[corner] - first[corner]).mean() < 4
+
+
+def test_mask_only_shows_the_face_alone_and_measures_nothing(clip, tmp_path, capsys):
+    code, out, err = run(capsys, "run", str(clip), "--out", str(tmp_path / "m.mp4"), "--mask-only")
+    assert code == 0, err
+    doc = json.loads((tmp_path / "m.json").read_text())
+    assert len(doc["frames"]) == FRAMES and all(f["face"] for f in doc["frames"])
+    assert not any("scene_departure" in f or "scene_departs" in f for f in doc["frames"])
+    assert "scene_departs" not in doc
+    synth = face_half(tmp_path / "m.mp4")
+    first = next(iter(VideoReader(clip))).astype(int)
+    for corner in CORNERS:
+        assert np.abs(synth[:, corner[0], corner[1]].astype(int) - BACKGROUND).max() <= 4
+        assert np.abs(synth[0][corner].astype(int) - first[corner]).mean() > 20
+    assert (np.abs(synth[:, 150:400, 180:330].astype(int) - BACKGROUND).sum(axis=3) > 40).mean() > 0.8  # the face

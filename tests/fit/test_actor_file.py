@@ -92,3 +92,52 @@ def test_oversized_members_are_refused_before_reading(tmp_path, monkeypatch, act
 def test_missing_file(tmp_path):
     with pytest.raises(InputFileError, match="actor file .*nope.actor does not exist"):
         load_actor(tmp_path / "nope.actor")
+
+
+def test_the_scene_round_trips_and_is_the_whole_source_picture(tmp_path, actor, lp_d0):
+    frame = lp_d0[0]
+    np.testing.assert_array_equal(actor.scene, frame)
+    back = load_actor(save_actor(tmp_path / "a.actor", actor))
+    assert back.scene.shape == actor.scene.shape == (512, 512, 3) and back.scene.dtype == np.uint8
+    np.testing.assert_array_equal(back.scene, actor.scene)
+    with zipfile.ZipFile(tmp_path / "a.actor") as z:
+        assert sorted(z.namelist()) == ["actor.json", "scene.png", "texture.png"]
+        assert json.loads(z.read("actor.json"))["scene"] == {"width": 512, "height": 512}
+
+
+def test_a_file_without_a_scene_loads_and_shows_the_face_alone(tmp_path, actor):
+    from dataclasses import replace
+
+    from facemime.animate.synth import BACKGROUND, Puppet
+    from facemime.fit.placement import model_iod
+
+    path = save_actor(tmp_path / "old.actor", replace(actor, scene=None))
+    with zipfile.ZipFile(path) as z:
+        assert sorted(z.namelist()) == ["actor.json", "texture.png"]
+        assert "scene" not in json.loads(z.read("actor.json"))
+    old = load_actor(path)
+    assert old.scene is None
+    sizes = Puppet(actor, np.ones(60), 1.0).deformer.feature_sizes()
+    frames = {}
+    for name, who in (("old", old), ("scene", actor)):
+        puppet = Puppet(who, sizes, model_iod(actor.model), actor.pose)
+        frames[name] = puppet.render(actor.pose, np.zeros((60, 2)), (512, 512))
+    corners = (slice(0, 40), slice(0, 40)), (slice(0, 40), slice(-40, None)), (slice(-40, None), slice(0, 40))
+    for corner in corners:
+        assert (frames["old"][corner] == BACKGROUND).all()
+        np.testing.assert_array_equal(frames["scene"][corner], actor.scene[corner])
+    face = (slice(200, 300), slice(200, 300))
+    assert np.abs(frames["old"][face].astype(int) - frames["scene"][face]).mean() < 2
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    (lambda n, b: None if n == "scene.png" else (n, b), "disagree on whether it has a scene"),
+    (edit_json(lambda doc: doc.pop("scene")), "disagree on whether it has a scene"),
+    (edit_json(lambda doc: doc["scene"].update(height=500)), "scene is 512x512, but actor.json says"),
+    (lambda n, b: (n, b"not a png") if n == "scene.png" else (n, b), "scene.png is not a PNG"),
+])
+def test_a_file_whose_scene_and_actor_json_disagree_is_refused(tmp_path, actor, change, message):
+    bad = rewrite(save_actor(tmp_path / "good.actor", actor), tmp_path / "bad.actor", change)
+    with pytest.raises(ActorFileError, match=message) as e:
+        load_actor(bad)
+    assert "\n" not in str(e.value) and str(bad) in str(e.value)
