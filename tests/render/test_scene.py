@@ -71,9 +71,10 @@ def check_topology(mesh):
     assert cov.max() == 1, f"{int((cov > 1).sum())} pixels covered twice"
     assert len(np.unique(tris)) == len(p), "a vertex in no triangle"
     # the border: the last vertices, still, on the picture's outer pixel edges, corners included
-    border = mesh.follow == 0
     n = 4 * (BORDER_STEPS - 1)
-    assert border.sum() == n and border[-n:].all()
+    border = np.zeros(len(p), bool)
+    border[-n:] = True
+    assert (mesh.follow[border] == 0).all()
     edge_x, edge_y = np.isin(p[border, 0], [-0.5, w - 0.5]), np.isin(p[border, 1], [-0.5, h - 0.5])
     assert (edge_x | edge_y).all()
     assert ((p[border] >= -0.5) & (p[border] <= [w - 0.5, h - 0.5])).all()
@@ -97,13 +98,13 @@ def test_the_mesh_covers_the_picture_once_wound_like_the_face(name):
     check_topology(mesh)
     np.testing.assert_array_equal(mesh.rest[:len(outline)], outline)
     np.testing.assert_array_equal(mesh.anchors, np.arange(100, 118))
-    # every ring that fits is there: three around a face in the middle, fewer near an edge
-    per_ring = [(mesh.follow[len(outline):] == share).sum() for _, share in RINGS[1:]]
+    # every ring vertex that fits is there: all around a face in the middle, fewer near an edge
+    rings = len(mesh.rest) - len(outline) - 4 * (BORDER_STEPS - 1)
     first = (mesh.follow[len(outline):] == 1).sum()
     if name in WHOLE:
-        assert first == len(outline) and all(0 < k <= len(outline) for k in per_ring)
+        assert first == len(outline) and rings == len(RINGS) * len(outline)
     else:
-        assert first < len(outline)
+        assert first < len(outline) and rings < len(RINGS) * len(outline)
 
 
 def test_the_mesh_of_a_fitted_actor_covers_its_picture_once(actor):
@@ -139,7 +140,7 @@ def test_rings_pushed_past_the_edge_stay_in_the_picture():
     assert (moved[:, 0] == -0.5).sum() > BORDER_STEPS  # rings clamped onto the left edge
 
 
-#: Small faces whose three rings all fit in the picture: (size, centre, half-axes, shift of the face).
+#: Small faces whose rings all fit in the picture: (size, centre, half-axes, shift of the face).
 SHIFTED = {
     "landscape": ((320, 240), (160, 120), (25, 32), (3.4, -2.3)),
     "portrait": ((200, 360), (100, 180), (22, 30), (-2.6, 4.2)),
@@ -152,18 +153,19 @@ def test_a_shifted_face_moves_its_surround_and_leaves_the_border(name):
     w, h = size
     outline = ellipse(centre, axes)
     mesh = SceneMesh.build(size, np.arange(len(outline)), outline)
-    outermost = mesh.follow == RINGS[-1][1]
-    assert outermost.sum() == len(outline)
+    outermost = np.zeros(len(mesh.rest), bool)
+    outermost[len(RINGS) * len(outline):(len(RINGS) + 1) * len(outline)] = True
+    assert (mesh.follow[outermost] == RINGS[-1][1]).all()
     key = key_frame(size)
     out = np.full_like(key, 255)
     mesh.draw(out, key, outline + d)
     y, x = np.mgrid[0:h, 0:w].astype(float)
     # inside the first ring (less a margin for its edges) the picture is the key frame shifted
     inner = polygon_mask(np.array(centre) + 0.95 * RINGS[0][0] * (outline - centre) + d, size)
-    assert inner.sum() > 3000
+    assert inner.sum() > 2000
     err = np.abs(out - plane(x - d[0], y - d[1]))[inner]
     assert err.max() <= 1.6, f"the face's surround is not the shifted key frame (error {err.max():.1f})"
-    # outside the outermost ring every pixel moves at most as far as that ring (a fifth of the
+    # outside the outermost ring every pixel moves at most as far as that ring (its share of the
     # shift), and is sampled at most half a pixel off (nearest): the plane's slope bounds the change
     outer = ~polygon_mask(np.concatenate([mesh.rest[outermost], mesh.points(outline + d)[outermost]]), size)
     assert outer.sum() > 0.3 * w * h

@@ -72,6 +72,6 @@ def departure(real: np.ndarray, synth: np.ndarray, outline: np.ndarray) -> float
     face = np.asarray(outline, np.float64) * (size[0] / w, size[1] / h)
     shares = []
     for region in (~_hull(face, 1.0 + 2.0 * FACE_GROWTH, far.shape), _hull(face, FACE_CORE, far.shape)):
-        total = int(region.sum())
-        shares.append(float((far & region).sum() / total) if total else 0.0)
-    return max(shares)
+        total = np.count_nonzero(region)  # (ndarray.sum of a bool array is 10x slower)
+        shares.append(np.count_nonzero(far & region) / total if total else 0.0)
+    return float(max(shares))
