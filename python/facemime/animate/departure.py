@@ -13,10 +13,11 @@ face hides the eyes, nose and mouth the synthesis shows); a frame's departure is
 share, and the frame departs above :data:`DEPARTS_AT`.
 
 Set on the ten shared videos and a hand of the face's own skin colour composited over two of
-them (lp_d0, vr_2; ``tests/animate/test_departure.py``): of the 23 frames with the hand 18 and 19
-depart, all 8 with it held over the face, none without it; the five videos whose body and
-camera stay put (lp_d0, vr_1, vr_2, mt_sun, mt_yongen) have no frame that departs; the others
-(lp_d3, lp_d6, lp_d12, st_aoc, st_kh: the body sways, the camera moves) 50-98% of their frames.
+them (lp_d0, vr_2; ``tests/animate/test_departure.py``): of the 23 frames with the hand 18
+depart on each, all 8 with it held over the face, none without it; the five videos whose body
+and camera stay put (lp_d0, vr_1, vr_2, mt_sun, mt_yongen) have no frame that departs; the
+others, where the body sways or the camera moves, lp_d6 55%, lp_d3 75%, st_kh 92%, lp_d12 94%
+and st_aoc 96% of their frames (``benchmarks/synthesis.py``).
 """
 
 from __future__ import annotations
