@@ -147,3 +147,39 @@ def test_user_motion_adds_turns_zoom_and_exaggeration(actor):
     for bad in ({"zoom": 0.0}, {"gain": -1}, {"yaw": float("nan")}):
         with pytest.raises(InvalidInputError):
             UserMotion(**bad)
+
+
+def test_another_actor_plays_in_its_own_picture_moved_as_the_source_moves(actor, lp_d0):
+    """Transfer in the scene: the driven actor sits where its own picture has it, moves by the
+    source's motion relative to the source's key pose, and a picture of another shape is fitted
+    whole into the frame."""
+    from dataclasses import replace
+
+    import cv2
+
+    from facemime.animate.synth import BACKGROUND
+    from facemime.fit.actor import smear_texture
+    from facemime.fit.placement import fit_model
+
+    frame, points, _ = lp_d0
+    tall = np.zeros((768, 512, 3), np.uint8)
+    tall[128:640] = frame
+    moved_points = {k: np.asarray(v) + [0.0, 128.0] for k, v in points.items()}
+    target = smear_texture(actor.model, tall, fit_model(actor.model, moved_points), moved_points,
+                           {"file": "tall.png", "frame": 0, "width": 512, "height": 768})
+    sizes = Puppet(actor, np.ones(60), 1.0).deformer.feature_sizes()
+    puppet = Puppet(target, sizes, model_iod(actor.model), actor.pose)
+    rest = puppet.pose(actor.pose)  # the source at its key pose: the target at its own
+    assert np.allclose([getattr(rest, k) for k in vars(rest)], [getattr(target.pose, k) for k in vars(rest)])
+    shifted = puppet.pose(replace(actor.pose, tx=actor.pose.tx + 10, roll=actor.pose.roll + 3))
+    # shifts scale by the two faces' sizes on screen (eye distances in pixels; the same face here)
+    ratio = target.pose.scale * model_iod(target.model) / (actor.pose.scale * model_iod(actor.model))
+    assert shifted.tx == pytest.approx(target.pose.tx + 10 * ratio) and abs(ratio - 1) < 0.01
+    assert shifted.roll == pytest.approx(target.pose.roll + 3)
+    still = puppet.render(actor.pose, np.zeros((60, 2)), (512, 512)).astype(int)
+    # the 512 x 768 picture fitted into 512 x 512: 341 px wide, centred, plain margins beside it
+    assert np.abs(still[:, :80] - BACKGROUND).max() == 0 and np.abs(still[:, -80:] - BACKGROUND).max() == 0
+    expected = cv2.resize(tall, (341, 512), interpolation=cv2.INTER_AREA).astype(int)
+    assert np.abs(still[:, 85:426] - expected).mean() < 6
+    mask = Puppet(target, sizes, model_iod(actor.model), actor.pose, mask_only=True)
+    assert mask.pose(actor.pose).tx == pytest.approx(actor.pose.tx)  # face alone: where the source's face is

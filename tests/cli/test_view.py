@@ -19,7 +19,9 @@ import numpy as np
 import pytest
 
 from facemime.animate.run import run_video
+from facemime.animate.synth import BACKGROUND
 from facemime.errors import InvalidInputError
+from facemime.io.video import VideoReader
 from facemime.viewer import HELP, Viewer, make_server
 
 from .test_cli import first_frames, run
@@ -77,6 +79,17 @@ def test_the_web_page_serves_frames_and_takes_keys(recorded):
     finally:
         server.shutdown()
         server.server_close()
+
+
+def test_a_video_plays_in_its_scene_or_with_mask_only_the_face_alone(recorded):
+    first = next(iter(VideoReader(recorded[0])))
+    corners = (slice(0, 24), slice(-24, None))
+    for mask_only in (False, True):
+        with Viewer(recorded[0], mask_only=mask_only) as viewer:
+            synth = viewer.frame()[:, 512:].astype(int)
+        for ys, xs in itertools.product(corners, corners):
+            expected = np.array(BACKGROUND) if mask_only else first[ys, xs]
+            assert np.abs(synth[ys, xs] - expected).mean() < 4
 
 
 def test_a_track_without_motion_is_refused(tmp_path):
