@@ -141,3 +141,30 @@ def test_a_file_whose_scene_and_actor_json_disagree_is_refused(tmp_path, actor, 
     with pytest.raises(ActorFileError, match=message) as e:
         load_actor(bad)
     assert "\n" not in str(e.value) and str(bad) in str(e.value)
+
+
+@pytest.mark.parametrize("source, message", [
+    ({"width": 10**6, "height": 10**6}, "more than 100000000 pixels"),
+    ({"width": 512, "height": 900}, "not its source picture"),
+    ({"width": 256, "height": 256}, "not its source picture"),
+    ({"width": "512", "height": 512}, "needs its source picture's width and height"),
+])
+def test_a_scene_whose_source_picture_is_huge_or_of_another_shape_is_refused(actor, tmp_path, source, message):
+    """The scene is drawn at its source picture's size: a forged size would make it allocate
+    without bound, or stretch it out of shape."""
+    import io
+
+    from facemime.io.actor_file import actor_bytes
+
+    path = tmp_path / "forged.actor"
+    with zipfile.ZipFile(io.BytesIO(actor_bytes(actor))) as z, zipfile.ZipFile(path, "w") as out:
+        for name in z.namelist():
+            data = z.read(name)
+            if name == "actor.json":
+                doc = json.loads(data)
+                doc["source"].update(source)
+                data = json.dumps(doc).encode()
+            out.writestr(name, data)
+    with pytest.raises(ActorFileError, match=message) as e:
+        load_actor(path)
+    assert "\n" not in str(e.value) and str(path) in str(e.value)

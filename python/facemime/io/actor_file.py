@@ -32,7 +32,7 @@ import numpy as np
 
 from facemime.errors import FacemimeError, InputFileError, InvalidInputError, ModelFormatError
 from facemime.fit.actor import Actor
-from facemime.io.limits import image_size, parse_json
+from facemime.io.limits import image_size, limit, parse_json
 from facemime.io.outputs import OutputFileError, check_outputs, write_bytes
 from facemime.model.head import head_document, head_from_document
 from facemime.render.projection import Pose
@@ -167,9 +167,30 @@ def actor_from_bytes(source: str | Path | bytes, where: str) -> Actor:
         points = {str(k): np.asarray(v, dtype=np.float64).reshape(-1, 2) for k, v in doc.get("points", {}).items()}
         if not isinstance(source, dict) or not np.isfinite(list(pose.__dict__.values())).all() or pose.scale <= 0:
             raise ValueError("bad pose or source")
-        return Actor(model, texture, pose, source, points, scene)
-    except (KeyError, TypeError, ValueError, AttributeError, OverflowError, InvalidInputError) as e:
+    except (KeyError, TypeError, ValueError, AttributeError, OverflowError) as e:
         raise ActorFileError(f"{where}: malformed actor ({e})") from None
+    if scene is not None:
+        _check_scene_source(source, scene, where)
+    try:
+        return Actor(model, texture, pose, source, points, scene)
+    except InvalidInputError as e:
+        raise ActorFileError(f"{where}: malformed actor ({e})") from None
+
+
+def _check_scene_source(source: dict, scene: np.ndarray, where: str) -> None:
+    """Refuse a scene whose source picture (what it is drawn at) is larger than the input policy
+    allows for an image (:mod:`facemime.io.limits`), or of another shape than the scene: the
+    scene is that picture, at most shrunk."""
+    w, h = source.get("width"), source.get("height")
+    if not (isinstance(w, int) and isinstance(h, int) and w > 0 and h > 0):
+        raise ActorFileError(f"{where}: an actor with a scene needs its source picture's width and height")
+    most = limit("FACEMIME_MAX_IMAGE_PIXELS")
+    if w * h > most:
+        raise ActorFileError(f"{where}: its source picture is {w}x{h}, more than {most} pixels; "
+                             "set FACEMIME_MAX_IMAGE_PIXELS to allow more")
+    sh, sw = scene.shape[:2]
+    if sw > w or sh > h or abs(sw / sh - w / h) > 2.0 / min(sw, sh):
+        raise ActorFileError(f"{where}: its scene is {sw}x{sh}, not its source picture ({w}x{h}) or a shrunk copy")
 
 
 def _texture(data: bytes, member: str, meta: object, where: str, what: str = "texture") -> np.ndarray:
