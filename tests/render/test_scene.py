@@ -209,3 +209,19 @@ def test_bad_input_is_refused():
     mesh = SceneMesh.build(size, np.arange(18), outline)
     with pytest.raises(InvalidInputError, match="the key frame is 300x240, the picture 320x240"):
         mesh.draw(np.zeros((240, 320, 3), np.uint8), np.zeros((240, 300, 3), np.uint8), outline)
+
+
+@pytest.mark.parametrize("centre, axes", [((100, 230), (40, 60)), ((-10, 100), (40, 60)), ((100, 120), (150, 190)),
+                                          ((100, 120), (0, 0))])
+def test_a_face_cut_by_the_picture_edge_or_degenerate_still_makes_a_whole_picture(centre, axes):
+    """A face whose outline reaches past the picture (a chin below its bottom edge, a face half
+    out, a face larger than the picture) or collapses to a point still gives a mesh that covers
+    the picture once and a drawing that writes every pixel."""
+    size = (200, 240)
+    outline = ellipse(centre, axes)
+    mesh = SceneMesh.build(size, np.arange(len(outline)), outline)
+    assert coverage(mesh.rest, mesh.triangles, size).min() == 1
+    key = key_frame(size)
+    out = np.full_like(key, 255)
+    mesh.draw(out, key, outline + [3.0, -2.0])
+    assert not (out == 255).all(axis=2).any()

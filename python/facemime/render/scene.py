@@ -102,8 +102,7 @@ class SceneMesh:
         points.append(border)
         follow.append(np.zeros(len(border)))
         rest = np.concatenate(points)
-        return cls((int(w), int(h)), np.asarray(anchors, np.int64), rest, np.concatenate(follow),
-                   _delaunay(rest, (w, h)))
+        return cls((int(w), int(h)), np.asarray(anchors, np.int64), rest, np.concatenate(follow), _delaunay(rest))
 
     def points(self, outline: np.ndarray) -> np.ndarray:
         """Every vertex now, (N, 2) pixels, for the face outline now at ``outline`` ((A, 2)
@@ -149,18 +148,20 @@ def _similarity(src: np.ndarray, dst: np.ndarray):
     return apply
 
 
-def _delaunay(points: np.ndarray, size: tuple[int, int]) -> np.ndarray:
-    """The Delaunay triangles of ``points`` ((N, 2), distinct, within the picture of ``size``
-    and its outer pixel edges), as vertex indices wound counter-clockwise in the image."""
-    w, h = size
-    subdiv = cv2.Subdiv2D((-2, -2, w + 4, h + 4))
+def _delaunay(points: np.ndarray) -> np.ndarray:
+    """The Delaunay triangles of ``points`` ((N, 2) pixels, anywhere: a face cut by the
+    picture's edge has outline vertices outside it), as vertex indices wound counter-clockwise
+    in the image. A vertex at the very place of an earlier one is left out of every triangle."""
+    f32 = points.astype(np.float32)
+    x0, y0 = np.floor(f32.min(axis=0)) - 2
+    x1, y1 = np.ceil(f32.max(axis=0)) + 2
+    subdiv = cv2.Subdiv2D((int(x0), int(y0), int(x1 - x0) + 1, int(y1 - y0) + 1))
     index = {}
-    for i, p in enumerate(points.astype(np.float32)):
+    for i, p in enumerate(f32):
         key = (float(p[0]), float(p[1]))
-        if key in index:
-            raise InvalidInputError("the scene's mesh has two vertices at one place")
-        index[key] = i
-        subdiv.insert(key)
+        if key not in index:
+            index[key] = i
+            subdiv.insert(key)
     tris = []
     for x0, y0, x1, y1, x2, y2 in subdiv.getTriangleList():
         try:
