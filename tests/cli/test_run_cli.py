@@ -182,3 +182,27 @@ def test_mask_only_shows_the_face_alone_and_measures_nothing(clip, tmp_path, cap
         assert np.abs(synth[:, corner[0], corner[1]].astype(int) - BACKGROUND).max() <= 4
         assert np.abs(synth[0][corner].astype(int) - first[corner]).mean() > 20
     assert (np.abs(synth[:, 150:400, 180:330].astype(int) - BACKGROUND).sum(axis=3) > 40).mean() > 0.8  # the face
+
+
+def test_run_names_the_frames_a_hand_hides_and_marks_them_in_the_track(clip, tmp_path, capsys):
+    """A hand-sized skin-coloured shape over the lower face in frames 20-34: run says which frames
+    depart from their synthesis, in one note, and the track file marks them."""
+    import cv2
+
+    frames = [f.copy() for f in VideoReader(clip)]
+    for f in frames[20:35]:
+        cv2.ellipse(f, (300, 420), (110, 130), 0, 0, 360, (205, 160, 140), -1)
+        cv2.line(f, (300, 420), (470, 560), (205, 160, 140), 110)
+    hand = tmp_path / "hand.mp4"
+    with VideoWriter(hand, 25) as w:
+        for f in frames:
+            w.write(f)
+    code, _, err = run(capsys, "run", str(hand), "--out", str(tmp_path / "out.mp4"))
+    assert code == 0, err
+    note = [line for line in err.splitlines() if "depart from their synthesis" in line]
+    assert len(note) == 1 and note[0].startswith("facemime: note: frames ")
+    doc = json.loads((tmp_path / "out.json").read_text())
+    flagged = [f["index"] for f in doc["frames"] if f["scene_departs"]]
+    assert flagged and set(flagged) <= set(range(20, 35)) and len(flagged) >= 10
+    assert doc["scene_departs"] and doc["scene_departs"][0][0] >= 20 and doc["scene_departs"][-1][1] <= 34
+    assert f"{doc['scene_departs'][0][0]}-" in note[0] or f" {doc['scene_departs'][0][0]} " in note[0]

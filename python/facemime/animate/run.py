@@ -3,8 +3,8 @@
 Writes a side-by-side video (the original with the tracked contours | the synthesised picture:
 the face in the driven actor's scene, or alone with ``mask_only``) that browsers play, and the
 ``facemime.track/1`` JSON with contours, head pose and knot offsets per frame; when the face is
-synthesised in its own scene, also how far each frame departs from that synthesis around the
-face (:mod:`facemime.animate.departure`): per frame ``scene_departure`` (0..1) and
+synthesised in its own scene, also how far each frame departs from that synthesis
+(:mod:`facemime.animate.departure`): per frame ``scene_departure`` (0..1) and
 ``scene_departs`` (bool), and top-level ``scene_departs`` (the [first, last] frame ranges
 reported). Outputs appear only when complete.
 """
@@ -42,7 +42,7 @@ NO_FACE_DIM = 0.45
 @dataclass
 class RunResult:
     """What :func:`run_video` did: frames, frames without a face, the files written, warnings,
-    the [first, last] ranges of frames that depart from their synthesis around the face, and
+    the [first, last] ranges of frames that depart from their synthesis, and
     seconds per stage (``decode``, ``track``, ``pose``, ``synth``, ``compose``, ``fit``,
     ``encode``: handing frames to the encoder, which encodes them on its own thread)."""
 

@@ -158,9 +158,9 @@ def run(video: Path, actor_file: Path | None, out_file: Path, track_file: Path |
     if result.departs:
         ranges = ", ".join(f"{a}" if a == b else f"{a}-{b}" for a, b in result.departs[:8])
         more = f" and {len(result.departs) - 8} more ranges" if len(result.departs) > 8 else ""
-        click.echo(f"facemime: note: frames {ranges}{more} depart from the synthesis around the face (something passes "
-                   "in front, or the body moves more than one key frame can show); they are marked in the track file",
-                   err=True)
+        click.echo(f"facemime: note: frames {ranges}{more} depart from their synthesis (something passes in front of "
+                   "the face, or the body or the camera moves more than one key frame can show); they are marked in "
+                   "the track file", err=True)
     click.echo(f"ran {result.frames} frames in {wall:.1f} s ({result.frames / wall:.0f} frames/s; the per-frame work "
                f"beside the encoder {result.fps:.0f} frames/s: {shares}){missing}", err=True)
 

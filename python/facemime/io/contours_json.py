@@ -20,9 +20,10 @@ and a top-level ``model``: ``unit`` (of the offsets and of the model), ``knots``
 vertex indices the offsets belong to), ``feature_sizes`` (K widths of each knot's feature,
 model units) and ``iod`` (distance between the outer eye corners, model units): what carrying
 the motion to another face needs. ``facemime run`` adds, when it synthesises the face in its
-own scene, per frame ``scene_departure`` (share 0..1 of the pixels around the face that differ
-from the synthesis, :mod:`facemime.animate.departure`) and ``scene_departs`` (bool: reported),
-and a top-level ``scene_departs``: the [first, last] ranges of reported frames.
+own scene, per frame ``scene_departure`` (0..1: the share of pixels around the face, or inside
+it, that differ from the synthesis, :mod:`facemime.animate.departure`) and ``scene_departs``
+(bool: reported), and a top-level ``scene_departs``: the [first, last] ranges of reported
+frames.
 """
 
 from __future__ import annotations
