@@ -26,7 +26,7 @@ import numpy as np
 
 from facemime.animate.analysis import Analysis
 from facemime.animate.run import pose_dict
-from facemime.animate.synth import Puppet, scene_mesh, synthesize
+from facemime.animate.synth import Puppet, key_frame, scene_mesh, synthesize
 from facemime.fit.actor import generic_actor
 from facemime.fit.placement import model_iod
 from facemime.fit.preview import preview_sheet
@@ -125,15 +125,15 @@ def _demo(files: list[Path], paths: list[Path], seconds: float) -> DemoResult:
     # 2. The scripted performance in her photo, with its true contours and pose.
     count = int(seconds * FPS)
     backdrop = _backdrop(SIZE)
-    scene = scene_mesh(actor)
+    scene, rest = scene_mesh(actor), actor.pose
+    key = key_frame(actor, scene)
     frames, truth, truth_poses = [], [], []
     t0 = time.perf_counter()
     for i in range(count):
         units, angles = performance(i / FPS)
-        rest = actor.pose
-        pose = replace(rest, yaw=rest.yaw + angles["yaw"], pitch=rest.pitch + angles["pitch"], roll=rest.roll + angles["roll"])
+        pose = replace(rest, **{k: getattr(rest, k) + a for k, a in angles.items()})
         vertices = actor.model.deform(units)
-        frames.append(synthesize(actor, vertices, pose, SIZE, scene=scene, key=actor.scene))
+        frames.append(synthesize(actor, vertices, pose, SIZE, scene=scene, key=key))
         pts = project(vertices, pose)[0]
         truth.append({n: pts[actor.model.groups[n]] for n in CONTOUR_NAMES})
         truth_poses.append(pose)
@@ -152,7 +152,6 @@ def _demo(files: list[Path], paths: list[Path], seconds: float) -> DemoResult:
             per_frame.append(group_nme(m.contours, ref, names, float(np.linalg.norm(corners[1] - corners[0]))))
         nme[group] = summarize(np.array(per_frame))
     first = analysis.actor.pose
-    rest = actor.pose
     pose_error = {k: float(np.mean([abs((getattr(m.pose, k) - getattr(first, k)) - (getattr(p, k) - getattr(rest, k)))
                                     for m, p in zip(motions, truth_poses)])) for k in ("yaw", "pitch", "roll")}
 

@@ -226,16 +226,15 @@ class Puppet:
     def pose(self, measured: Pose, user: UserMotion = UserMotion()) -> Pose:
         """The pose to show the actor in for a ``measured`` pose of the source face."""
         if self.scene is None or self.source_pose is None:
-            base, scale, tx, ty = measured, measured.scale * self._scale, measured.tx, measured.ty
+            shown = replace(measured, scale=measured.scale * self._scale)
         else:
             rest, key = self.actor.pose, self.source_pose
             ratio = rest.scale / self._scale / key.scale  # target pixels per source pixel
-            base = Pose(yaw=rest.yaw + measured.yaw - key.yaw, pitch=rest.pitch + measured.pitch - key.pitch,
-                        roll=rest.roll + measured.roll - key.roll)
-            scale = rest.scale * measured.scale / key.scale
-            tx, ty = rest.tx + ratio * (measured.tx - key.tx), rest.ty + ratio * (measured.ty - key.ty)
-        return Pose(yaw=base.yaw + user.yaw, pitch=base.pitch + user.pitch, roll=base.roll + user.roll,
-                    scale=scale * user.zoom, tx=tx, ty=ty)
+            shown = Pose(yaw=rest.yaw + measured.yaw - key.yaw, pitch=rest.pitch + measured.pitch - key.pitch,
+                         roll=rest.roll + measured.roll - key.roll, scale=rest.scale * measured.scale / key.scale,
+                         tx=rest.tx + ratio * (measured.tx - key.tx), ty=rest.ty + ratio * (measured.ty - key.ty))
+        return replace(shown, yaw=shown.yaw + user.yaw, pitch=shown.pitch + user.pitch, roll=shown.roll + user.roll,
+                       scale=shown.scale * user.zoom)
 
     def vertices(self, offsets: np.ndarray, user: UserMotion = UserMotion()) -> np.ndarray:
         """The actor's vertices moved by the source's knot ``offsets`` (K, 2), lips all but
@@ -269,5 +268,6 @@ def letterbox(image: np.ndarray, out: np.ndarray) -> np.ndarray:
     sw, sh = max(1, round(image.shape[1] * f)), max(1, round(image.shape[0] * f))
     x0, y0 = (w - sw) // 2, (h - sh) // 2
     fill(out, BACKGROUND)
-    out[y0:y0 + sh, x0:x0 + sw] = cv2.resize(image, (sw, sh), interpolation=cv2.INTER_AREA if f < 1 else cv2.INTER_LINEAR)
+    shrink = cv2.INTER_AREA if f < 1 else cv2.INTER_LINEAR
+    out[y0:y0 + sh, x0:x0 + sw] = cv2.resize(image, (sw, sh), interpolation=shrink)
     return out

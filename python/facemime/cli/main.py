@@ -113,6 +113,11 @@ def fit(source: Path, frame: int, points_file: Path | None, out_file: Path, forc
     click.echo(f"fitted in {run.seconds:.2f} s; the model's contours end {run.residual:.2f} px from the points", err=True)
 
 
+#: ``--mask-only`` of the commands that show a synthesised picture (``run``, ``decode``, ``view``).
+mask_only_option = click.option("--mask-only", is_flag=True,
+                                help="Show the synthesised face alone on a plain backdrop, not in its actor's scene.")
+
+
 def user_motion_options(f):
     """The options that add motion on top of the measured one (``run`` and ``view``)."""
     for opt in reversed((
@@ -132,11 +137,11 @@ def user_motion_options(f):
 @click.option("--actor", "actor_file", type=click.Path(path_type=Path),
               help="NAME.actor to drive (from facemime fit; default: the face fitted on the first frame).")
 @click.option("--out", "out_file", type=click.Path(path_type=Path), required=True,
-              help="Side-by-side video to write (.mp4 or .webm): the original with contours | the synthesised face.")
+              help="Side-by-side video to write (.mp4 or .webm): the original with contours | the synthesised picture.")
 @click.option("--track", "track_file", type=click.Path(path_type=Path),
               help="facemime.track/1 JSON to write: contours, head pose and motion per frame (default: OUT with .json).")
 @user_motion_options
-@click.option("--mask-only", is_flag=True, help="Show the synthesised face alone on a plain backdrop, not in its scene.")
+@mask_only_option
 @click.option("--force", is_flag=True, help="Overwrite existing output files.")
 def run(video: Path, actor_file: Path | None, out_file: Path, track_file: Path | None, yaw: float, pitch: float,
         roll: float, zoom: float, gain: float, mask_only: bool, force: bool) -> None:
@@ -205,8 +210,8 @@ def encode(video: Path, actor_file: Path | None, quality: int | None, rate: floa
 @click.option("--actor", "actor_file", type=click.Path(path_type=Path),
               help="NAME.actor the stream names, when the stream does not carry its actor.")
 @click.option("--out", "out_file", type=click.Path(path_type=Path), required=True,
-              help="Video of the synthesised face to write (.mp4 or .webm).")
-@click.option("--mask-only", is_flag=True, help="Show the face alone on a plain backdrop, not in its actor's scene.")
+              help="Video of the synthesised picture to write (.mp4 or .webm).")
+@mask_only_option
 @click.option("--force", is_flag=True, help="Overwrite an existing output file.")
 def decode(stream: Path, actor_file: Path | None, out_file: Path, mask_only: bool, force: bool) -> None:
     """Synthesise the face of a facemime STREAM into a video, with no access to the source video."""
@@ -226,7 +231,7 @@ def decode(stream: Path, actor_file: Path | None, out_file: Path, mask_only: boo
               help="NAME.actor to drive (default: the video's own face, or the generic head for a track file).")
 @click.option("--port", default=8765, show_default=True, help="Local port of the viewer's web page (0: any free port).")
 @click.option("--no-browser", is_flag=True, help="Do not open a browser; print the address only.")
-@click.option("--mask-only", is_flag=True, help="Show the synthesised face alone on a plain backdrop, not in its scene.")
+@mask_only_option
 def view(source: Path, actor_file: Path | None, port: int, no_browser: bool, mask_only: bool) -> None:
     """Play VIDEO (analysed live) or a TRACK.json from facemime run in the interactive viewer, a
     page in your web browser: keys turn, tilt, roll, zoom and exaggerate the synthesised face.

@@ -78,7 +78,8 @@ def actor_bytes(actor: Actor, texture: str = "png", quality: int = 90) -> bytes:
         z.writestr("actor.json", actor_json(actor))
         for what, image in (("texture", actor.texture), ("scene", actor.scene)):
             if image is not None:
-                z.writestr(zipfile.ZipInfo(f"{what}.{texture}"), _encoded(image, what, texture, quality), zipfile.ZIP_STORED)
+                data = _encoded(image, what, texture, quality)
+                z.writestr(zipfile.ZipInfo(f"{what}.{texture}"), data, zipfile.ZIP_STORED)
     return buf.getvalue()
 
 

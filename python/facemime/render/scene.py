@@ -7,8 +7,9 @@ The mesh's vertices are, in order: the **anchors**, the model's ``face_outline``
 meets the 3-D face exactly); **rings** around the face, the outline scaled about its centre by
 :data:`RINGS`, each following a share of the head's motion (the least-squares similarity, turn,
 uniform scale and shift, taking the anchors from the key frame to now); and the **border**,
-vertices on the picture's edges that never move. Everything inside the outline is triangulated too: it is drawn under the face and shows
-only where the face mesh does not cover (a turned head's culled side), never as a hole.
+vertices on the picture's edges that never move. Everything inside the outline is triangulated
+too: it is drawn under the face and shows only where the face mesh does not cover (a turned
+head's culled side), never as a hole.
 
 Where the head moves away from what the key frame showed, the uncovered part is filled by
 stretching the band between the moving ring and the still one. The alternative, inpainting the
@@ -31,6 +32,7 @@ import numpy as np
 
 from facemime.errors import InvalidInputError
 from facemime.render.texture_map import render_mesh_into
+from facemime.track.motion import apply, robust_similarity
 
 #: (distance from the face's centre as a multiple of the outline's, share of the head's motion
 #: followed) per ring: the first reaches over the hair and ears and moves with the head; the
@@ -109,7 +111,8 @@ class SceneMesh:
         pixels): the anchors there, the rings moved by their share of the outline's similarity
         motion, the border where it was; all kept inside the picture."""
         a = len(self.anchors)
-        moved = _similarity(self.rest[:a], outline)(self.rest)
+        # least squares: with no limit on the residuals no anchor is an outlier
+        moved = apply(robust_similarity(self.rest[:a], outline, limit=np.inf)[0], self.rest)
         out = self.rest + self.follow[:, None] * (moved - self.rest)
         out[:a] = outline
         w, h = self.size
@@ -122,7 +125,8 @@ class SceneMesh:
         written: the key frame is copied and only the triangles that moved are drawn again,
         those that moved less than :data:`SLOW` pixels sampled nearest, the others bilinear."""
         if key.shape != out.shape:
-            raise InvalidInputError(f"the key frame is {key.shape[1]}x{key.shape[0]}, the picture {out.shape[1]}x{out.shape[0]}")
+            raise InvalidInputError(f"the key frame is {key.shape[1]}x{key.shape[0]}, "
+                                    f"the picture {out.shape[1]}x{out.shape[0]}")
         w, h = self.size
         points = self.points(outline)
         moved = np.abs(points - self.rest).max(axis=1)[self.triangles].max(axis=1)
@@ -133,19 +137,6 @@ class SceneMesh:
                                (self.triangles[moved >= SLOW], "bilinear")):
             if len(tris):  # no culling: a triangle the motion folds over shows as a fold, never a hole
                 render_mesh_into(out, key, uv, points, depth, tris, filter=sampling, cull=False)
-
-
-def _similarity(src: np.ndarray, dst: np.ndarray):
-    """The least-squares similarity (turn, uniform scale, shift) taking ``src`` to ``dst``
-    ((A, 2) each), as a function of (N, 2) points."""
-    cs, cd = src.mean(axis=0), dst.mean(axis=0)
-    s, d = src - cs, dst - cd
-    zs, zd = s[:, 0] + 1j * s[:, 1], d[:, 0] + 1j * d[:, 1]
-    k = np.vdot(zs, zd) / max(np.vdot(zs, zs).real, 1e-12)  # complex: scale and turn
-    def apply(p: np.ndarray) -> np.ndarray:
-        z = k * ((p[:, 0] - cs[0]) + 1j * (p[:, 1] - cs[1]))
-        return np.stack([z.real + cd[0], z.imag + cd[1]], axis=1)
-    return apply
 
 
 def _delaunay(points: np.ndarray) -> np.ndarray:
