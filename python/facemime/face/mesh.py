@@ -18,6 +18,10 @@ POINT_INDICES = {
     "eye_right_inner": 133,
     "eye_left_inner": 362,
     "eye_left_outer": 263,
+    "eye_right_upper": 159,
+    "eye_right_lower": 145,
+    "eye_left_upper": 386,
+    "eye_left_lower": 374,
     "nose_tip": 4,
     "chin": 152,
 }
@@ -33,7 +37,7 @@ def reference_points(landmarks: np.ndarray) -> dict[str, np.ndarray]:
 
     >>> points = reference_points(np.arange(478 * 2, dtype=float).reshape(478, 2))
     >>> points["nose_tip"].tolist(), len(points["face_outline"]), len(points)
-    ([[8.0, 9.0]], 36, 15)
+    ([[8.0, 9.0]], 36, 19)
     """
     xy = np.asarray(landmarks, dtype=np.float64)[:, :2]
     points = {name: xy[[i]] for name, i in POINT_INDICES.items()}

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from facemime import _core
-from facemime.fit.points import POINTS, ReferencePoints, model_chain
+from facemime.fit.points import LIDS, POINTS, ReferencePoints, model_chain
 from facemime.model.head import HeadModel
 from facemime.render.projection import Pose, project, rotation_matrix
 
@@ -76,13 +76,16 @@ def fit_model(model: HeadModel, points: ReferencePoints) -> Fit:
     :func:`facemime.fit.points.check_points`), then adjust it elastically until its contours
     lie on theirs.
 
-    The placement is the least-squares similarity of the single points and the curve ends; the
-    adjusted image positions are taken back into model space through it, so proportions that
-    differ from the generic head (a longer face, a wider mouth) stay in the vertices.
+    The placement is the least-squares similarity of the single points (but the lids) and the
+    curve ends; the adjusted image positions are taken back into model space through it, so
+    proportions that differ from the generic head (a longer face, a wider mouth) stay in the
+    vertices.
     """
     anchors_m, anchors_i = [], []
     for name, pts in points.items():
         chain = model_chain(model, name)
+        if name in LIDS:
+            continue
         if name in POINTS:
             anchors_m.append(model.vertices[chain])
             anchors_i.append(pts)

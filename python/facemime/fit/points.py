@@ -23,11 +23,18 @@ POINTS = {
     "eye_right_inner": ("eye_right", 4),
     "eye_left_inner": ("eye_left", 0),
     "eye_left_outer": ("eye_left", 4),
+    "eye_right_upper": ("eye_right", 2),  # the middle of each upper and lower lid
+    "eye_right_lower": ("eye_right", 6),
+    "eye_left_upper": ("eye_left", 2),
+    "eye_left_lower": ("eye_left", 6),
     "nose_tip": ("nose", 6),
     "chin": ("face_outline", 9),
 }
 #: Curves, named like the model groups they follow.
 CURVES = CONTOUR_NAMES + ("face_outline",)
+#: Points that move with the face's expression: the elastic adjustment follows them, the
+#: placement does not.
+LIDS = ("eye_right_upper", "eye_right_lower", "eye_left_upper", "eye_left_lower")
 #: Every name a reference-point set may hold.
 NAMES = tuple(POINTS) + CURVES
 #: Names a set must hold: enough to place and scale the model.
