@@ -166,7 +166,7 @@ def _demo(files: list[Path], paths: list[Path], seconds: float) -> DemoResult:
         for i, (frame, m) in enumerate(zip(frames, motions)):
             perf_video.write(frame)
             s0 = time.perf_counter()
-            panels = [p.render(m.pose, m.offsets, SIZE, out=backdrop.copy()) for p in puppets]
+            panels = [p.render(m.pose, m.offsets, SIZE, out=backdrop.copy(), look=m.look) for p in puppets]
             synth_seconds += time.perf_counter() - s0
             row = np.hstack([draw_contours(frame, m.contours, m.lost)] + panels)
             video.write(row)
@@ -177,7 +177,8 @@ def _demo(files: list[Path], paths: list[Path], seconds: float) -> DemoResult:
     write_json(paths[4], track_document(
         {"width": SIZE[0], "height": SIZE[1], "fps": FPS, "frames": count},
         [{"index": i, "contours": m.contours, "confidence": m.confidence, "lost": m.lost, "redetected": m.redetected,
-          "face": m.face, "pose": pose_dict(m.pose), "offsets": m.offsets} for i, m in enumerate(motions)],
+          "face": m.face, "pose": pose_dict(m.pose), "offsets": m.offsets, "look": m.look.as_dict()}
+         for i, m in enumerate(motions)],
         model=analysis.model_block))
     write_image(paths[5], _still_sheet(stills))
     write_text(paths[6], _report(nme, pose_error, timing, count, sorted(shown)))

@@ -134,11 +134,11 @@ class Viewer:
         self._shown = next(self._frames)
 
     def _play(self) -> Iterator[tuple[np.ndarray | None, Pose, np.ndarray, Puppet]]:
-        """(left panel or None, pose, knot offsets, puppet) per frame, looping forever."""
+        """(left panel or None, pose, knot offsets, look, puppet) per frame, looping forever."""
         while True:
             if self._is_track:
                 for m in self._motions:
-                    yield None, Pose(**m["pose"]), m["offsets"], self._puppet
+                    yield None, Pose(**m["pose"]), m["offsets"], m["look"], self._puppet
                 continue
             analysis = None
             with VideoReader(self.source) as reader:
@@ -157,16 +157,17 @@ class Viewer:
                         m = analysis.last
                     else:
                         m = analysis.update(frame)
-                    yield (draw_contours(frame, m.contours, m.lost) if m.face else frame), m.pose, m.offsets, puppet
+                    yield ((draw_contours(frame, m.contours, m.lost) if m.face else frame), m.pose, m.offsets, m.look,
+                           puppet)
             if analysis is None:
                 raise InputFileError(f"video {self.source} has no frames")
 
     def _render(self) -> np.ndarray:
-        left, pose, offsets, puppet = self._shown
+        left, pose, offsets, look, puppet = self._shown
         synth = np.empty((self.size[1], self.size[0], 3), np.uint8)
         if puppet.scene is None:
             fill(synth, BACKGROUND)
-        puppet.render(pose, offsets, self.size, self.user, out=synth)
+        puppet.render(pose, offsets, self.size, self.user, out=synth, look=look)
         return synth if left is None else np.hstack([left, synth])
 
     def key(self, name: str) -> dict:

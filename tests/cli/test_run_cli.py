@@ -10,6 +10,7 @@ import pytest
 from facemime.animate.run import SideBySide
 from facemime.animate.synth import BACKGROUND
 from facemime.errors import InputFileError
+from facemime.animate.look import NAMES
 from facemime.io.contours_json import read_motion
 from facemime.io.video import VideoReader, VideoWriter
 from facemime.metrics import group_nme
@@ -64,6 +65,10 @@ def test_run_writes_a_side_by_side_video_and_the_motion(own, shared):
     # The grin (frames 20-45) widens the mouth: the corner knots move apart in the head frame.
     width = [m["offsets"][10, 0] - m["offsets"][0, 0] for m in motion]
     assert max(width[20:45]) > 4.0 and abs(width[1]) < 1.0
+    # She looks aside and back (Face Mesh irises: 0.2 of an eye's width): the look follows.
+    assert set(doc["frames"][5]["look"]) == set(NAMES)
+    gaze = np.array([m["look"].iris[:, 0] for m in motion])
+    assert np.abs(gaze[:3]).max() < 0.05 and np.abs(gaze).max() > 0.12
 
 
 def test_the_per_frame_work_composes_every_frame_without_encoding(clip):

@@ -6,7 +6,9 @@ import numpy as np
 import pytest
 
 from facemime.errors import InputFileError
-from facemime.io.contours_json import ContourFileError, init_document, read_init, read_track, track_document, write_json
+from facemime.animate.look import Look
+from facemime.io.contours_json import (ContourFileError, init_document, read_init, read_motion, read_track,
+                                       track_document, write_json)
 from facemime.track.synthetic import band_face
 
 
@@ -63,3 +65,32 @@ def test_bad_init_files_give_one_line(tmp_path, text, message):
 def test_missing_init_file(tmp_path):
     with pytest.raises(InputFileError, match="does not exist"):
         read_init(tmp_path / "nope.json")
+
+
+def _motion_file(tmp_path, look):
+    frame = {"index": 0, "pose": {"yaw": 0, "pitch": 0, "roll": 0, "scale": 2.0, "tx": 100, "ty": 90},
+             "offsets": [[0.0, 0.0]] * 3}
+    if look is not None:
+        frame["look"] = look
+    doc = {"format": "facemime.track/1", "video": {}, "frames": [frame],
+           "model": {"unit": "mm", "knots": [1, 2, 3], "feature_sizes": [1, 1, 1], "iod": 90}}
+    path = tmp_path / "m.json"
+    path.write_text(json.dumps(doc))
+    return path
+
+
+def test_the_look_is_read_back_and_a_file_without_it_plays_neutral(tmp_path):
+    look = Look([1.0, 0.25], [[0.1, -0.02], [0.08, 0.0]])
+    assert read_motion(_motion_file(tmp_path, look.as_dict()))[2][0]["look"].as_dict() == look.as_dict()
+    assert not read_motion(_motion_file(tmp_path, None))[2][0]["look"].vector().any()
+    partial = read_motion(_motion_file(tmp_path, {"eye_left_closure": 0.5}))[2][0]["look"]
+    assert partial.vector().tolist() == [0.0, 0.5, 0.0, 0.0, 0.0, 0.0]
+
+
+@pytest.mark.parametrize("look, message", [({"eye_right_closure": "shut"}, "malformed 'look'"),
+                                           ([0.5, 0.5], "malformed 'look'"),
+                                           ({"iris_left_u": 1e9}, "beyond"),
+                                           ({"iris_left_v": float("nan")}, "beyond")])
+def test_a_bad_look_is_refused_in_one_line(tmp_path, look, message):
+    with pytest.raises(ContourFileError, match=message):
+        read_motion(_motion_file(tmp_path, look))

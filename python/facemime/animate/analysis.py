@@ -16,11 +16,12 @@ again by a fit of the actor on the frame at most once in :data:`ANCHOR_EVERY` fr
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from facemime.animate.deform import Deformer
+from facemime.animate.look import Look
 from facemime.animate.pose import PoseTracker
 from facemime.errors import NoFaceError
 from facemime.face.mesh import reference_points
@@ -29,6 +30,7 @@ from facemime.fit.placement import fit_model, model_iod
 from facemime.fit.run import fit_actor, init_contours
 from facemime.render.projection import Pose
 from facemime.track.contours import FEATURES
+from facemime.track.eyes import EyeTracker
 from facemime.track.redetect import FaceTracker
 from facemime.track.tracker import TrackerParams
 
@@ -51,7 +53,8 @@ class FrameMotion:
     contours collapsed; ``face``: False when the face was not found (pose and offsets then
     repeat the last good frame's); ``pose``: the head pose of the analysis actor; ``offsets``:
     (K, 2) knot offsets, model units; ``redetected``: the face landmark model put the contours
-    right on this frame.
+    right on this frame; ``look``: the eyes (:class:`~facemime.animate.look.Look`, relative to
+    the first frame's).
     """
 
     contours: dict[str, np.ndarray]
@@ -61,6 +64,7 @@ class FrameMotion:
     pose: Pose
     offsets: np.ndarray
     redetected: bool = False
+    look: Look = field(default_factory=Look)
 
 
 @dataclass
@@ -70,6 +74,7 @@ class Timings:
     track: float = 0.0
     pose: float = 0.0
     fit: float = 0.0
+    look: float = 0.0
 
 
 class Analysis:
@@ -93,6 +98,8 @@ class Analysis:
         contours = init_contours(self.actor)
         self._knots0 = self.deformer.knot_positions(contours, self.actor.pose)
         self.tracker = FaceTracker(frame, contours, params)
+        self.eyes = EyeTracker(self.actor.model, frame, self.actor.pose)
+        self.eye_state = self.eyes.key  # the eyes as last measured (image positions, for checks)
         self._follow_pose(self.actor.pose)
         self.last = FrameMotion(contours, {f: 1.0 for f in FEATURES}, [], True, self.actor.pose,
                                 np.zeros((len(self.deformer.knots), 2)))
@@ -137,12 +144,18 @@ class Analysis:
             t1 += fitting  # not the pose's
         if face:
             offsets = self.deformer.knot_positions(result.contours, self.pose.pose) - self._knots0
+            t2 = time.perf_counter()
+            self.eye_state = self.eyes.update(frame, self.pose.pose)
+            closure, iris = self.eyes.look(self.eye_state)
+            look = Look(closure, iris)
+            self.timings.look += time.perf_counter() - t2
+            t1 += time.perf_counter() - t2  # not the pose's
             self.last = FrameMotion(result.contours, result.confidence, result.lost, True, self.pose.pose, offsets,
-                                    result.redetected)
+                                    result.redetected, look)
         else:
             self.frames_without_face += 1
             self.last = FrameMotion(self.last.contours, {f: 0.0 for f in FEATURES}, list(FEATURES), False,
-                                    self.last.pose, self.last.offsets)
+                                    self.last.pose, self.last.offsets, look=self.last.look)
         self.timings.track += t1 - t0
         self.timings.pose += time.perf_counter() - t1
         return self.last

@@ -2,7 +2,8 @@
 
 Writes a side-by-side video (the original with the tracked contours | the synthesised picture:
 the face in the driven actor's scene, or alone with ``mask_only``) that browsers play, and the
-``facemime.track/1`` JSON with contours, head pose and knot offsets per frame; when the face is
+``facemime.track/1`` JSON with contours, head pose, knot offsets and look (the eyes,
+:mod:`facemime.animate.look`) per frame; when the face is
 synthesised in its own scene, also how far each frame departs from that synthesis
 (:mod:`facemime.animate.departure`): per frame ``scene_departure`` (0..1) and
 ``scene_departs`` (bool), and top-level ``scene_departs`` (the [first, last] frame ranges
@@ -43,7 +44,7 @@ NO_FACE_DIM = 0.45
 class RunResult:
     """What :func:`run_video` did: frames, frames without a face, the files written, warnings,
     the [first, last] ranges of frames that depart from their synthesis, and
-    seconds per stage (``decode``, ``track``, ``pose``, ``synth``, ``compose``, ``fit``,
+    seconds per stage (``decode``, ``track``, ``pose``, ``look``, ``synth``, ``compose``, ``fit``,
     ``encode``: handing frames to the encoder, which encodes them on its own thread)."""
 
     frames: int
@@ -66,7 +67,7 @@ class RunResult:
     @property
     def shares(self) -> dict[str, float]:
         """Fraction of the per-frame work spent in each stage."""
-        return {k: self.seconds[k] / self._busy for k in ("decode", "track", "pose", "synth", "compose")}
+        return {k: self.seconds[k] / self._busy for k in ("decode", "track", "pose", "look", "synth", "compose")}
 
 
 def pose_dict(pose: Pose) -> dict[str, float]:
@@ -98,7 +99,7 @@ class SideBySide:
         self.records = [] if records is None else records
         self.departs: list[list[int]] = []
         self.frames = 0
-        self.seconds = dict.fromkeys(("decode", "track", "pose", "synth", "compose"), 0.0)
+        self.seconds = dict.fromkeys(("decode", "track", "pose", "look", "synth", "compose"), 0.0)
         self.analysis: Analysis | None = None
 
     def __iter__(self) -> Iterator[np.ndarray]:
@@ -131,10 +132,10 @@ class SideBySide:
             t1 = time.perf_counter()
             if puppet.scene is None:
                 fill(synth, BACKGROUND)
-            puppet.render(motion.pose, motion.offsets, (w, h), self._user, out=synth)
+            puppet.render(motion.pose, motion.offsets, (w, h), self._user, out=synth, look=motion.look)
             record = {"index": self.frames, "contours": motion.contours, "confidence": motion.confidence,
                       "lost": motion.lost, "redetected": motion.redetected, "face": motion.face,
-                      "pose": pose_dict(motion.pose), "offsets": motion.offsets}
+                      "pose": pose_dict(motion.pose), "offsets": motion.offsets, "look": motion.look.as_dict()}
             if compare and motion.face:
                 vertices, shown = puppet.shown
                 share = departure(frame, synth, project(vertices[outline], shown)[0])
@@ -157,7 +158,7 @@ class SideBySide:
             yield canvas
         if self.analysis is not None:
             t = self.analysis.timings
-            seconds.update(track=t.track, pose=t.pose, fit=t.fit)
+            seconds.update(track=t.track, pose=t.pose, fit=t.fit, look=t.look)
 
     def result(self, files: list[Path], encode_seconds: float = 0.0) -> RunResult:
         """What the run did, once iterated to the end (``encode_seconds``: the time the caller

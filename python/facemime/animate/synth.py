@@ -15,6 +15,8 @@ import cv2
 import numpy as np
 
 from facemime.animate.deform import Deformer, mouth_width
+from facemime.animate.eyes import LookPainter
+from facemime.animate.look import Look
 from facemime.errors import InvalidInputError
 from facemime.fit.actor import Actor
 from facemime.fit.placement import model_iod
@@ -135,13 +137,15 @@ def key_frame(actor: Actor, scene: SceneMesh) -> np.ndarray:
 
 def synthesize(actor: Actor, vertices: np.ndarray, pose: Pose, size: tuple[int, int],
                background: np.ndarray | tuple[int, int, int] = BACKGROUND, out: np.ndarray | None = None,
-               scene: SceneMesh | None = None, key: np.ndarray | None = None) -> np.ndarray:
+               scene: SceneMesh | None = None, key: np.ndarray | None = None,
+               texture: np.ndarray | None = None) -> np.ndarray:
     """The actor with ``vertices`` (its model's, deformed) seen in ``pose``: an (H, W, 3) image
     of ``size`` = (width, height) over ``background`` (a colour or an image of that size), or
     drawn into ``out`` when given (the background is then what ``out`` holds). With ``scene``
     (the actor's :func:`scene_mesh`, of this ``size``) and ``key`` (its scene image at that size,
     :func:`key_frame`), the face is drawn in the actor's scene warped to follow it, and the
-    background is not used."""
+    background is not used. ``texture``: drawn instead of the actor's own (same size: its eyes
+    repainted, :class:`~facemime.animate.eyes.LookPainter`)."""
     w, h = size
     if out is None:
         out = np.empty((h, w, 3), np.uint8)
@@ -155,7 +159,8 @@ def synthesize(actor: Actor, vertices: np.ndarray, pose: Pose, size: tuple[int, 
     g = actor.model.groups
     spread = mouth_width(actor.model, vertices) / max(mouth_width(actor.model, actor.model.vertices), 1e-9)
     draw_mouth_interior(out, points[g["mouth_inner_upper"]], points[g["mouth_inner_lower"]], teeth_uncovered(spread))
-    render_mesh_into(out, actor.texture, actor.model.uv, points, depth, actor.model.triangles)
+    render_mesh_into(out, actor.texture if texture is None else texture, actor.model.uv, points, depth,
+                     actor.model.triangles)
     return out
 
 
@@ -216,6 +221,7 @@ class Puppet:
         self._key = None if self.scene is None else key_frame(actor, self.scene)
         self.shown: tuple[np.ndarray, Pose] | None = None
         self.deformer = Deformer(actor.model)
+        self.painter = LookPainter(actor)
         sizes = np.asarray(source_sizes, np.float64)
         if sizes.shape != (len(self.deformer.knots),) or not np.isfinite(sizes).all() or (sizes <= 0).any():
             raise InvalidInputError(f"the motion has {len(sizes)} knots but actor {actor.model.name!r} has "
@@ -236,27 +242,31 @@ class Puppet:
         return replace(shown, yaw=shown.yaw + user.yaw, pitch=shown.pitch + user.pitch, roll=shown.roll + user.roll,
                        scale=shown.scale * user.zoom)
 
-    def vertices(self, offsets: np.ndarray, user: UserMotion = UserMotion()) -> np.ndarray:
+    def vertices(self, offsets: np.ndarray, user: UserMotion = UserMotion(), look: Look = Look()) -> np.ndarray:
         """The actor's vertices moved by the source's knot ``offsets`` (K, 2), lips all but
-        touching shown closed (:data:`SEAL`)."""
-        return self.deformer.sealed(self.deformer.vertices(offsets * self._ratio, user.gain), SEAL)
+        touching shown closed (:data:`SEAL`), lids closed by ``look`` (times the user's gain)."""
+        vertices = self.deformer.sealed(self.deformer.vertices(offsets * self._ratio, user.gain), SEAL)
+        return self.painter.vertices(vertices, Look(look.closure * user.gain))
 
     def render(self, measured: Pose, offsets: np.ndarray, size: tuple[int, int], user: UserMotion = UserMotion(),
-               out: np.ndarray | None = None) -> np.ndarray:
+               out: np.ndarray | None = None, look: Look = Look()) -> np.ndarray:
         """The synthesised frame, (H, W, 3) of ``size`` = (width, height), drawn into ``out``
-        when given. A scene of another size is drawn at its own and fitted into ``size``
-        (its aspect kept, the rest :data:`BACKGROUND`); without a scene the face is drawn over
-        what ``out`` holds (or :data:`BACKGROUND`). The vertices and pose drawn are left in
-        :attr:`shown`."""
-        vertices, pose = self.vertices(offsets, user), self.pose(measured, user)
+        when given, with the eyes of ``look``. A scene of another size is drawn at its
+        own and fitted into ``size`` (its aspect kept, the rest :data:`BACKGROUND`); without a
+        scene the face is drawn over what ``out`` holds (or :data:`BACKGROUND`). The vertices and
+        pose drawn are left in :attr:`shown`."""
+        vertices, pose = self.vertices(offsets, user, look), self.pose(measured, user)
+        texture = self.painter.texture(Look(look.closure, look.iris * user.gain))
         self.shown = (vertices, pose)
         if self.scene is None:
-            return synthesize(self.actor, vertices, pose, size, out=out)
+            return synthesize(self.actor, vertices, pose, size, out=out, texture=texture)
         if out is None:
             out = np.empty((size[1], size[0], 3), np.uint8)
         if tuple(size) == self.scene.size:
-            return synthesize(self.actor, vertices, pose, size, out=out, scene=self.scene, key=self._key)
-        synthesize(self.actor, vertices, pose, self.scene.size, out=self._picture, scene=self.scene, key=self._key)
+            return synthesize(self.actor, vertices, pose, size, out=out, scene=self.scene, key=self._key,
+                              texture=texture)
+        synthesize(self.actor, vertices, pose, self.scene.size, out=self._picture, scene=self.scene, key=self._key,
+                   texture=texture)
         return letterbox(self._picture, out)
 
 

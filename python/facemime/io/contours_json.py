@@ -15,6 +15,9 @@ extends ``facemime.track/1`` compatibly with per-frame keys:
   :mod:`facemime.render.projection`);
 - ``offsets``: (K, 2) displacements of the model's contour vertices (the knots) in the head's own
   frame, model units, relative to the first frame: the local motion that drives synthesis;
+- ``look``: the eyes, relative to the first frame (names and units in
+  :mod:`facemime.animate.look`: ``eye_right_closure``, ``iris_right_u``, ...); a name left
+  out is 0;
 
 and a top-level ``model``: ``unit`` (of the offsets and of the model), ``knots`` (the K model
 vertex indices the offsets belong to), ``feature_sizes`` (K widths of each knot's feature,
@@ -35,6 +38,7 @@ from typing import Any
 
 import numpy as np
 
+from facemime.animate.look import Look
 from facemime.errors import FacemimeError
 from facemime.io.limits import parse_json, read_json_text
 from facemime.io.outputs import OutputFileError, write_text
@@ -42,6 +46,8 @@ from facemime.track.contours import CONTOUR_NAMES
 
 INIT_FORMAT = "facemime.init/1"
 POSE_KEYS = ("yaw", "pitch", "roll", "scale", "tx", "ty")
+#: Largest magnitude of a look value a track file may hold (closures, eye widths).
+LOOK_LIMIT = 10.0
 TRACK_FORMAT = "facemime.track/1"
 
 Contours = dict[str, np.ndarray]
@@ -158,6 +164,8 @@ def track_entry(f: Mapping[str, Any]) -> dict[str, Any]:
         entry["pose"] = {k: round(float(v), 4) for k, v in f["pose"].items()}
     if "offsets" in f:
         entry["offsets"] = np.round(np.asarray(f["offsets"], float), 3).tolist()
+    if "look" in f:
+        entry["look"] = {k: round(float(v), 4) for k, v in f["look"].items()}
     if "scene_departure" in f:
         entry["scene_departure"] = round(float(f["scene_departure"]), 4)
         entry["scene_departs"] = bool(f["scene_departs"])
@@ -228,7 +236,8 @@ def read_track(path: str | Path) -> tuple[dict[str, Any], dict[int, Contours]]:
 def read_motion(path: str | Path) -> tuple[dict[str, Any], dict[str, Any], list[dict[str, Any]]]:
     """Read the motion of a ``facemime.track/1`` file written by ``facemime run``: (video info,
     the ``model`` block, frames in order as dicts with ``index``, ``face`` (bool), ``pose``
-    (mapping of the six pose values) and ``offsets`` ((K, 2) float64 array))."""
+    (mapping of the six pose values), ``offsets`` ((K, 2) float64 array) and ``look`` (a
+    :class:`facemime.animate.look.Look`; neutral for files written before it, or without one))."""
     doc = load_document(path, "track", TRACK_FORMAT)
     where = str(path)
     model = doc.get("model")
@@ -249,5 +258,15 @@ def read_motion(path: str | Path) -> tuple[dict[str, Any], dict[str, Any], list[
             raise ContourFileError(f"{where}: frame entry {n} needs a 'pose' with {', '.join(POSE_KEYS)} and 'offsets'") from None
         if arr.shape != (k, 2) or not np.isfinite(arr).all() or not all(np.isfinite(list(values.values()))) or values["scale"] <= 0:
             raise ContourFileError(f"{where}: frame entry {n} has malformed 'offsets' or 'pose'")
-        out.append({"index": f.get("index", n), "face": bool(f.get("face", True)), "pose": values, "offsets": arr})
+        try:
+            look = f.get("look", {})
+            if not isinstance(look, dict):
+                raise TypeError
+            look = Look.from_dict(look)
+        except (TypeError, ValueError, OverflowError):
+            raise ContourFileError(f"{where}: frame entry {n} has a malformed 'look'") from None
+        if not np.isfinite(look.vector()).all() or np.abs(look.vector()).max() > LOOK_LIMIT:
+            raise ContourFileError(f"{where}: frame entry {n} has a 'look' value beyond ±{LOOK_LIMIT:g}")
+        out.append({"index": f.get("index", n), "face": bool(f.get("face", True)), "pose": values, "offsets": arr,
+                     "look": look})
     return doc.get("video", {}), model, out

@@ -15,6 +15,8 @@ LIP = (176, 78, 78)
 MOUTH_LINE = (96, 36, 40)
 SCLERA = (236, 232, 226)
 IRIS = (70, 96, 120)
+LID_RIM = (60, 40, 36)
+LASHES = (40, 28, 26)
 
 
 def painted_texture(model: HeadModel, size: int = 512) -> np.ndarray:
@@ -47,13 +49,18 @@ def painted_texture(model: HeadModel, size: int = 512) -> np.ndarray:
     for side in ("left", "right"):
         cv2.fillPoly(img, [poly(f"brow_{side}_upper", f"brow_{side}_lower")], BROW, **draw)
         eye = np.round(px[model.groups[f"eye_{side}"]] * 16).astype(np.int32)
-        cv2.fillPoly(img, [eye], SCLERA, **draw)
         ring = px[model.groups[f"eye_{side}"]]
         c = ring.mean(axis=0)
-        r = 0.42 * np.ptp(ring[:, 1]) + 1.0
-        cv2.circle(img, tuple(np.round(c * 16).astype(int)), int(r * 16), IRIS, -1, **draw)
-        cv2.circle(img, tuple(np.round(c * 16).astype(int)), int(r * 7), (20, 16, 16), -1, **draw)
-        cv2.polylines(img, [eye], True, (60, 40, 36), max(1, round(2 * scale)), **draw)
+        r = 0.21 * np.hypot(*(ring[4] - ring[0]))  # a human iris: 0.21 of the eye's width
+        ball = np.full_like(img, SCLERA)  # the eyeball, seen through the opening only
+        cv2.circle(ball, tuple(np.round(c * 16).astype(int)), int(r * 16), IRIS, -1, **draw)
+        cv2.circle(ball, tuple(np.round(c * 16).astype(int)), int(r * 7), (20, 16, 16), -1, **draw)
+        opening = np.zeros(img.shape[:2], np.uint8)
+        cv2.fillPoly(opening, [eye], 255, **draw)
+        alpha = opening[..., None].astype(np.float32) / 255.0
+        img[:] = (img + alpha * (ball.astype(np.float32) - img) + 0.5).astype(np.uint8)
+        cv2.polylines(img, [eye], True, LID_RIM, max(1, round(2 * scale)), **draw)
+        cv2.polylines(img, [eye[:5]], False, LASHES, max(1, round(3 * scale)), **draw)  # the upper lid's lashes
     cv2.fillPoly(img, [poly("mouth_outer_upper", "mouth_outer_lower")], LIP, **draw)
     cv2.polylines(img, [poly("mouth_inner_upper")], False, MOUTH_LINE, max(1, round(3 * scale)), **draw)
     nose = px[model.groups["nose"]]

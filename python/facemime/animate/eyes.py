@@ -1,0 +1,119 @@
+"""Eyes in the synthesis: lids that close and irises that move.
+
+- Lids: the upper-lid vertices of each eye ring (:mod:`facemime.track.eyes` says the ring's
+  order) move towards the lower-lid vertices below them by the look's closure.
+- Irises: the actor's texture is the key frame, iris and all. On it, each eye's iris is found
+  (:func:`facemime.track.eyes.find_iris` in the texture's own eye frame); a copy of the eye with
+  the iris painted out (``cv2.inpaint``) is kept, and each frame the iris disc is pasted back,
+  shifted by the look, inside the eye's opening.
+
+Texture pixels: (x, y) with (0, 0) the centre of the top-left texel (uv 0..1 from its corner).
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from facemime.animate.look import Look
+from facemime.fit.actor import Actor
+from facemime.track.eyes import EYES, LID_EDGE, SPAN_U, SPAN_V, EyeFrame, find_iris
+
+#: The ring positions of the upper-lid vertices and of the lower-lid vertices below them.
+UPPER_LID = (1, 2, 3)
+LOWER_LID = (7, 6, 5)
+#: The iris pasted is this many times the measured radius (its dark rim included).
+IRIS_REACH = 1.15
+
+
+def close_lids(vertices: np.ndarray, rings: list[np.ndarray], closure: np.ndarray) -> np.ndarray:
+    """``vertices`` (N, 3) with each eye's upper lid moved ``closure[k]`` of the way to its
+    lower lid (negative: away from it); ``rings`` the two eye rings' vertex indices. A copy."""
+    out = vertices.copy()
+    for ring, c in zip(rings, closure):
+        if c:
+            up, low = ring[list(UPPER_LID)], ring[list(LOWER_LID)]
+            out[up] = vertices[up] + float(c) * (vertices[low] - vertices[up])
+    return out
+
+
+class _Eye:
+    """One eye of the texture: its region, the region with the iris painted out, the iris patch,
+    its alpha, and the opening's mask."""
+
+    def __init__(self, texture: np.ndarray, ring_px: np.ndarray):
+        frame = EyeFrame.of(ring_px)
+        self.frame = frame
+        w = frame.width
+        lo = np.floor(frame.to_image(np.array([[SPAN_U[0], SPAN_V[0]], [SPAN_U[1], SPAN_V[1]],
+                                               [SPAN_U[0], SPAN_V[1]], [SPAN_U[1], SPAN_V[0]]])).min(axis=0))
+        hi = np.ceil(frame.to_image(np.array([[SPAN_U[0], SPAN_V[0]], [SPAN_U[1], SPAN_V[1]],
+                                              [SPAN_U[0], SPAN_V[1]], [SPAN_U[1], SPAN_V[0]]])).max(axis=0))
+        x0, y0 = np.maximum(lo.astype(int), 0)
+        x1, y1 = np.minimum(hi.astype(int) + 1, [texture.shape[1], texture.shape[0]])
+        self.box = (x0, y0, x1, y1)
+        region = texture[y0:y1, x0:x1]
+        self.iris_uv = find_iris(frame.patch(texture))[0]
+        centre = frame.to_image(self.iris_uv) - [x0, y0]
+        self.radius = 0.21 * w * IRIS_REACH
+        shape = region.shape[:2]
+        yy, xx = np.mgrid[0:shape[0], 0:shape[1]].astype(np.float32)
+        self.disc = np.clip(self.radius + 0.5 - np.hypot(xx - centre[0], yy - centre[1]), 0.0, 1.0)
+        opening = np.zeros(shape, np.uint8)
+        cv2.fillPoly(opening, [np.round((ring_px - [x0, y0]) * 16).astype(np.int32)], 255, cv2.LINE_AA, 4)
+        self.opening = opening.astype(np.float32) / 255.0
+        # only what the key frame's opening showed of the iris moves, not the lid's edge
+        k = 2 * max(1, int(round(LID_EDGE * w))) + 1
+        inner = cv2.erode(self.opening, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
+        self.disc *= inner
+        hole = self.disc > 0
+        inside = inner > 0.5
+        # the sclera: the brighter half of the opening's pixels beside the iris
+        beside = region[inside & ~hole].reshape(-1, 3)
+        if len(beside) == 0:
+            beside = region[inside].reshape(-1, 3) if inside.any() else region.reshape(-1, 3)
+        grey = beside.astype(np.float64) @ (0.299, 0.587, 0.114)
+        sclera = np.median(beside[grey >= np.median(grey)], axis=0)
+        # the hole is filled from the sclera beside it, and from sclera colour at and beyond the lids
+        source = region.copy()
+        source[~inside] = np.round(sclera).astype(np.uint8)
+        self.clean = cv2.inpaint(source, cv2.dilate(hole.astype(np.uint8) * 255, np.ones((3, 3), np.uint8)),
+                                 max(2.0, self.radius / 3), cv2.INPAINT_TELEA).astype(np.float32)
+        self.clean[~hole] = region[~hole]  # the key frame as it is wherever no iris is taken from
+        self.iris = region.astype(np.float32)
+
+    def paint(self, out: np.ndarray, shift: np.ndarray) -> None:
+        """Paint the eye into ``out`` (the texture's working copy) with the iris shifted by
+        ``shift`` (u, v) eye widths."""
+        x0, y0, x1, y1 = self.box
+        d = np.asarray(shift, np.float64) @ self.frame.axes  # texture px
+        m = np.float32([[1, 0, d[0]], [0, 1, d[1]]])
+        size = (x1 - x0, y1 - y0)
+        iris = cv2.warpAffine(self.iris, m, size, borderMode=cv2.BORDER_REPLICATE)
+        alpha = cv2.warpAffine(self.disc, m, size) * self.opening
+        out[y0:y1, x0:x1] = np.clip(self.clean + alpha[:, :, None] * (iris - self.clean) + 0.5, 0, 255)
+
+
+class LookPainter:
+    """Paints a :class:`~facemime.animate.look.Look` on ``actor``: :meth:`vertices` closes the
+    lids, :meth:`texture` moves the irises."""
+
+    def __init__(self, actor: Actor):
+        self.actor = actor
+        model = actor.model
+        self.rings = [model.groups[e] for e in EYES]
+        size = np.array([actor.texture.shape[1], actor.texture.shape[0]], np.float64)
+        self._eyes = [_Eye(actor.texture, model.uv[r] * size - 0.5) for r in self.rings]
+        self._work = actor.texture.copy()
+
+    def vertices(self, vertices: np.ndarray, look: Look) -> np.ndarray:
+        """``vertices`` with the lids closed by ``look.closure``."""
+        return close_lids(vertices, self.rings, look.closure)
+
+    def texture(self, look: Look) -> np.ndarray:
+        """The actor's texture with the irises shifted by ``look`` (a working copy, valid until
+        the next call)."""
+        out = self._work  # each eye's box is painted whole: the rest stays the actor's texture
+        for eye, shift in zip(self._eyes, look.iris):
+            eye.paint(out, shift)
+        return out
