@@ -28,17 +28,24 @@ def chunks(data: bytes):
 
 
 def header(p: bytes) -> dict:
-    assert p[:4] == b"FMST" and p[4] == 1
+    assert p[:4] == b"FMST" and p[4] in (1, 2)
     num, den, w, h = struct.unpack_from("<IIHH", p, 5)
     at = 17 + 8
     frames, keyframes, n = struct.unpack_from("<BHB", p, at)
     at += 4
     params = [struct.unpack_from("<fiB", p, at + 9 * i) for i in range(n)]
     at += 9 * n
+    extras = []
+    if p[4] == 2:
+        extras = list(p[at + 1:at + 1 + p[at]])
+        at += 1 + p[at]
+        assert len(extras) <= n - 6 and 0 not in extras and len(set(extras)) == len(extras)
     (rows,) = struct.unpack_from("<H", p, at)
-    at += 2 + 2 * (n - 6) * rows + 32
+    at += 2 + 2 * (n - 6 - len(extras)) * rows + 32
+    assert at + 1 == len(p)
     return {"fps": (num, den), "size": (w, h), "P": frames, "K": keyframes, "steps": [x[0] for x in params],
-            "references": [x[1] for x in params], "classes": [x[2] for x in params], "carried": p[at]}
+            "references": [x[1] for x in params], "classes": [x[2] for x in params], "extras": extras,
+            "carried": p[at]}
 
 
 def table(freq: list[int]) -> list[int]:
@@ -112,7 +119,9 @@ class Range:
 
 
 def decode(data: bytes) -> list[dict]:
-    """Every frame of an undamaged stream: index, face, lost, values (floats)."""
+    """Every frame of an undamaged stream: index, face, lost, values (floats, the extras last;
+    the header's ``extras`` name their kinds), and with extras ``look``: the look's six values
+    (kinds 1-6; an absent kind is 0, an unknown one ignored)."""
     frames, h, state = [], None, None
     for kind, count, seq, payload in chunks(data):
         if kind == 1:
@@ -138,5 +147,11 @@ def decode(data: bytes) -> list[dict]:
                         q.append(state["pred"][i] + v)
                 state["pred"] = q
                 entry["values"] = [float(x) * float(step) for x, step in zip(q, h["steps"])]
+                if h["extras"]:
+                    look = [0.0] * 6
+                    for kind, value in zip(h["extras"], entry["values"][len(q) - len(h["extras"]):]):
+                        if 1 <= kind <= 6:
+                            look[kind - 1] = value
+                    entry["look"] = look
             frames.append(entry)
     return frames

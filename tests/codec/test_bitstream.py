@@ -1,15 +1,21 @@
-"""The bitstream at the level of the native encoder and decoder: the golden stream, and
-hostile bytes (hypothesis)."""
+"""The bitstream at the level of the native encoder and decoder: the golden streams (version 1,
+and version 2 with looks), headers of either version, and hostile bytes (hypothesis)."""
 
 import json
+import re
+import struct
+import zlib
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from facemime import _core
+from facemime.codec.stream import MotionDecoder, StreamError
 
 from . import golden
+from .reference_decoder import decode as reference
 
 
 def decode(data: bytes, from_start: bool = True):
@@ -56,10 +62,11 @@ def test_random_bytes_are_never_decoded(data):
 @settings(max_examples=300, deadline=None)
 @given(st.lists(st.tuples(st.integers(0, 10**6), st.integers(0, 255), st.sampled_from("flip drop insert cut")),
                 min_size=1, max_size=10),
-       st.integers(1, 50), st.booleans())
-def test_mutated_streams_decode_only_true_frames(edits, piece, from_start):
-    truth = {f["index"]: f["values"] for f in json.loads(golden.EXPECTED.read_text())["frames"] if f["face"]}
-    data = bytearray(golden.STREAM.read_bytes())
+       st.integers(1, 50), st.booleans(), st.sampled_from([1, 2]))
+def test_mutated_streams_decode_only_true_frames(edits, piece, from_start, version):
+    stream, expected = (golden.STREAM, golden.EXPECTED) if version == 1 else (golden.STREAM_V2, golden.EXPECTED_V2)
+    truth = {f["index"]: f["values"] for f in json.loads(expected.read_text())["frames"] if f["face"]}
+    data = bytearray(stream.read_bytes())
     for at, value, how in edits:
         if not data:
             break
@@ -82,10 +89,136 @@ def test_mutated_streams_decode_only_true_frames(edits, piece, from_start):
 
 
 def test_a_decoder_written_from_the_specification_reads_the_golden_stream():
-    from .reference_decoder import decode as reference
-
     expected = json.loads(golden.EXPECTED.read_text())["frames"]
     frames = reference(golden.STREAM.read_bytes())
     flags = lambda fs: [(f["index"], f["face"], f["lost"]) for f in fs]  # noqa: E731
     assert flags(frames) == flags(expected)
     assert [f["values"] for f in frames if f["face"]] == [f["values"] for f in expected if f["face"]]
+
+
+def test_the_version_2_golden_stream_decodes_to_its_checked_in_parameters_and_looks():
+    expected = json.loads(golden.EXPECTED_V2.read_text())
+    data = golden.STREAM_V2.read_bytes()
+    dec, (index, face, lost, values, concealed) = decode(data)
+    assert data[9] == 2  # the header's version byte (after tag, seq, a two-byte length, magic)
+    assert dec.header()["extras"] == expected["extras"] == list(range(1, 7))
+    assert dec.header()["basis"].shape == (2, 6)
+    assert index.tolist() == [f["index"] for f in expected["frames"]] == list(range(golden.FRAMES_V2))
+    assert face.tolist() == [f["face"] for f in expected["frames"]]
+    assert lost.tolist() == [f["lost"] for f in expected["frames"]]
+    assert values.tolist() == [f["values"] for f in expected["frames"]]  # exactly, bit for bit
+    assert len(concealed) == 0
+    assert index[~face].tolist() == [14, 15] and index[lost > 0].tolist() == [7]
+    for (has_face, _, v), out in zip(golden.frames_v2(), values):
+        if has_face:
+            assert np.all(np.abs(v - out) <= 0.8 * np.array(golden.STEPS_V2) + 1e-6)
+    closure = values[:, 6 + 2:6 + 4]
+    assert closure[9].tolist() == [1.0, 1.0] and closure[8].tolist() == [0.0, 0.0]  # the blink, in one frame
+    assert closure[21, 0] < -0.3 and closure[21, 1] == 0.0  # the right eye opened wide
+
+
+def test_the_encoder_still_writes_the_version_2_golden_stream_byte_for_byte():
+    assert golden.encode(2) == golden.STREAM_V2.read_bytes()
+
+
+def test_a_decoder_written_from_the_specification_reads_the_version_2_golden_stream():
+    expected = json.loads(golden.EXPECTED_V2.read_text())["frames"]
+    frames = reference(golden.STREAM_V2.read_bytes())
+    flags = lambda fs: [(f["index"], f["face"], f["lost"]) for f in fs]  # noqa: E731
+    assert flags(frames) == flags(expected)
+    assert [f["values"] for f in frames if f["face"]] == [f["values"] for f in expected if f["face"]]
+    assert [f["look"] for f in frames if f["face"]] == [f["values"][-6:] for f in expected if f["face"]]
+
+
+@pytest.mark.parametrize("kinds", [(1, 2, 3, 4, 5, 6), (6, 200, 1, 7), (255,)])
+def test_the_specification_and_the_rust_decoder_agree_on_version_2_streams(kinds):
+    """A longer stream with random-walk looks (escapes, blinks), kinds in any order, unknown ones
+    among them: the reference decoder's values are the Rust decoder's, bit for bit."""
+    rng = np.random.default_rng(sum(kinds))
+    x, m, frames = len(kinds), 3, 400
+    steps = [0.5, 0.5, 0.5, 0.004, 0.5, 0.5] + [2.0] * m + list(rng.uniform(0.01, 0.1, x))
+    enc = _core.StreamEncoder((24, 1), (640, 360), b"spec-rs!", 7, 5, steps, [0, 0, 0, 200, 320, 180] + [3] * (m + x),
+                              list(rng.integers(0, 16, 6 + m + x)), rng.integers(-30000, 30000, (m, 10), np.int16),
+                              bytes(32), True, 0.3, list(kinds))
+    walk = np.cumsum(rng.normal(0, 1.5, (frames, 6 + m + x)) * steps, axis=0) + np.array(steps) * 3
+    walk[::37, 6 + m:] += 1.0  # blinks: jumps of 10-100 steps
+    data = [enc.header_chunk()]
+    for t in range(frames):
+        data.append(enc.push(t % 50 < 47, t % 3, walk[t])[1] or b"")
+    data.append(enc.finish() or b"")
+    _, (index, face, lost, values, _) = decode(b"".join(data))
+    frames_ = reference(b"".join(data))
+    assert [(f["index"], f["face"], f["lost"]) for f in frames_] == list(zip(index.tolist(), face.tolist(),
+                                                                             lost.tolist()))
+    assert [f["values"] for f in frames_ if f["face"]] == values[face].tolist()
+    known = [(i, k) for i, k in enumerate(kinds) if k <= 6]
+    for f, v in zip([f for f in frames_ if f["face"]], values[face]):
+        assert [f["look"][k - 1] for _, k in known] == [v[6 + m + i] for i, _ in known]
+
+
+def header_chunk(payload: bytes) -> bytes:
+    """A header chunk (kind 1) around ``payload`` (``docs/bitstream.md``, "Chunks")."""
+    n, length = len(payload), b""
+    while True:
+        length += bytes([(n & 0x7F) | (0x80 if n >> 7 else 0)])
+        n >>= 7
+        if not n:
+            break
+    body = bytes([1 << 5, 0, 0]) + length + payload
+    return body + struct.pack("<I", zlib.crc32(body))
+
+
+def golden_v2_header() -> tuple[bytearray, int]:
+    """The version-2 golden stream's header payload, and where its X byte is."""
+    data = golden.STREAM_V2.read_bytes()
+    length = (data[3] & 0x7F) | (data[4] << 7)  # a two-byte LEB128 length
+    payload = bytearray(data[5:5 + length])
+    assert header_chunk(bytes(payload)) == data[:5 + length + 4]
+    return payload, 29 + 9 * payload[28]
+
+
+@pytest.mark.parametrize("edit, reason", [
+    ("many", "9 extra parameters do not fit in 14 parameters per frame (at most 8 after the pose)"),
+    ("twice", "extra parameter kind 3 appears twice"),
+    ("zero", "extra parameter 4 has kind 0; kinds are 1-255"),
+    ("version 3", "stream format version 3; this decoder reads versions 1 and 2"),
+    ("version 0", "stream format version 0; this decoder reads versions 1 and 2"),
+])
+def test_bad_version_2_headers_are_refused_with_their_reason(edit, reason):
+    payload, x = golden_v2_header()
+    assert payload[4] == 2 and payload[x:x + 7] == bytes([6, *range(1, 7)])
+    if edit == "many":  # nine extras where only eight parameters follow the pose
+        payload[x] = 9
+        payload[x + 7:x + 7] = bytes([7, 8, 9])
+    elif edit == "twice":
+        payload[x + 2] = 3
+    elif edit == "zero":
+        payload[x + 5] = 0
+    else:
+        payload[4] = int(edit[-1])
+    dec = _core.StreamDecoder(True)
+    dec.push(header_chunk(bytes(payload)) + golden.STREAM_V2.read_bytes()[len(header_chunk(golden_v2_header()[0])):])
+    assert dec.header() is None and dec.header_error() == reason
+    receiver = MotionDecoder()
+    receiver.push(header_chunk(bytes(payload)))
+    with pytest.raises(StreamError, match=f"^the stream: {re.escape(reason)}$"):
+        receiver.finish()
+
+
+def test_a_version_2_header_read_as_version_1_is_refused_not_misread():
+    payload, _ = golden_v2_header()
+    payload[4] = 1  # the extras' bytes are then read as the basis: the length no longer fits
+    dec = _core.StreamDecoder(True)
+    dec.push(header_chunk(bytes(payload)))
+    assert dec.header() is None and dec.header_error() == "the stream header is cut short"
+
+
+def test_the_encoder_refuses_bad_extras():
+    basis = np.zeros((2, 6), np.int16)
+    args = ((30, 1), (160, 120), b"golden02", 4, 3, golden.STEPS_V2, [0] * 14, [6] * 14, basis, bytes(32), False, 0.3)
+    with pytest.raises(ValueError, match="^extra parameter kind 2 appears twice$"):
+        _core.StreamEncoder(*args, [1, 2, 3, 4, 5, 2])
+    with pytest.raises(ValueError, match="^extra parameter 0 has kind 0; kinds are 1-255$"):
+        _core.StreamEncoder(*args, [0, 2, 3, 4, 5, 6])
+    with pytest.raises(ValueError, match="^the basis holds 12 entries, not 3 x 6$"):
+        _core.StreamEncoder(*args, [1, 2, 3, 4, 5])

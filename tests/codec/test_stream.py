@@ -1,13 +1,19 @@
 """A real video's motion through the stream: closed loop, live pieces, loss, the actor carried
-or named, the rate settings."""
+or named, the rate settings, and looks (format version 2) carried with the motion."""
+
+import copy
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
+from facemime import _core
+from facemime.animate.look import Look
 from facemime.codec.files import analyse, encode_clip
-from facemime.codec.params import Basis
-from facemime.codec.stream import MotionDecoder, MotionEncoder, Settings, StreamError
-from facemime.io.actor_file import actor_bytes, actor_from_bytes
+from facemime.codec.params import LOOK_KINDS, Basis, pose_vector, topology_id
+from facemime.codec.stream import LOOK_STEPS, MotionDecoder, MotionEncoder, Settings, StreamError
+from facemime.errors import InvalidInputError
+from facemime.io.actor_file import actor_bytes, actor_from_bytes, actor_id
 
 
 @pytest.fixture(scope="module")
@@ -39,6 +45,9 @@ def test_the_decoder_outputs_the_encoders_reconstruction_over_a_whole_video(clip
     assert [f.index for f in frames] == list(range(len(clip.motion)))
     assert all(same(f, e) for f, e in zip(frames, recon))
     assert not any(f.concealed for f in frames)
+    # a stream without looks is version 1 and decodes to neutral looks
+    assert data[0][9] == 1 and dec.info.extras == () and not dec.info.has_look
+    assert all(np.all(f.look.vector() == 0) and np.all(e.look.vector() == 0) for f, e in zip(frames, recon))
     # the reconstruction is close to what was measured: pose within a step, offsets within the
     # basis's reach (the clip's own basis of 16 directions) plus the quantiser
     tx = np.array([m.pose.tx for m in clip.motion]) - [e.pose.tx for e in recon]
@@ -131,3 +140,122 @@ def test_a_stream_for_another_head_model_is_refused(clip):
                               basis.raw, actor_id(clip.actor), False, 0.3)
     with pytest.raises(StreamError, match="another head model"):
         MotionDecoder(clip.actor).push(enc.header_chunk())
+
+
+def looks(n: int, seed: int = 0) -> list[Look]:
+    """Made-up looks of ``n`` frames at 25 fps: a blink every 3 s (shut in one frame, open again
+    over three), the irises jumping between a few places and drifting between jumps (noise of a
+    tracker included)."""
+    rng = np.random.default_rng(seed)
+    closure = np.zeros(n)
+    for start in range(20, n, 75):
+        closure[start:start + 4] = [1.0, 0.8, 0.4, 0.1][:len(closure[start:start + 4])]
+    jumps = np.repeat(rng.uniform(-0.15, 0.15, (n // 20 + 1, 2)), 20, axis=0)[:n]
+    iris = jumps + rng.normal(0, 0.005, (n, 2))
+    out = []
+    for i in range(n):
+        c = [closure[i], closure[i] * 0.95]
+        out.append(Look(np.array(c), np.array([iris[i], iris[i] + [0.01, 0.0]])))
+    return out
+
+
+def with_looks(clip, given):
+    """The clip with each frame's look set (FrameMotion's ``look``)."""
+    motion = []
+    for m, look in zip(clip.motion, given):
+        m = copy.copy(m)
+        m.look = look
+        motion.append(m)
+    return replace(clip, motion=motion)
+
+
+def test_looks_round_trip_exactly_and_within_half_a_step(clip):
+    settings = Settings(hysteresis=0.0)
+    given = looks(len(clip.motion))
+    enc = MotionEncoder(clip.actor, clip.fps, clip.size, Basis.learn(np.array([m.offsets for m in clip.motion]), 16),
+                        settings, True, look=True)
+    data, recon = [enc.start()], []
+    for m, look in zip(clip.motion, given):
+        recon.append(enc.push(m.face, m.lost, m.pose, m.offsets, look))
+        data.append(recon[-1].data)
+    data.append(enc.finish())
+    dec = MotionDecoder()
+    frames = dec.push(b"".join(data)) + dec.finish()
+    assert data[0][9] == 2 and dec.info.extras == LOOK_KINDS and dec.info.has_look
+    assert len(frames) == len(clip.motion) and not any(f.concealed for f in frames)
+    assert all(same(f, e) and np.array_equal(f.look.vector(), e.look.vector()) for f, e in zip(frames, recon))
+    steps = np.array(LOOK_STEPS)  # quality 5: factor 1
+    for m, look, f in zip(clip.motion, given, frames):
+        if m.face:
+            assert np.all(np.abs(f.look.vector() - look.vector()) <= steps / 2 + 1e-9)
+    blinks = [f.index for f in frames if f.look.closure[0] == 1.0]
+    assert blinks and blinks[0] == 20
+
+
+def test_a_lost_packet_repeats_the_last_good_look(clip):
+    given = looks(len(clip.motion), 1)
+    enc = MotionEncoder(clip.actor, clip.fps, clip.size, Basis.learn(np.array([m.offsets for m in clip.motion]), 8),
+                        Settings(packet=0.2), False, look=True)
+    packets = [enc.push(m.face, m.lost, m.pose, m.offsets, look).data for m, look in zip(clip.motion, given)]
+    packets = [p for p in packets + [enc.finish()] if p]
+    dec = MotionDecoder(clip.actor)
+    frames = dec.push(enc.header + b"".join(packets[:4] + packets[5:])) + dec.finish()
+    concealed = [f for f in frames if f.concealed]
+    assert concealed and all(f.look is frames[concealed[0].index - 1].look for f in concealed)
+    assert np.any(frames[concealed[0].index - 1].look.vector() != 0)
+
+
+def test_an_encoder_without_looks_refuses_one_and_writes_version_1(clip):
+    basis = Basis.learn(np.array([m.offsets for m in clip.motion]), 4)
+    enc = MotionEncoder(clip.actor, clip.fps, clip.size, basis, Settings(), False)
+    m = clip.motion[0]
+    with pytest.raises(InvalidInputError, match="carries no look: make it with look=True"):
+        enc.push(m.face, m.lost, m.pose, m.offsets, Look(closure=np.array([0.5, 0.5])))
+    assert np.all(enc.push(m.face, m.lost, m.pose, m.offsets, Look()).look.vector() == 0)
+    looking = MotionEncoder(clip.actor, clip.fps, clip.size, basis, Settings(), False, look=True)
+    with pytest.raises(InvalidInputError, match="the look's values must be finite"):
+        looking.push(m.face, m.lost, m.pose, m.offsets, Look(iris=np.array([[0, np.nan], [0, 0]])))
+    with pytest.raises(InvalidInputError, match=r"classes must have one entry per parameter \(16\), got 10"):
+        MotionEncoder(clip.actor, clip.fps, clip.size, basis, Settings(), False, [6] * 10, look=True)
+
+
+def test_encode_clip_sends_looks_only_when_one_is_not_neutral(clip):
+    plain = encode_clip(with_looks(clip, [Look()] * len(clip.motion)), Settings(), False)
+    assert plain[0][9] == 1  # version 1
+    given = looks(len(clip.motion), 2)
+    header, _, packets = encode_clip(with_looks(clip, given), Settings(), False)
+    assert header[9] == 2
+    dec = MotionDecoder(clip.actor)
+    frames = dec.push(header + b"".join(packets)) + dec.finish()
+    assert dec.info.extras == LOOK_KINDS
+    faces = [(f, look) for f, look, m in zip(frames, given, clip.motion) if m.face]
+    err = np.array([np.abs(f.look.vector() - look.vector()) for f, look in faces])
+    assert np.all(err <= 0.8 * np.array(LOOK_STEPS) + 1e-9)  # half a step and the hysteresis
+    # the motion is coded as before: the same poses and offsets as the version-1 stream's
+    dec1 = MotionDecoder(clip.actor)
+    frames1 = dec1.push(plain[0] + b"".join(plain[2])) + dec1.finish()
+    assert all(a.pose == b.pose and np.array_equal(a.offsets, b.offsets) for a, b in zip(frames, frames1))
+    # the look's classes are chosen from the clip's looks (each parameter's class depends on its
+    # own values only), not left at the default
+    classes = list(dec._core.header()["classes"])
+    alone = _core.choose_classes(list(LOOK_STEPS), 0.3, np.array([look.vector() for (_, look) in faces]))
+    assert len(classes) == 6 + 16 + 6 and classes[-6:] == list(alone) and set(alone) != {6}
+    # one non-neutral look is enough
+    one = [Look()] * len(clip.motion)
+    one[5] = Look(iris=np.array([[0.05, 0], [0, 0]]))
+    assert encode_clip(with_looks(clip, one), Settings(), False)[0][9] == 2
+
+
+def test_kinds_the_decoder_does_not_know_are_decoded_and_ignored(clip):
+    basis = Basis.learn(np.array([m.offsets for m in clip.motion]), 2)
+    steps = Settings().steps(2) + [1 / 64, 0.5, 1 / 16, 0.5]
+    enc = _core.StreamEncoder((25, 1), clip.size, topology_id(clip.actor.model), 5, 5, steps, [0] * 12, [6] * 12,
+                              basis.raw, actor_id(clip.actor), False, 0.3, [5, 200, 2, 7])
+    m = clip.motion[0]
+    values = np.concatenate([pose_vector(m.pose), basis.coefficients(m.offsets), [0.25, 40.0, 0.5, 3.0]])
+    data = enc.header_chunk() + (enc.push(True, 0, values)[1] or b"") + (enc.finish() or b"")
+    dec = MotionDecoder(clip.actor)
+    (frame,) = dec.push(data) + dec.finish()
+    assert dec.info.extras == (5, 200, 2, 7) and dec.info.has_look
+    assert frame.look.vector().tolist() == [0, 0.5, 0, 0, 0.25, 0]
+    assert np.array_equal(frame.offsets, basis.offsets(np.round(basis.coefficients(m.offsets) / 3.0) * 3.0))

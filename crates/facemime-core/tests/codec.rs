@@ -31,6 +31,7 @@ fn header(packet_frames: u8, keyframe_packets: u16) -> Header {
         packet_frames,
         keyframe_packets,
         quantisers,
+        extras: vec![],
         basis_rows: 6,
         basis: (0..24).map(|i| (i * 1000 - 12000) as i16).collect(),
         actor_id: [7; 32],
@@ -212,12 +213,15 @@ fn a_stream_cut_anywhere_decodes_its_whole_packets() {
 fn headers_from_other_versions_or_with_absurd_fields_are_refused_with_a_reason() {
     let h = header(5, 5);
     let mut raw = h.to_bytes();
-    raw[4] = 2;
+    raw[4] = 3;
     let bytes =
         facemime_core::codec::chunk::write(facemime_core::codec::chunk::Kind::Header, 0, 0, &raw);
     let (d, _) = decode(&bytes, true);
     assert!(d.header().is_none());
-    assert!(d.header_error().unwrap().contains("version 2"));
+    assert_eq!(
+        d.header_error(),
+        Some("stream format version 3; this decoder reads versions 1 and 2")
+    );
     let mut bad = h.clone();
     bad.width = 0;
     assert!(bad.validate().is_err());
@@ -225,6 +229,45 @@ fn headers_from_other_versions_or_with_absurd_fields_are_refused_with_a_reason()
     bad = h.clone();
     bad.quantisers[2].step = f32::NAN;
     assert!(Encoder::new(bad, 0.0).is_err());
+}
+
+/// `header(5, 5)` with two of its four coefficients turned into extras of kinds 1 and 7.
+fn header_with_extras() -> Header {
+    let mut h = header(5, 5);
+    h.extras = vec![1, 7];
+    h.basis.truncate(2 * h.basis_rows as usize);
+    h
+}
+
+#[test]
+fn a_version_2_stream_round_trips_and_a_version_1_header_is_unchanged() {
+    let h = header_with_extras();
+    let frames = clip(203, 7);
+    let (chunks, recon) = encode(&h, &frames);
+    let (d, out) = decode(&chunks.concat(), true);
+    assert_eq!(check(&out, &recon), (203, 0));
+    assert_eq!(d.header().map(|h| h.extras.clone()), Some(vec![1, 7]));
+    assert_eq!(d.header().map(Header::coefficients), Some(2));
+    // the extras are coded like any parameter: the same values cost the same bytes as
+    // coefficients in version 1, give or take the header's three more bytes
+    let (v1, _) = encode(&header(5, 5), &frames);
+    assert_eq!(v1[1..], chunks[1..]);
+    assert_eq!(chunks[0].len(), v1[0].len() - 2 * 2 * 6 + 3);
+    assert_eq!((header(5, 5).to_bytes()[4], h.to_bytes()[4]), (1, 2));
+}
+
+#[test]
+fn a_stream_whose_header_changes_from_version_1_to_2_decodes_both() {
+    let (a, recon_a) = encode(&header(5, 5), &clip(30, 8));
+    let (b, recon_b) = encode(&header_with_extras(), &clip(30, 9));
+    let mut d = Decoder::new(true);
+    let mut out = d.push(&a.concat());
+    let first = out.len();
+    out.extend(d.push(&b.concat()));
+    out.extend(d.finish());
+    assert_eq!(check(&out[..first], &recon_a), (30, 0));
+    assert_eq!(check(&out[first..], &recon_b), (30, 0));
+    assert_eq!(d.header().map(|h| h.extras.len()), Some(2));
 }
 
 #[test]

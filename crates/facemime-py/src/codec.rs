@@ -19,8 +19,9 @@ fn fixed<const N: usize>(name: &str, bytes: &[u8]) -> PyResult<[u8; N]> {
 type Pushed<'py> = (Bound<'py, PyArray1<f64>>, Option<Bound<'py, PyBytes>>);
 
 /// The stream encoder. `steps`, `references`, `classes`: per parameter (the six pose
-/// parameters, then the coefficients); `basis`: (M, rows) basis vectors, entries ×32767;
-/// `hysteresis`: steps of hysteresis of the quantiser.
+/// parameters, then the coefficients, then the extras); `basis`: (M, rows) basis vectors,
+/// entries ×32767; `hysteresis`: steps of hysteresis of the quantiser; `extras`: the kinds of
+/// the last parameters (empty: a version-1 stream; `docs/bitstream.md`, "Look").
 #[pyclass(module = "facemime._core")]
 pub struct StreamEncoder {
     enc: codec::Encoder,
@@ -31,7 +32,7 @@ impl StreamEncoder {
     #[new]
     #[allow(clippy::too_many_arguments)]
     #[pyo3(signature = (fps, size, topology, packet_frames, keyframe_packets, steps, references, classes, basis, actor_id,
-                        actor_in_stream, hysteresis))]
+                        actor_in_stream, hysteresis, extras=Vec::new()))]
     fn new(
         fps: (u32, u32),
         size: (u16, u16),
@@ -45,6 +46,7 @@ impl StreamEncoder {
         actor_id: &[u8],
         actor_in_stream: bool,
         hysteresis: f64,
+        extras: Vec<u8>,
     ) -> PyResult<Self> {
         if steps.len() != references.len() || steps.len() != classes.len() {
             return Err(PyValueError::new_err(
@@ -70,6 +72,7 @@ impl StreamEncoder {
                     class,
                 })
                 .collect(),
+            extras,
             basis_rows: u16::try_from(b.ncols())
                 .map_err(|_| PyValueError::new_err("basis vectors are too long"))?,
             basis: b.iter().copied().collect(),
@@ -220,8 +223,9 @@ impl StreamDecoder {
     }
 
     /// The header as a dict (None before one was read): fps (num, den), size (w, h), topology,
-    /// packet_frames, keyframe_packets, steps, references, classes, basis (M, rows) int16,
-    /// actor_id, actor_in_stream.
+    /// packet_frames, keyframe_packets, steps, references, classes (per parameter), extras (the
+    /// kinds of the last parameters, empty for version 1), basis (M, rows) int16, actor_id,
+    /// actor_in_stream.
     fn header<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
         let Some(h) = self.dec.header() else {
             return Ok(None);
@@ -243,6 +247,11 @@ impl StreamDecoder {
         d.set_item(
             "classes",
             h.quantisers.iter().map(|q| q.class).collect::<Vec<_>>(),
+        )?;
+        // a list of ints (a Vec<u8> would become bytes)
+        d.set_item(
+            "extras",
+            h.extras.iter().map(|&k| k as u32).collect::<Vec<_>>(),
         )?;
         let basis = ndarray::Array2::from_shape_vec(
             (h.coefficients(), h.basis_rows as usize),

@@ -21,6 +21,7 @@ import numpy as np
 from facemime import _core
 from facemime.animate.analysis import Analysis, FrameMotion
 from facemime.animate.deform import Deformer
+from facemime.animate.look import Look
 from facemime.animate.run import NO_FACE_DIM
 from facemime.animate.synth import BACKGROUND, Puppet
 from facemime.codec.params import Basis, pose_vector
@@ -98,21 +99,30 @@ def analyse(video: str | Path, actor: Actor | None = None) -> Clip:
                     list(analysis.warnings) + list(reader.warnings), time.perf_counter() - t0)
 
 
+def _look(frame: FrameMotion) -> Look:
+    # a frame's look; neutral for motion made without one (FrameMotion before it had a look)
+    return getattr(frame, "look", None) or Look()
+
+
 def encode_clip(clip: Clip, settings: Settings, carry_actor: bool,
                 basis: Basis | None = None) -> tuple[bytes, bytes, list[bytes]]:
     """The stream of an analysed clip: (header, actor chunk or b"", packets). ``basis``: the
-    clip's (default: learned from it, at the settings' size)."""
+    clip's (default: learned from it, at the settings' size). The stream carries the frames'
+    looks (format version 2) when a frame with a face has a look that is not neutral; otherwise
+    it is a version-1 stream."""
     faces = [m for m in clip.motion if m.face]
     m = settings.basis_size
     if basis is None:
         basis = Basis.learn(np.array([f.offsets for f in faces]).reshape(len(faces), -1, 2), m)
     basis = Basis(basis.raw[:m])
-    steps = settings.steps(m)
-    values = np.array([np.concatenate([pose_vector(f.pose), basis.coefficients(f.offsets)]) for f in faces])
+    look = any(np.any(_look(f).vector() != 0) for f in faces)
+    steps = settings.steps(m, look)
+    values = np.array([np.concatenate([pose_vector(f.pose), basis.coefficients(f.offsets)]
+                                      + ([_look(f).vector()] if look else [])) for f in faces])
     classes = _core.choose_classes(steps, settings.hysteresis, values.reshape(len(faces), len(steps)))
     enc = MotionEncoder(clip.actor, clip.fps, clip.size, basis, settings, carry_actor, classes,
-                        reference=clip.motion[0].pose)
-    packets = [enc.push(f.face, f.lost, f.pose, f.offsets).data for f in clip.motion]
+                        reference=clip.motion[0].pose, look=look)
+    packets = [enc.push(f.face, f.lost, f.pose, f.offsets, _look(f) if look else None).data for f in clip.motion]
     packets.append(enc.finish())
     start = enc.start()
     return enc.header, start[len(enc.header):], [p for p in packets if p]
@@ -222,7 +232,7 @@ def decode_stream(stream: str | Path, out: str | Path, actor: str | Path | None 
             if not f.concealed:
                 if puppet.scene is None:
                     fill(image, BACKGROUND)
-                puppet.render(f.pose, f.offsets, (w, h), out=image)
+                puppet.render(f.pose, f.offsets, (w, h), out=image, look=f.look)
                 shown[:] = image if f.face else (image * NO_FACE_DIM).astype(np.uint8)
             writer.write(shown)
     return DecodeResult(len(frames), decoder.stats["concealed"], decoder.stats, time.perf_counter() - t0)

@@ -5,7 +5,9 @@ per model unit; tx, ty in pixels: :class:`facemime.render.projection.Pose`) foll
 coefficients of the knot offsets on an orthonormal basis (model units, millimetres for the
 generic head): offsets (K, 2), flattened x0, y0, x1, y1, ..., are ``basis.T @ coefficients``.
 The basis travels in the stream's header as int16 (entries ×32767); both ends use that
-quantised basis, so they agree exactly.
+quantised basis, so they agree exactly. A version-2 stream (``docs/bitstream.md``, "Look") ends
+the vector with *extras*, each named by a kind: facemime sends the six values of a
+:class:`facemime.animate.look.Look` as kinds 1-6 (:data:`LOOK_KINDS`).
 """
 
 from __future__ import annotations
@@ -18,12 +20,17 @@ from functools import cached_property
 import numpy as np
 
 from facemime.animate.deform import Deformer
+from facemime.animate.look import NAMES as LOOK_NAMES
+from facemime.animate.look import Look
 from facemime.model.head import HeadModel
 from facemime.render.projection import Pose
 
 POSE_PARAMETERS = 6
 #: Entries of a basis vector are sent ×BASIS_ONE as int16.
 BASIS_ONE = 32767
+#: The extra parameters' kinds of the look's values, in the order of :meth:`Look.vector`
+#: (``facemime.animate.look.NAMES``): kind k is ``vector()[k - 1]``.
+LOOK_KINDS = tuple(range(1, len(LOOK_NAMES) + 1))
 
 
 def pose_vector(pose: Pose) -> np.ndarray:
@@ -35,6 +42,22 @@ def pose_from_vector(v: np.ndarray) -> Pose:
     """The pose of a (6,) :func:`pose_vector`."""
     return Pose(yaw=float(v[0]), pitch=float(v[1]), roll=float(v[2]), scale=float(np.exp(v[3])), tx=float(v[4]),
                 ty=float(v[5]))
+
+
+def look_from_extras(kinds: tuple[int, ...], values: np.ndarray) -> Look:
+    """The look of a stream's extras: ``values`` (X,) of the parameters of ``kinds`` (X,). A kind
+    that is not a look value (:data:`LOOK_KINDS`) is ignored; a look value without its kind is 0.
+
+    Examples
+    --------
+    >>> look_from_extras((5, 1, 7, 200), np.array([0.25, 0.5, 8.0, 9.0])).vector().tolist()
+    [0.5, 0.0, 0.0, 0.0, 0.25, 0.0]
+    """
+    v = np.zeros(len(LOOK_KINDS))
+    for kind, value in zip(kinds, values):
+        if kind in LOOK_KINDS:
+            v[kind - 1] = value
+    return Look.from_vector(v)
 
 
 @dataclass(frozen=True, eq=False)

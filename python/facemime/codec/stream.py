@@ -1,5 +1,6 @@
-"""The bitstream, frame by frame: :class:`MotionEncoder` turns each analysed frame's head pose
-and knot offsets into packets, :class:`MotionDecoder` turns bytes back into poses and offsets.
+"""The bitstream, frame by frame: :class:`MotionEncoder` turns each analysed frame's head pose,
+knot offsets and (optionally) look into packets, :class:`MotionDecoder` turns bytes back into
+poses, offsets and looks.
 Packets, prediction, quantisation and entropy coding are the Rust core's
 (``facemime._core.StreamEncoder`` / ``StreamDecoder``); the format is ``docs/bitstream.md``.
 
@@ -18,7 +19,9 @@ import numpy as np
 
 from facemime import _core
 from facemime.animate.deform import Deformer
-from facemime.codec.params import POSE_PARAMETERS, Basis, pose_from_vector, pose_vector, topology_id
+from facemime.animate.look import Look
+from facemime.codec.params import (LOOK_KINDS, POSE_PARAMETERS, Basis, look_from_extras, pose_from_vector, pose_vector,
+                                   topology_id)
 from facemime.errors import FacemimeError, InvalidInputError
 from facemime.fit.actor import Actor
 from facemime.io.actor_file import ActorFileError, actor_bytes, actor_from_bytes, actor_id
@@ -37,6 +40,9 @@ LADDER = ((2.83, 4), (2.0, 6), (1.68, 8), (1.41, 10), (1.19, 12), (1.0, 16), (0.
 #: 0.001; halving the coefficients' step from 3 (2 mm changed it by less than 0.001 anywhere).
 POSE_STEPS = (0.5, 0.5, 0.5, 0.004, 0.5, 0.5)
 COEFFICIENT_STEP = 3.0
+#: Quantiser steps at factor 1 of the look's values (``facemime.animate.look``, in the order of
+#: its NAMES): eye closure (share of the key frame's opening), iris u and v (eye widths).
+LOOK_STEPS = (1 / 16, 1 / 16, 0.02, 0.02, 0.02, 0.02)
 
 
 class StreamError(FacemimeError, ValueError):
@@ -75,10 +81,11 @@ class Settings:
         """Basis coefficients per frame."""
         return LADDER[self.quality][1] if self.coefficients is None else self.coefficients
 
-    def steps(self, coefficients: int) -> list[float]:
-        """Quantiser step per parameter (pose, then ``coefficients`` coefficients)."""
+    def steps(self, coefficients: int, look: bool = False) -> list[float]:
+        """Quantiser step per parameter (pose, then ``coefficients`` coefficients, then with
+        ``look`` the look's six values)."""
         scale = LADDER[self.quality][0]
-        return [s * scale for s in POSE_STEPS] + [COEFFICIENT_STEP * scale] * coefficients
+        return [s * scale for s in POSE_STEPS + (COEFFICIENT_STEP,) * coefficients + (LOOK_STEPS if look else ())]
 
     def framing(self, fps: float) -> tuple[int, int]:
         """(frames per packet, packets per intra packet) at ``fps``."""
@@ -99,12 +106,14 @@ def _lost_bits(lost: Sequence[str]) -> int:
 
 @dataclass
 class EncodedFrame:
-    """What the receiver will decode for a frame: its pose and (K, 2) offsets (model units), and
-    the bytes this frame completed (a packet, or nothing)."""
+    """What the receiver will decode for a frame: its pose, (K, 2) offsets (model units) and
+    look (neutral when the stream carries none), and the bytes this frame completed (a packet,
+    or nothing)."""
 
     pose: Pose
     offsets: np.ndarray
     data: bytes
+    look: Look = field(default_factory=Look)
 
 
 class MotionEncoder:
@@ -114,21 +123,28 @@ class MotionEncoder:
     the header; with ``carry_actor`` the actor itself follows the header, texture as WebP);
     ``fps``, ``size`` (width, height px): the video's; ``basis``: the coefficients' basis
     (learned from the clip, :meth:`Basis.learn`); ``classes``: per parameter, the spread class
-    of its starting table (``facemime._core.choose_classes``; default: a middle class).
+    of its starting table (``facemime._core.choose_classes``; default: a middle class);
+    ``reference``: the pose intra frames are coded from (default: the actor's); ``look``: the
+    stream carries each frame's :class:`~facemime.animate.look.Look` (format version 2; without
+    it the stream is version 1 and the receiver decodes a neutral look).
     """
 
     def __init__(self, actor: Actor, fps: float, size: tuple[int, int], basis: Basis, settings: Settings = Settings(),
-                 carry_actor: bool = True, classes: Sequence[int] | None = None, reference: Pose | None = None):
-        self.settings, self.basis = settings, basis
+                 carry_actor: bool = True, classes: Sequence[int] | None = None, reference: Pose | None = None,
+                 look: bool = False):
+        self.settings, self.basis, self.look = settings, basis, bool(look)
         m = len(basis.raw)
-        steps = settings.steps(m)
+        steps = settings.steps(m, self.look)
+        extras = list(LOOK_KINDS) if self.look else []
         ref = pose_vector(reference or actor.pose)
-        references = [int(round(v / s)) for v, s in zip(ref, steps)] + [0] * m
+        references = [int(round(v / s)) for v, s in zip(ref, steps)] + [0] * (m + len(extras))
+        if classes is not None and len(classes) != len(steps):
+            raise InvalidInputError(f"classes must have one entry per parameter ({len(steps)}), got {len(classes)}")
         frames, keyframes = settings.framing(fps)
         self._core = _core.StreamEncoder(
             _fps_fraction(fps), (int(size[0]), int(size[1])), topology_id(actor.model), frames, keyframes, steps,
-            references, list(classes) if classes is not None else [6] * (POSE_PARAMETERS + m), basis.raw,
-            actor_id(actor), carry_actor, settings.hysteresis)
+            references, list(classes) if classes is not None else [6] * len(steps), basis.raw,
+            actor_id(actor), carry_actor, settings.hysteresis, extras)
         self.actor_data = actor_bytes(actor, "webp", settings.texture) if carry_actor else b""
 
     def start(self) -> bytes:
@@ -140,13 +156,24 @@ class MotionEncoder:
         """The header chunk alone (what a sender repeats to a receiver that joins)."""
         return self._core.header_chunk()
 
-    def push(self, face: bool, lost: Sequence[str], pose: Pose, offsets: np.ndarray) -> EncodedFrame:
-        """Adds a frame: ``face`` (False: the pose and offsets are not sent), the features
-        ``lost``, the ``pose`` and (K, 2) ``offsets`` (model units)."""
-        values = np.concatenate([pose_vector(pose), self.basis.coefficients(offsets)])
+    def push(self, face: bool, lost: Sequence[str], pose: Pose, offsets: np.ndarray,
+             look: Look | None = None) -> EncodedFrame:
+        """Adds a frame: ``face`` (False: the pose, offsets and look are not sent), the features
+        ``lost``, the ``pose``, (K, 2) ``offsets`` (model units) and the ``look`` (None:
+        neutral; only an encoder made with ``look=True`` sends one)."""
+        look_values = (Look() if look is None else look).vector()
+        if not np.all(np.isfinite(look_values)):
+            raise InvalidInputError(f"the look's values must be finite, got {look_values.tolist()}")
+        if not self.look and np.any(look_values != 0):
+            raise InvalidInputError("this encoder's stream carries no look: make it with look=True to send one")
+        m = len(self.basis.raw)
+        values = np.concatenate([pose_vector(pose), self.basis.coefficients(offsets)]
+                                + ([look_values] if self.look else []))
         recon, packet = self._core.push(bool(face), _lost_bits(lost), values)
-        return EncodedFrame(pose_from_vector(recon[:POSE_PARAMETERS]), self.basis.offsets(recon[POSE_PARAMETERS:]),
-                            packet or b"")
+        coded = recon[POSE_PARAMETERS + m:]
+        return EncodedFrame(pose_from_vector(recon[:POSE_PARAMETERS]),
+                            self.basis.offsets(recon[POSE_PARAMETERS:POSE_PARAMETERS + m]), packet or b"",
+                            look_from_extras(LOOK_KINDS, coded) if self.look else Look())
 
     def finish(self) -> bytes:
         """The last packet's bytes (empty when none is pending)."""
@@ -156,8 +183,9 @@ class MotionEncoder:
 @dataclass
 class DecodedFrame:
     """One frame out of the decoder: its ``index`` from the stream's start, ``face`` (False: show
-    the last face, dimmed), the features ``lost``, ``pose`` and (K, 2) ``offsets``, and
-    ``concealed``: it was lost or damaged and repeats the last good frame."""
+    the last face, dimmed), the features ``lost``, ``pose``, (K, 2) ``offsets``, ``concealed``:
+    it was lost or damaged and repeats the last good frame, and its ``look`` (neutral for a
+    version-1 stream, which carries none, and before the first decoded frame)."""
 
     index: int
     face: bool
@@ -165,12 +193,15 @@ class DecodedFrame:
     pose: Pose
     offsets: np.ndarray
     concealed: bool = False
+    look: Look = field(default_factory=Look)
 
 
 @dataclass
 class StreamInfo:
     """The header's facts: ``fps``, ``size`` (width, height px), frames per packet, packets per
-    intra packet, the basis, whether the actor is in the stream, and its content hash."""
+    intra packet, the basis, whether the actor is in the stream, its content hash, and
+    ``extras``: the kinds of the extra parameters (``docs/bitstream.md``, "Look"; kinds 1-6 are
+    the look's values, :data:`~facemime.codec.params.LOOK_KINDS`; empty for version 1)."""
 
     fps: float
     size: tuple[int, int]
@@ -180,6 +211,12 @@ class StreamInfo:
     actor_in_stream: bool
     actor_id: bytes
     topology: bytes = field(repr=False, default=b"")
+    extras: tuple[int, ...] = ()
+
+    @property
+    def has_look(self) -> bool:
+        """Whether the stream carries any of the look's values."""
+        return any(k in LOOK_KINDS for k in self.extras)
 
 
 class MotionDecoder:
@@ -203,11 +240,12 @@ class MotionDecoder:
     def _read_header(self) -> None:
         h = self._core.header()
         if h is None or (self.info is not None and h["basis"].tobytes() == self.info.basis.raw.tobytes()
-                         and h["actor_id"] == self.info.actor_id):
+                         and h["actor_id"] == self.info.actor_id and tuple(h["extras"]) == self.info.extras):
             return
         self.actor = None  # a first header, or a new one: its actor is looked up again
         self.info = StreamInfo(h["fps"][0] / h["fps"][1], tuple(h["size"]), h["packet_frames"], h["keyframe_packets"],
-                               Basis(h["basis"]), h["actor_in_stream"], h["actor_id"], h["topology"])
+                               Basis(h["basis"]), h["actor_in_stream"], h["actor_id"], h["topology"],
+                               tuple(int(k) for k in h["extras"]))
 
     def _resolve_actor(self) -> None:
         if self.actor is not None or self.info is None:
@@ -243,10 +281,13 @@ class MotionDecoder:
             raise StreamError(f"{self.name} is too damaged to play: {stats['concealed']} frames lost against "
                               f"{stats['frames']} decoded")
         out: list[tuple[int, DecodedFrame | None, int]] = []
+        m = len(self.info.basis.raw) if self.info is not None else 0
         for i, f, l, v in zip(index, face, lost, values):
+            look = look_from_extras(self.info.extras, v[POSE_PARAMETERS + m:]) if self.info.extras else Look()
             out.append((int(i), DecodedFrame(int(i), bool(f), [n for b, n in enumerate(FEATURES) if l >> b & 1],
                                              pose_from_vector(v[:POSE_PARAMETERS]),
-                                             self.info.basis.offsets(v[POSE_PARAMETERS:])), 0))
+                                             self.info.basis.offsets(v[POSE_PARAMETERS:POSE_PARAMETERS + m]),
+                                             look=look), 0))
         for first, count in concealed:
             out.append((int(first), None, int(count)))
         frames = []
@@ -260,7 +301,8 @@ class MotionDecoder:
                 if last is None:
                     frames.append(DecodedFrame(first + k, False, list(FEATURES), self.reference(), self._rest(), True))
                 else:
-                    frames.append(DecodedFrame(first + k, last.face, last.lost, last.pose, last.offsets, True))
+                    frames.append(DecodedFrame(first + k, last.face, last.lost, last.pose, last.offsets, True,
+                                               last.look))
         return frames
 
     def reference(self) -> Pose:
