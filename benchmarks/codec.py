@@ -5,9 +5,9 @@ Per video, the clip is analysed once (actor fitted on frame 0, every frame track
 
 - **Rate-quality curve**: the motion (packets: pose, coefficients, flags, framing) in kbit/s at
   qualities 0, 1, 2, 3, 5 (the default), 7, 10 and with ``--rate 1``, and the decoded face's luma
-  PSNR and SSIM (11×11 Gaussian window) inside the face (the convex hull of the reference Face
-  Mesh points of each frame), next to the unquantised synthesis (the analysis's own pose and
-  offsets). The one-time bytes beside it: header (with the clip's basis) and actor (WebP texture).
+  PSNR and SSIM (11×11 Gaussian window; the eyes as decoded too) inside the face (the convex
+  hull of the reference Face Mesh points of each frame), next to the unquantised synthesis (the
+  analysis's own pose, offsets and look). The one-time bytes beside it: header (with the clip's basis) and actor (WebP texture).
 - **Representations** at the default steps: the 60 knots' 120 coordinates directly; a basis
   learned from the *other* nine videos (what a basis shipped with the package would do on an
   unseen face); the clip's own basis (the format's choice) with 8, 16 and 24 vectors.
@@ -109,8 +109,11 @@ class Scene:
         self.offsets = np.array(faces)
         self.basis = Basis.learn(self.offsets, MAX_COEFFICIENTS)
 
-    def quality(self, poses, offsets) -> tuple[float, float]:
-        images = {i: self.puppet.render(poses[i], offsets[i], self.clip.size) for i in self.masks}
+    def quality(self, frames) -> tuple[float, float]:
+        """Face luma PSNR and SSIM of the synthesis of ``frames`` (decoded or analysed: their
+        pose, offsets and look)."""
+        images = {i: self.puppet.render(frames[i].pose, frames[i].offsets, self.clip.size, look=frames[i].look)
+                  for i in self.masks}
         return score(images, self.real, self.masks)
 
     def coded(self, settings: Settings, basis: Basis | None = None) -> dict:
@@ -118,7 +121,7 @@ class Scene:
         header, actor, packets = encode_clip(self.clip, settings, True, basis or self.basis)
         dec = MotionDecoder()
         frames = dec.push(header + actor + b"".join(packets)) + dec.finish()
-        psnr, ssim = self.quality([f.pose for f in frames], [f.offsets for f in frames])
+        psnr, ssim = self.quality(frames)
         return {"kbit_s": sum(map(len, packets)) * 8 / 1000 / self.duration, "header_bytes": len(header),
                 "actor_bytes": len(actor), "psnr": psnr, "ssim": ssim}
 
@@ -139,7 +142,7 @@ def lossy(scene: Scene, drop: float, seeds: int = 10) -> dict:
         frames = dec.push(header + actor + b"".join(kept)) + dec.finish()
         missing = len(scene.clip.motion) - len(frames)  # the last packets lost: their frames hold the last one
         frames += [frames[-1]] * missing
-        psnr, ssim = scene.quality([f.pose for f in frames], [f.offsets for f in frames])
+        psnr, ssim = scene.quality(frames)
         runs.append((len(packets) - len(kept), dec.stats["concealed"] + missing, psnr, ssim))
     dropped, concealed, psnr, ssim = np.mean(runs, axis=0)
     return {"packets": len(packets), "dropped": dropped, "concealed": concealed, "frames": len(scene.clip.motion),
@@ -195,7 +198,7 @@ def speed(scene: Scene) -> dict:
         for label, seq in (("decoded", frames), ("analysed", scene.clip.motion)):
             t0 = time.perf_counter()
             for f in seq:
-                scene.puppet.render(f.pose, f.offsets, size, out=out)
+                scene.puppet.render(f.pose, f.offsets, size, out=out, look=f.look)
             fps[label] = max(fps[label], n / (time.perf_counter() - t0))
     picture_fps, synth_fps = fps["decoded"], fps["analysed"]
     t0 = time.perf_counter()
@@ -254,7 +257,7 @@ def main() -> None:
     for name in names:
         t0 = time.perf_counter()
         scenes[name] = s = Scene(args.data, name, args.every)
-        base = s.quality([m.pose for m in s.clip.motion], [m.offsets for m in s.clip.motion])
+        base = s.quality(s.clip.motion)
         curve = {q: s.coded(Settings(quality=q)) for q in QUALITIES}
         header, _, packets = encode_clip(s.clip, Settings(), True, s.basis)
         at_rate = None
