@@ -25,12 +25,13 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from facemime.animate.deform import head_plane
 from facemime.model.head import HeadModel
 from facemime.render.projection import Pose, project
 
 EYES = ("eye_right", "eye_left")
 #: Samples per eye width, and the patch's extent (eye widths) along and across the eye.
-DENSITY = 40
+DENSITY = 20
 SPAN_U = (-0.7, 0.7)
 SPAN_V = (-0.55, 0.55)
 #: The iris's radius, eye widths (the shared videos' Face Mesh irises: 0.21 of the corner distance).
@@ -235,12 +236,14 @@ class LidModel:
 class EyeState:
     """Both eyes measured on one frame: ``opening`` (2,) upper to lower lid, eye widths;
     ``iris`` (2, 2) iris centres (u, v); ``frames`` the two :class:`EyeFrame`; ``seen`` (2,)
-    whether each iris shows (:data:`IRIS_SEEN`). The subject's right (image-left) eye first."""
+    whether each iris shows (:data:`IRIS_SEEN`); ``rest`` (2, 2) where the key frame's irises
+    are in this pose (u, v). The subject's right (image-left) eye first."""
 
     opening: np.ndarray
     iris: np.ndarray
     frames: tuple[EyeFrame, EyeFrame]
     seen: np.ndarray
+    rest: np.ndarray
 
     def iris_xy(self) -> np.ndarray:
         """(2, 2) iris centres, image px."""
@@ -276,6 +279,14 @@ class EyeTracker:
             self._models.append(LidModel(profiles(patch), at(np.array(COLUMNS), upper), at(np.array(COLUMNS), lower)))
             self._opening[k] = at(0.0, lower) - at(0.0, upper)
             self._contrast[k] = find_iris(patch)[1]
+        # the key frame's irises on the head: at the depth of the lids, they turn with it (an
+        # eye's surface bulges in front of its corners, so a turned head moves the iris across
+        # the eye by itself; the synthesis's mesh does the same)
+        self._irises = np.zeros((2, 3))
+        iris = np.array([f.to_image(find_iris(f.patch(key))[0]) for f in frames])
+        for k, r in enumerate(self._rings):
+            depth = r[[1, 2, 3, 5, 6, 7], 2].mean()
+            self._irises[k] = [*head_plane(iris[[k]], np.array([depth]), key_pose)[0], depth]
         self.key = self.update(key, key_pose)
         self._shift = np.zeros((2, 2))
 
@@ -292,14 +303,16 @@ class EyeTracker:
             opening[k] = share * self._opening[k]
             iris[k], contrast = find_iris(p)
             seen[k] = contrast >= IRIS_SEEN * self._contrast[k]
-        return EyeState(opening, iris, frames, seen)
+        rest = np.array([f.to_eye(xy) for f, xy in zip(frames, project(self._irises, pose)[0])])
+        return EyeState(opening, iris, frames, seen, rest)
 
     def look(self, state: EyeState) -> tuple[np.ndarray, np.ndarray]:
         """The closure (2,) and iris shift (2, 2) of :class:`facemime.animate.look.Look` for a
-        measured ``state``: relative to the key frame, an iris not seen or hidden by its lids
-        (:data:`IRIS_HIDDEN`) held where it was last seen."""
+        measured ``state``: relative to the key frame (the iris to where the head's turn carries
+        the key frame's), an iris not seen or hidden by its lids (:data:`IRIS_HIDDEN`) held where
+        it was last seen."""
         closure = 1.0 - state.opening / np.maximum(self.key.opening, 1e-6)
-        shift = state.iris - self.key.iris
+        shift = state.iris - state.rest
         seen = state.seen & (closure <= IRIS_HIDDEN)
         self._shift[seen] = shift[seen]
         return closure, self._shift.copy()
