@@ -264,8 +264,11 @@ class SnakeSolver:
         pair_targets: npt.NDArray[np.float64],
     ) -> tuple[float, npt.NDArray[np.float64]]: ...
 
+#: (index, face, lost, values, concealed (C, 2) of (first, count), appearance: the appearance
+#: payloads in stream order as (frames output before it in this call, payload)).
 Decoded = tuple[
-    npt.NDArray[np.uint64], npt.NDArray[np.bool_], npt.NDArray[np.uint8], npt.NDArray[np.float64], npt.NDArray[np.uint64]
+    npt.NDArray[np.uint64], npt.NDArray[np.bool_], npt.NDArray[np.uint8], npt.NDArray[np.float64], npt.NDArray[np.uint64],
+    list[tuple[int, bytes]],
 ]
 
 class StreamEncoder:
@@ -293,6 +296,7 @@ class StreamEncoder:
     def next_is_intra(self) -> bool: ...
 
 def actor_chunk(payload: bytes) -> bytes: ...
+def appearance_chunk(payload: bytes) -> bytes: ...
 def choose_classes(steps: list[float], hysteresis: float, values: npt.NDArray[np.float64]) -> list[int]: ...
 
 class StreamDecoder:

@@ -117,3 +117,16 @@ def test_bad_streams_and_outputs_give_one_line(stream, tmp_path, capsys):
 def test_quality_and_rate_are_one_or_the_other(clip, tmp_path, capsys):
     code, out, err = run(capsys, "encode", str(clip), "--quality", "3", "--rate", "1", "--out", str(tmp_path / "s.fmstream"))
     assert code == 1 and "not both" in err and not (tmp_path / "s.fmstream").exists()
+
+
+def test_appearance_updates_are_sent_within_their_budget_and_applied(clip, tmp_path, capsys):
+    code, _, err = run(capsys, "encode", str(clip), "--appearance", "8", "--out", str(tmp_path / "s.fmstream"))
+    assert code == 0, err
+    m = re.search(r"appearance ([\d.]+) kbit/s \((\d+) updates, (\d+) bytes\)", err)
+    assert m and 0 < float(m[1]) <= 8.0 and int(m[2]) > 0, err
+    code, _, err = run(capsys, "decode", str(tmp_path / "s.fmstream"), "--out", str(tmp_path / "x.mp4"))
+    assert code == 0 and f"{m[2]} appearance updates" in err, err
+    for bad in ("-1", "nan", "5000"):
+        code, out, err = run(capsys, "encode", str(clip), "--appearance", bad, "--out", str(tmp_path / "b.fmstream"))
+        assert code == 1 and out == "" and err.count("\n") == 1 and "appearance budget" in err, err
+    assert not (tmp_path / "b.fmstream").exists()

@@ -80,7 +80,7 @@ def write(version: int) -> None:
     stream, expected = (STREAM, EXPECTED) if version == 1 else (STREAM_V2, EXPECTED_V2)
     data = encode(version)
     dec = _core.StreamDecoder(True)
-    index, face, lost, values, _ = dec.push(data)
+    index, face, lost, values, *_ = dec.push(data)
     stream.write_bytes(data)
     rows = [json.dumps({"index": int(i), "face": bool(f), "lost": int(b), "values": v.tolist()})
             for i, f, b, v in zip(index, face, lost, values)]

@@ -8,11 +8,18 @@ D = (3764, 6909, 11147, 16245, 21852, 27600, 33170, 38337, 42966, 47001, 50443, 
 M32 = 0xFFFFFFFF
 
 
+#: The largest payload of each kind: header, actor, intra and inter packets, appearance.
+LIMITS = {1: 1 << 20, 2: 1 << 26, 3: 1 << 16, 4: 1 << 16, 5: 1 << 20}
+
+
 def chunks(data: bytes):
-    """(kind, frames, seq, payload) of each chunk (the stream must be undamaged)."""
+    """(kind, frames, seq, payload) of each chunk (the stream must be undamaged: anything that
+    is not a chunk fails an assertion)."""
     at = 0
     while at < len(data):
         tag, seq = data[at], struct.unpack_from("<H", data, at + 1)[0]
+        kind = tag >> 5
+        assert kind in LIMITS and (kind in (3, 4) or tag & 31 == 0)
         length, shift, pos = 0, 0, at + 3
         while True:
             b = data[pos]
@@ -21,9 +28,11 @@ def chunks(data: bytes):
             shift += 7
             if not b & 0x80:
                 break
+            assert shift < 28
+        assert length <= LIMITS[kind]
         end = pos + length
         assert zlib.crc32(data[at:end]) == struct.unpack_from("<I", data, end)[0]
-        yield tag >> 5, (tag & 31) + 1, seq, data[pos:end]
+        yield kind, (tag & 31) + 1, seq, data[pos:end]
         at = end + 4
 
 
@@ -118,14 +127,18 @@ class Range:
         return (-(13 + m) if negative else 13 + m), s
 
 
-def decode(data: bytes) -> list[dict]:
+def decode(data: bytes, appearance: list | None = None) -> list[dict]:
     """Every frame of an undamaged stream: index, face, lost, values (floats, the extras last;
     the header's ``extras`` name their kinds), and with extras ``look``: the look's six values
-    (kinds 1-6; an absent kind is 0, an unknown one ignored)."""
+    (kinds 1-6; an absent kind is 0, an unknown one ignored). ``appearance``: a list that gets
+    (frames before it, payload) of each appearance chunk after a header whose payload holds at
+    least its 8 bytes of frame and place."""
     frames, h, state = [], None, None
     for kind, count, seq, payload in chunks(data):
         if kind == 1:
             h = header(payload)
+        if kind == 5 and h is not None and len(payload) >= 8 and appearance is not None:
+            appearance.append((len(frames), payload))
         if kind not in (3, 4):
             continue
         if kind == 3:

@@ -15,6 +15,7 @@ from facemime import _core
 from facemime.codec.stream import MotionDecoder, StreamError
 
 from . import golden
+from .reference_decoder import chunks as reference_chunks
 from .reference_decoder import decode as reference
 
 
@@ -66,7 +67,10 @@ def test_random_bytes_are_never_decoded(data):
 def test_mutated_streams_decode_only_true_frames(edits, piece, from_start, version):
     stream, expected = (golden.STREAM, golden.EXPECTED) if version == 1 else (golden.STREAM_V2, golden.EXPECTED_V2)
     truth = {f["index"]: f["values"] for f in json.loads(expected.read_text())["frames"] if f["face"]}
-    data = bytearray(stream.read_bytes())
+    data, updates = bytearray(stream.read_bytes()), []
+    if version == 2:  # with appearance updates between packets
+        data, updates = with_appearance(bytes(data))
+        data = bytearray(data)
     for at, value, how in edits:
         if not data:
             break
@@ -81,11 +85,12 @@ def test_mutated_streams_decode_only_true_frames(edits, piece, from_start, versi
             del data[i:]
     dec = _core.StreamDecoder(from_start)
     outs = [dec.push(bytes(data[k:k + piece])) for k in range(0, len(data), piece)] + [dec.finish()]
-    for index, face, _, values, concealed in outs:
+    for index, face, _, values, concealed, appearance in outs:
         for i, f, v in zip(index, face, values):
             if f:
                 assert v.tolist() == truth[int(i)]
         assert np.all(concealed[:, 1] >= 1) if len(concealed) else True
+        assert all(bytes(p) in [u for _, u in updates] for _, p in appearance)  # whole and true
 
 
 def test_a_decoder_written_from_the_specification_reads_the_golden_stream():
@@ -156,16 +161,25 @@ def test_the_specification_and_the_rust_decoder_agree_on_version_2_streams(kinds
         assert [f["look"][k - 1] for _, k in known] == [v[6 + m + i] for i, _ in known]
 
 
-def header_chunk(payload: bytes) -> bytes:
-    """A header chunk (kind 1) around ``payload`` (``docs/bitstream.md``, "Chunks")."""
-    n, length = len(payload), b""
+def leb128(n: int) -> bytes:
+    out = b""
     while True:
-        length += bytes([(n & 0x7F) | (0x80 if n >> 7 else 0)])
+        out += bytes([(n & 0x7F) | (0x80 if n >> 7 else 0)])
         n >>= 7
         if not n:
-            break
-    body = bytes([1 << 5, 0, 0]) + length + payload
+            return out
+
+
+def any_chunk(kind: int, payload: bytes, frames: int = 0, seq: int = 0) -> bytes:
+    """A chunk of ``kind`` around ``payload`` (``docs/bitstream.md``, "Chunks"); ``frames`` goes
+    in the tag as frames - 1 (0: none)."""
+    body = bytes([kind << 5 | max(frames - 1, 0)]) + struct.pack("<H", seq) + leb128(len(payload)) + payload
     return body + struct.pack("<I", zlib.crc32(body))
+
+
+def header_chunk(payload: bytes) -> bytes:
+    """A header chunk (kind 1) around ``payload``."""
+    return any_chunk(1, payload)
 
 
 def golden_v2_header() -> tuple[bytearray, int]:
@@ -222,3 +236,135 @@ def test_the_encoder_refuses_bad_extras():
         _core.StreamEncoder(*args, [0, 2, 3, 4, 5, 6])
     with pytest.raises(ValueError, match="^the basis holds 12 entries, not 3 x 6$"):
         _core.StreamEncoder(*args, [1, 2, 3, 4, 5])
+
+
+def split_chunks(data: bytes) -> list[bytes]:
+    """The bytes of each chunk of an undamaged stream."""
+    out = [any_chunk(kind, payload, count if kind in (3, 4) else 0, seq)
+           for kind, count, seq, payload in reference_chunks(data)]
+    assert b"".join(out) == data
+    return out
+
+
+def appearance_payload(frame: int, x: int, y: int, image: bytes) -> bytes:
+    return struct.pack("<IHH", frame, x, y) + image
+
+
+def with_appearance(data: bytes) -> tuple[bytes, list[tuple[int, bytes]]]:
+    """The version-2 golden stream with an appearance chunk before every other packet (for that
+    packet's first frame, P = 4), and (frames before it, payload) of each."""
+    chunks, updates, out, frames = split_chunks(data), [], [], 0
+    for c in chunks:
+        kind, count = c[0] >> 5, (c[0] & 31) + 1
+        if kind in (3, 4):
+            if len(updates) < 4 and frames % 8 == 4:
+                p = appearance_payload(frames, 16 * len(updates), 3, b"RIFF" + bytes([len(updates)]) * (5 + frames))
+                updates.append((frames, p))
+                out.append(_core.appearance_chunk(p))
+            frames += count
+        out.append(c)
+    return b"".join(out), updates
+
+
+def decode_all(data: bytes):
+    """(decoder, the five frame arrays, (frames before it, payload) per appearance update) of
+    ``data`` pushed at once, then finished (damage may hold bytes back until then)."""
+    dec = _core.StreamDecoder(True)
+    parts, updates, seen = [dec.push(data), dec.finish()], [], 0
+    for index, *_, concealed, appearance in parts:
+        updates += [(seen + int(at), bytes(p)) for at, p in appearance]
+        seen += len(index) + int(concealed[:, 1].sum())
+    return dec, [np.concatenate([p[k] for p in parts]) for k in range(5)], updates
+
+
+def same_arrays(a, b) -> bool:
+    return all(np.array_equal(x, y) for x, y in zip(a, b))
+
+
+def test_appearance_chunks_between_packets_change_no_frame_and_come_out_in_order():
+    data = golden.STREAM_V2.read_bytes()
+    plain, plain_frames, none = decode_all(data)
+    assert none == [] and plain.stats()["appearance"] == 0
+    mixed, updates = with_appearance(data)
+    assert [at for at, _ in updates] == [4, 12, 20, 28]
+    dec, frames, got = decode_all(mixed)
+    assert same_arrays(frames, plain_frames)
+    assert got == updates  # in stream order, each before its packet's frames
+    # nothing else is counted: no damage, no undecodable chunk, the same packets and frames
+    assert dec.stats() == {**plain.stats(), "appearance": 4}
+    # the decoder written from the specification agrees, and takes them as chunks, not damage
+    found = []
+    assert reference(mixed, found) == reference(data)
+    assert found == updates
+    # fed a byte at a time: each update comes out in the call that completes its chunk
+    dec, seen, got = _core.StreamDecoder(True), 0, []
+    for i in range(len(mixed)):
+        index, _, _, _, concealed, app = dec.push(mixed[i:i + 1])
+        got += [(seen + int(at), bytes(p)) for at, p in app]
+        seen += len(index) + int(concealed[:, 1].sum())
+    assert got == updates and seen == golden.FRAMES_V2
+
+
+def test_appearance_chunks_come_out_in_a_version_1_stream_too():
+    data = golden.STREAM.read_bytes()
+    chunks = split_chunks(data)
+    p = appearance_payload(5, 0, 0, b"RIFF....WEBP")
+    mixed = b"".join(chunks[:2] + [_core.appearance_chunk(p)] + chunks[2:])
+    dec, frames, got = decode_all(mixed)
+    assert same_arrays(frames, decode_all(data)[1]) and got == [(5, p)]
+
+
+def test_a_damaged_appearance_chunk_is_skipped_as_damage_and_the_rest_decodes():
+    data = golden.STREAM_V2.read_bytes()
+    _, plain_frames, _ = decode_all(data)
+    mixed, updates = with_appearance(data)
+    at = mixed.index(updates[1][1]) + 10  # a byte of the second update's image
+    damaged = bytearray(mixed)
+    damaged[at] ^= 0x20
+    dec, frames, got = decode_all(bytes(damaged))
+    assert same_arrays(frames, plain_frames)
+    assert got == updates[:1] + updates[2:]
+    stats = dec.stats()
+    assert (stats["damaged_runs"], stats["undecodable"], stats["appearance"]) == (1, 0, 3)
+    assert stats["damaged_bytes"] == len(_core.appearance_chunk(updates[1][1]))
+
+
+def test_an_appearance_payload_too_short_for_its_frame_and_place_is_undecodable():
+    data = golden.STREAM_V2.read_bytes()
+    chunks = split_chunks(data)
+    short = any_chunk(5, b"\x04\x00\x00\x00\x00\x00\x00")  # 7 bytes: no room for y
+    good = appearance_payload(0, 0, 0, b"")  # 8 bytes: an update with an empty image is passed on
+    dec, frames, got = decode_all(b"".join(chunks[:1] + [short, _core.appearance_chunk(good)] + chunks[1:]))
+    assert same_arrays(frames, decode_all(data)[1]) and got == [(0, good)]
+    assert (dec.stats()["undecodable"], dec.stats()["damaged_runs"]) == (1, 0)
+    found = []
+    reference(b"".join(chunks[:1] + [short] + chunks[1:]), found)
+    assert found == []
+    with pytest.raises(ValueError, match="^an appearance payload must hold at least 8 bytes \\(frame, x, y\\), got 7$"):
+        _core.appearance_chunk(b"1234567")
+    with pytest.raises(ValueError, match="^an appearance payload must hold at most 1048576 bytes, got 1048577$"):
+        _core.appearance_chunk(bytes(8 + (1 << 20) - 7))
+    assert len(_core.appearance_chunk(bytes(1 << 20))) == 3 + 3 + (1 << 20) + 4
+
+
+def test_an_appearance_chunk_before_any_header_is_undecodable():
+    data = golden.STREAM_V2.read_bytes()
+    dec, frames, got = decode_all(_core.appearance_chunk(appearance_payload(0, 0, 0, b"x")) + data)
+    assert same_arrays(frames, decode_all(data)[1]) and got == []
+    assert (dec.stats()["undecodable"], dec.stats()["damaged_runs"]) == (1, 0)
+
+
+@pytest.mark.parametrize("bad", ["length", "frames"])
+def test_an_appearance_chunk_over_its_limit_or_with_frame_bits_is_not_a_chunk(bad):
+    data = golden.STREAM_V2.read_bytes()
+    chunks = split_chunks(data)
+    if bad == "length":  # a declared length of 2^20 + 1, then the next packet
+        fake = bytes([5 << 5, 0, 0]) + leb128((1 << 20) + 1)
+    else:  # a good CRC, but a tag with frame bits
+        fake = any_chunk(5, appearance_payload(4, 0, 0, b"RIFF"), frames=2)
+    dec, frames, got = decode_all(b"".join(chunks[:2] + [fake] + chunks[2:]))
+    assert same_arrays(frames, decode_all(data)[1]) and got == []
+    stats = dec.stats()
+    assert (stats["damaged_runs"], stats["damaged_bytes"], stats["undecodable"]) == (1, len(fake), 0)
+    with pytest.raises(AssertionError):  # the reference decoder takes no damage
+        reference(b"".join(chunks[:2] + [fake] + chunks[2:]))

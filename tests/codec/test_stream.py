@@ -259,3 +259,32 @@ def test_kinds_the_decoder_does_not_know_are_decoded_and_ignored(clip):
     assert dec.info.extras == (5, 200, 2, 7) and dec.info.has_look
     assert frame.look.vector().tolist() == [0, 0.5, 0, 0, 0.25, 0]
     assert np.array_equal(frame.offsets, basis.offsets(np.round(basis.coefficients(m.offsets) / 3.0) * 3.0))
+
+
+def test_the_decoder_collects_appearance_payloads_in_order_and_where_they_fall(clip):
+    data, recon = encoded(clip)
+    plain = MotionDecoder()
+    expected = plain.push(b"".join(data)) + plain.finish()
+    # an update before every third packet, for that packet's first frame (payloads not parsed
+    # here); data[t + 1] is what frame t completed: a packet of the frames up to t, or nothing
+    mixed, payloads, after, frames = [data[0]], [], [], 0
+    for t, d in enumerate(data[1:]):
+        if not d:
+            continue
+        if len(mixed) % 3 == 1:
+            p = frames.to_bytes(4, "little") + bytes([t % 256, 0, 7, 0]) + b"RIFF" + bytes(t % 50)
+            mixed.append(_core.appearance_chunk(p))
+            payloads.append(p)
+            after.append(frames)
+        mixed.append(d)
+        frames = min(t + 1, len(clip.motion))
+    stream = b"".join(mixed)
+    assert len(payloads) >= 3
+    dec = MotionDecoder()
+    got = [f for k in range(0, len(stream), 37) for f in dec.push(stream[k:k + 37])] + dec.finish()
+    assert [(f.index, f.face, f.lost, f.pose, f.concealed) for f in got] == \
+        [(f.index, f.face, f.lost, f.pose, f.concealed) for f in expected]
+    assert all(np.array_equal(f.offsets, e.offsets) for f, e in zip(got, expected))
+    assert dec.appearance == payloads and dec.appearance_after == after
+    assert dec.stats["appearance"] == len(payloads) and dec.stats["undecodable"] == 0
+    assert plain.appearance == [] and plain.appearance_after == []

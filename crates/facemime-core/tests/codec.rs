@@ -1,5 +1,6 @@
 //! The bitstream end to end: round trips, loss, damage and hostile bytes.
 
+use facemime_core::codec::chunk::{self, Kind};
 use facemime_core::codec::{Decoder, Encoder, Header, Output, Quantiser};
 use proptest::prelude::*;
 
@@ -98,6 +99,7 @@ fn check(out: &[Output], recon: &[Vec<f64>]) -> (usize, u64) {
                 decoded += 1;
             }
             Output::Concealed { count, .. } => concealed += count,
+            Output::Appearance(_) => {}
         }
     }
     (decoded, concealed)
@@ -281,6 +283,135 @@ fn values_beyond_the_formats_range_are_an_error_not_garbage() {
     assert!(enc.push(true, 0, &v[..3]).is_err());
 }
 
+/// An appearance payload: first frame `frame`, at (x, y) = (3, 4), then `image` (not parsed).
+fn appearance_payload(frame: u32, image: &[u8]) -> Vec<u8> {
+    [
+        &frame.to_le_bytes()[..],
+        &3u16.to_le_bytes(),
+        &4u16.to_le_bytes(),
+        image,
+    ]
+    .concat()
+}
+
+/// The frames only, and the appearance payloads each with the frames output before it.
+fn split(out: Vec<Output>) -> (Vec<Output>, Vec<(u64, Vec<u8>)>) {
+    let (mut frames, mut updates, mut seen) = (vec![], vec![], 0);
+    for o in out {
+        match o {
+            Output::Appearance(p) => updates.push((seen, p)),
+            Output::Frame { .. } => {
+                seen += 1;
+                frames.push(o);
+            }
+            Output::Concealed { count, .. } => {
+                seen += count;
+                frames.push(o);
+            }
+        }
+    }
+    (frames, updates)
+}
+
+/// The stream with an appearance chunk before every third packet (for that
+/// packet's first frame), and the payloads in order.
+fn with_appearance(chunks: &[Vec<u8>], per: u64) -> (Vec<u8>, Vec<(u64, Vec<u8>)>) {
+    let (mut bytes, mut updates) = (chunks[0].clone(), vec![]);
+    for (s, packet) in chunks[1..].iter().enumerate() {
+        if s % 3 == 1 {
+            let frame = s as u64 * per;
+            let p = appearance_payload(frame as u32, &vec![s as u8; 10 + s]);
+            bytes.extend(chunk::appearance(&p).unwrap());
+            updates.push((frame, p));
+        }
+        bytes.extend(packet);
+    }
+    (bytes, updates)
+}
+
+#[test]
+fn appearance_chunks_between_packets_change_no_frame_and_come_out_in_order() {
+    let h = header(4, 3);
+    let (chunks, recon) = encode(&h, &clip(120, 8));
+    let (plain, plain_out) = decode(&chunks.concat(), true);
+    let (bytes, updates) = with_appearance(&chunks, 4);
+    assert_eq!(updates.len(), 10);
+    for piece in [bytes.len(), 7, 1] {
+        let mut d = Decoder::new(true);
+        let mut out = Vec::new();
+        for p in bytes.chunks(piece) {
+            out.extend(d.push(p));
+        }
+        out.extend(d.finish());
+        let (frames, got) = split(out);
+        assert_eq!(frames, plain_out);
+        // each comes out where it was read: just before its packet's frames
+        assert_eq!(got, updates);
+        assert_eq!(check(&frames, &recon), (120, 0));
+        let mut stats = d.stats.clone();
+        assert_eq!(stats.appearance, 10);
+        stats.appearance = 0;
+        assert_eq!(stats, plain.stats);
+    }
+}
+
+#[test]
+fn a_damaged_appearance_chunk_is_skipped_as_damage_and_the_rest_decodes() {
+    let h = header(4, 3);
+    let (chunks, recon) = encode(&h, &clip(60, 9));
+    let (_, plain_out) = decode(&chunks.concat(), true);
+    let (bytes, updates) = with_appearance(&chunks, 4);
+    // flip a byte of the first update's image
+    let at = chunks[0].len() + chunks[1].len() + 4 + 8 + 3;
+    assert_eq!(bytes[at], 1);
+    let mut damaged = bytes.clone();
+    damaged[at] ^= 0x40;
+    let (d, out) = decode(&damaged, true);
+    let (frames, got) = split(out);
+    assert_eq!(frames, plain_out);
+    assert_eq!(check(&frames, &recon), (60, 0));
+    assert_eq!(got, updates[1..]);
+    assert_eq!((d.stats.damaged_runs, d.stats.undecodable), (1, 0));
+    assert_eq!(d.stats.appearance, updates.len() as u64 - 1);
+}
+
+#[test]
+fn a_short_appearance_payload_or_one_before_the_header_is_undecodable() {
+    let h = header(4, 3);
+    let (chunks, recon) = encode(&h, &clip(20, 10));
+    let short = chunk::write(Kind::Appearance, 0, 0, &[1, 2, 3, 4, 5, 6, 7]);
+    let good = chunk::appearance(&appearance_payload(0, b"RIFF")).unwrap();
+    let bytes = [
+        good.clone(),
+        chunks[0].clone(),
+        short,
+        good.clone(),
+        chunks[1..].concat(),
+    ]
+    .concat();
+    let (d, out) = decode(&bytes, true);
+    let (frames, got) = split(out);
+    assert_eq!(check(&frames, &recon), (20, 0));
+    assert_eq!(got, vec![(0, appearance_payload(0, b"RIFF"))]);
+    assert_eq!((d.stats.undecodable, d.stats.appearance), (2, 1));
+    assert_eq!(d.stats.damaged_runs, 0);
+}
+
+#[test]
+fn an_appearance_chunk_declaring_more_than_a_mebibyte_is_not_a_chunk() {
+    let h = header(4, 3);
+    let (chunks, recon) = encode(&h, &clip(20, 11));
+    // the tag, seq, and a length of 2^20 + 1: damage; the reader resynchronises after it
+    let n = (1usize << 20) + 1;
+    let fake = [5 << 5, 0, 0, (n & 0x7f) as u8 | 0x80, 0x80, (n >> 14) as u8];
+    let bytes = [chunks[0].clone(), fake.to_vec(), chunks[1..].concat()].concat();
+    let (d, out) = decode(&bytes, true);
+    let (frames, got) = split(out);
+    assert_eq!(check(&frames, &recon), (20, 0));
+    assert!(got.is_empty());
+    assert_eq!((d.stats.damaged_runs, d.stats.damaged_bytes), (1, 6));
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
 
@@ -295,7 +426,7 @@ proptest! {
                                             pieces in 1usize..7) {
         let h = header(3, 4);
         let (chunks, recon) = encode(&h, &clip(90, 6));
-        let mut bytes = chunks.concat();
+        let (mut bytes, updates) = with_appearance(&chunks, 3);
         for (at, value, how) in edits {
             let i = at.index(bytes.len());
             match how {
@@ -315,5 +446,9 @@ proptest! {
         }
         out.extend(d.finish());
         check(&out, &recon);
+        // an update that comes out is one that was sent, whole
+        for (_, p) in split(out).1 {
+            prop_assert!(updates.iter().any(|(_, u)| *u == p));
+        }
     }
 }

@@ -134,6 +134,16 @@ fn actor_chunk<'py>(py: Python<'py>, payload: &[u8]) -> PyResult<Bound<'py, PyBy
     ))
 }
 
+/// The appearance chunk carrying `payload` (`u32` first frame, `u16` x, `u16` y, then a WebP
+/// image; `docs/bitstream.md`, "Appearance"), 8 bytes to 1 MiB.
+#[pyfunction]
+fn appearance_chunk<'py>(py: Python<'py>, payload: &[u8]) -> PyResult<Bound<'py, PyBytes>> {
+    Ok(PyBytes::new(
+        py,
+        &chunk::appearance(payload).map_err(CoreErr)?,
+    ))
+}
+
 /// Spread class per parameter for a clip (see `facemime_core::codec::choose_classes`):
 /// `values` (T, N), the frames that show a face.
 #[pyfunction]
@@ -148,13 +158,15 @@ fn choose_classes(
 }
 
 /// Decoded frames: (index (F,) uint64, face (F,) bool, lost (F,) uint8, values (F, N) float64,
-/// concealed (C, 2) uint64 of (first frame, count)).
+/// concealed (C, 2) uint64 of (first frame, count), appearance: the appearance payloads in
+/// stream order, each as (frames output before it in this call, decoded and concealed, payload)).
 type Decoded<'py> = (
     Bound<'py, PyArray1<u64>>,
     Bound<'py, PyArray1<bool>>,
     Bound<'py, PyArray1<u8>>,
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<u64>>,
+    Vec<(u64, Bound<'py, PyBytes>)>,
 );
 
 /// The stream decoder, fed bytes in pieces of any size. `from_start`: the stream starts at
@@ -167,8 +179,9 @@ pub struct StreamDecoder {
 impl StreamDecoder {
     fn arrays<'py>(&self, py: Python<'py>, out: Vec<Output>) -> Decoded<'py> {
         let n = self.dec.header().map_or(0, |h| h.quantisers.len());
-        let (mut index, mut face, mut lost, mut values, mut concealed) =
-            (vec![], vec![], vec![], vec![], vec![]);
+        let (mut index, mut face, mut lost, mut values, mut concealed, mut appearance) =
+            (vec![], vec![], vec![], vec![], vec![], vec![]);
+        let mut seen = 0; // frames output so far, decoded and concealed
         for o in out {
             match o {
                 Output::Frame {
@@ -181,9 +194,14 @@ impl StreamDecoder {
                     face.push(f);
                     lost.push(l);
                     values.extend(v);
+                    seen += 1;
                 }
                 Output::Frame { .. } => {}
-                Output::Concealed { first, count } => concealed.extend([first, count]),
+                Output::Concealed { first, count } => {
+                    concealed.extend([first, count]);
+                    seen += count;
+                }
+                Output::Appearance(p) => appearance.push((seen, PyBytes::new(py, &p))),
             }
         }
         let rows = index.len();
@@ -197,6 +215,7 @@ impl StreamDecoder {
             ndarray::Array2::from_shape_vec((concealed.len() / 2, 2), concealed)
                 .expect("C x 2")
                 .into_pyarray(py),
+            appearance,
         )
     }
 }
@@ -210,7 +229,7 @@ impl StreamDecoder {
         }
     }
 
-    /// Reads `data`; returns the frames it completed.
+    /// Reads `data`; returns the frames it completed and the appearance payloads it held.
     fn push<'py>(&mut self, py: Python<'py>, data: &[u8]) -> Decoded<'py> {
         let out = py.detach(|| self.dec.push(data));
         self.arrays(py, out)
@@ -283,6 +302,7 @@ impl StreamDecoder {
             ("lost_packets", s.lost_packets),
             ("late_packets", s.late_packets),
             ("undecodable", s.undecodable),
+            ("appearance", s.appearance),
             ("damaged_runs", s.damaged_runs),
             ("damaged_bytes", s.damaged_bytes),
             ("frames", s.frames),
@@ -298,6 +318,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<StreamEncoder>()?;
     m.add_class::<StreamDecoder>()?;
     m.add_function(wrap_pyfunction!(actor_chunk, m)?)?;
+    m.add_function(wrap_pyfunction!(appearance_chunk, m)?)?;
     m.add_function(wrap_pyfunction!(choose_classes, m)?)?;
     Ok(())
 }

@@ -229,6 +229,11 @@ class Puppet:
         self._ratio = (self.deformer.feature_sizes() / sizes)[:, None]
         self._scale = float(source_iod) / model_iod(actor.model)
 
+    def retexture(self, texture: np.ndarray) -> None:
+        """Draw the actor with ``texture`` (its texture as updated, same size) from now on."""
+        self.actor = replace(self.actor, texture=texture)
+        self.painter = LookPainter(self.actor)
+
     def pose(self, measured: Pose, user: UserMotion = UserMotion()) -> Pose:
         """The pose to show the actor in for a ``measured`` pose of the source face."""
         if self.scene is None or self.source_pose is None:

@@ -182,10 +182,12 @@ def run(video: Path, actor_file: Path | None, out_file: Path, track_file: Path |
 @click.option("--packet", type=float, default=0.5, show_default=True,
               help="Seconds of frames per packet (shorter: less delay, more bytes).")
 @click.option("--embed-actor", is_flag=True, help="Carry the actor given with --actor in the stream too.")
+@click.option("--appearance", type=float, default=0.0, show_default=True,
+              help="kbit/s for sending the face's appearance again where it changes (light, skin); 0: never.")
 @click.option("--out", "out_file", type=click.Path(path_type=Path), required=True, help="X.fmstream to write.")
 @click.option("--force", is_flag=True, help="Overwrite an existing output file.")
 def encode(video: Path, actor_file: Path | None, quality: int | None, rate: float | None, keyframe: float, packet: float,
-           embed_actor: bool, out_file: Path, force: bool) -> None:
+           embed_actor: bool, appearance: float, out_file: Path, force: bool) -> None:
     """Analyse the face in VIDEO and write its motion as a facemime stream: a couple of kilobits
     a second, plus the actor once."""
     from facemime.codec.files import encode_video
@@ -195,14 +197,17 @@ def encode(video: Path, actor_file: Path | None, quality: int | None, rate: floa
     if quality is not None and rate is not None:
         raise InvalidInputError("give --quality or --rate, not both")
     settings = Settings(quality=DEFAULT_QUALITY if quality is None else quality, keyframe=keyframe, packet=packet)
-    result = encode_video(video, out_file, actor_file, settings, rate, True if embed_actor else None, force)
+    result = encode_video(video, out_file, actor_file, settings, rate, True if embed_actor else None, force,
+                          appearance)
     for w in result.warnings:
         click.echo(f"facemime: warning: {w}", err=True)
     click.echo(str(out_file))
     scene = f", its scene {result.scene_bytes} of them" if result.scene_bytes else ""
     actor = (f"the actor {result.actor_bytes} bytes once{scene}" if result.actor_bytes else f"the actor named ({actor_file})")
+    updates = (f", appearance {result.appearance_kbit_s:.2f} kbit/s ({result.appearance_updates} updates, "
+               f"{result.appearance_bytes} bytes)" if appearance else "")
     click.echo(f"encoded {result.frames} frames at quality {result.quality}: motion {result.motion_kbit_s:.2f} kbit/s "
-               f"({result.motion_bytes} bytes), header {result.header_bytes} bytes, {actor}", err=True)
+               f"({result.motion_bytes} bytes){updates}, header {result.header_bytes} bytes, {actor}", err=True)
 
 
 @cli.command()
@@ -222,7 +227,10 @@ def decode(stream: Path, actor_file: Path | None, out_file: Path, mask_only: boo
     s = result.stats
     damage = (f"; {result.concealed} frames concealed ({s['lost_packets']} packets lost, {s['damaged_bytes']} bytes "
               f"damaged, {s['undecodable']} undecodable)" if result.concealed or s["damaged_bytes"] else "")
-    click.echo(f"decoded {result.frames} frames in {result.seconds:.1f} s{damage}", err=True)
+    refused = f", {result.appearance_refused} refused" if result.appearance_refused else ""
+    updates = (f", {result.appearance_updates} appearance updates{refused}"
+               if result.appearance_updates or result.appearance_refused else "")
+    click.echo(f"decoded {result.frames} frames in {result.seconds:.1f} s{updates}{damage}", err=True)
 
 
 @cli.command()

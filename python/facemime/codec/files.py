@@ -4,8 +4,9 @@
 Encoding analyses the whole video first (fit, track, head pose, knot offsets), learns the basis
 of the knots' motion from this clip (its principal directions; sent once, in the header), picks
 each parameter's starting table from the clip, then codes the frames. With a target rate, it
-takes the finest quality whose motion fits. Decoding needs only the stream and, when the stream
-does not carry it, the actor.
+takes the finest quality whose motion fits. With an appearance budget, it reads the video again
+and puts appearance updates (:mod:`facemime.codec.appearance`) between the packets. Decoding
+needs only the stream and, when the stream does not carry it, the actor.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from facemime.animate.deform import Deformer
 from facemime.animate.look import Look
 from facemime.animate.run import NO_FACE_DIM
 from facemime.animate.synth import BACKGROUND, Puppet
+from facemime.codec.appearance import Appearance, AppearanceSender
 from facemime.codec.params import Basis, pose_vector
 from facemime.codec.stream import LADDER, MotionDecoder, MotionEncoder, Settings, StreamError
 from facemime.errors import InputFileError, InvalidInputError, NoFaceError
@@ -41,6 +43,8 @@ MAX_STREAM_BYTES = 1 << 30
 #: A stream file is refused when it conceals more than this many frames per frame decoded (and a
 #: minute besides): sequence numbers that jump far ahead would otherwise make hours of video.
 MAX_CONCEALED_RATIO = 10
+#: The largest appearance budget, kbit/s (more is a video codec's business).
+MAX_APPEARANCE = 1000.0
 #: The most basis vectors any quality uses (the clip's basis is learned once at this size).
 MAX_COEFFICIENTS = max(m for _, m in LADDER)
 
@@ -49,7 +53,7 @@ MAX_COEFFICIENTS = max(m for _, m in LADDER)
 class EncodeResult:
     """What :func:`encode_video` wrote: frames, the quality used, bytes of the header (with the
     basis), of the actor (0 when only named; its scene's image ``scene_bytes`` of them), of the
-    motion (packets), and seconds (analysis, coding)."""
+    motion (packets), of the appearance updates and how many, and seconds (analysis, coding)."""
 
     frames: int
     fps: float
@@ -60,11 +64,18 @@ class EncodeResult:
     seconds: dict[str, float] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
     scene_bytes: int = 0
+    appearance_bytes: int = 0
+    appearance_updates: int = 0
 
     @property
     def motion_kbit_s(self) -> float:
         """The motion's rate, kbit/s."""
         return self.motion_bytes * 8 / 1000 / (self.frames / self.fps)
+
+    @property
+    def appearance_kbit_s(self) -> float:
+        """The appearance updates' rate, kbit/s (their chunks, framing included)."""
+        return self.appearance_bytes * 8 / 1000 / (self.frames / self.fps)
 
 
 @dataclass
@@ -128,18 +139,43 @@ def encode_clip(clip: Clip, settings: Settings, carry_actor: bool,
     return enc.header, start[len(enc.header):], [p for p in packets if p]
 
 
+def with_appearance(video: str | Path, clip: Clip, header: bytes, actor_chunk: bytes, packets: list[bytes],
+                    settings: Settings, budget: float) -> tuple[list[bytes], AppearanceSender]:
+    """``packets`` with appearance updates (:mod:`facemime.codec.appearance`) of at most
+    ``budget`` kbit/s put before the packet holding each update's first frame: ``video`` is read
+    again, each frame laid onto the texture through what the receiver draws (the stream decoded
+    here). Returns the chunks and the sender (its texture is the receiver's at the end)."""
+    decoder = MotionDecoder(None if actor_chunk else clip.actor)
+    decoded = decoder.push(header + actor_chunk + b"".join(packets)) + decoder.finish()
+    held = decoder.actor  # the actor as the receiver holds it: its texture as the stream carries it
+    puppet = Puppet(held, Deformer(held.model).feature_sizes(), model_iod(held.model), mask_only=True)
+    sender = AppearanceSender(held.model, held.texture, budget, clip.fps)
+    per_packet = settings.framing(clip.fps)[0]
+    before: dict[int, list[bytes]] = {}
+    with VideoReader(video) as reader:
+        for i, (frame, f) in enumerate(zip(progress(reader, len(decoded), "appearance"), decoded)):
+            if f.face and not f.concealed:
+                payload = sender.update(i, frame, puppet.vertices(f.offsets, look=f.look), puppet.pose(f.pose))
+                if payload is not None:
+                    before.setdefault(i // per_packet, []).append(_core.appearance_chunk(payload))
+    return [c for k, p in enumerate(packets) for c in before.get(k, []) + [p]], sender
+
+
 def encode_video(video: str | Path, out: str | Path, actor: str | Path | None = None, settings: Settings = Settings(),
-                 rate: float | None = None, carry_actor: bool | None = None, force: bool = False) -> EncodeResult:
+                 rate: float | None = None, carry_actor: bool | None = None, force: bool = False,
+                 appearance: float = 0.0) -> EncodeResult:
     """Analyse ``video`` and write the stream ``out`` (``.fmstream``). ``actor``: an ``.actor``
     file the receiver holds (the stream names it; default: fit one on the first frame, and the
     stream carries it). ``rate``: the motion's target, kbit/s: the finest quality that fits
     (``settings.quality`` is then ignored). ``carry_actor``: put the actor in the stream (default:
-    only when it was fitted here)."""
+    only when it was fitted here). ``appearance``: kbit/s for appearance updates (0: none)."""
     out = Path(out)
     if out.suffix.lower() != SUFFIX:
         raise InvalidInputError(f"the stream must end in {SUFFIX}, got {out.name!r}")
     if rate is not None and not (np.isfinite(rate) and rate > 0):
         raise InvalidInputError(f"the target rate must be a positive number of kbit/s, got {rate}")
+    if not (np.isfinite(appearance) and 0 <= appearance <= MAX_APPEARANCE):
+        raise InvalidInputError(f"the appearance budget must be 0-{MAX_APPEARANCE:g} kbit/s, got {appearance}")
     check_outputs([out], force, inputs=[video, actor])
     given = load_actor(actor) if actor is not None else None
     carry = given is None if carry_actor is None else carry_actor
@@ -161,10 +197,15 @@ def encode_video(video: str | Path, out: str | Path, actor: str | Path | None = 
         else:
             warnings.append(f"the coarsest quality needs {sum(map(len, packets)) * 8 / 1000 / duration:.2f} kbit/s, "
                             f"more than the {rate:g} asked for")
+    motion_bytes, updates, sent = sum(map(len, packets)), 0, 0
+    if appearance > 0:
+        chunks, sender = with_appearance(video, clip, header, actor_chunk, packets, chosen, appearance)
+        sent, updates = sum(map(len, chunks)) - motion_bytes, sender.updates
+        packets = chunks
     write_bytes(out, header + actor_chunk + b"".join(packets))
     seconds = {"analysis": clip.seconds, "coding": time.perf_counter() - t0}
-    return EncodeResult(len(clip.motion), clip.fps, chosen.quality, len(header), len(actor_chunk),
-                        sum(map(len, packets)), seconds, warnings, scene_bytes(actor_chunk))
+    return EncodeResult(len(clip.motion), clip.fps, chosen.quality, len(header), len(actor_chunk), motion_bytes,
+                        seconds, warnings, scene_bytes(actor_chunk), sent, updates)
 
 
 def scene_bytes(actor_chunk: bytes) -> int:
@@ -181,13 +222,16 @@ def scene_bytes(actor_chunk: bytes) -> int:
 
 @dataclass
 class DecodeResult:
-    """What :func:`decode_stream` did: frames written, frames concealed, and the decoder's
-    counts (see :attr:`MotionDecoder.stats`)."""
+    """What :func:`decode_stream` did: frames written, frames concealed, the decoder's counts
+    (see :attr:`MotionDecoder.stats`), and the appearance updates applied and refused (their
+    image did not decode, or lay outside the texture)."""
 
     frames: int
     concealed: int
     stats: dict[str, int]
     seconds: float
+    appearance_updates: int = 0
+    appearance_refused: int = 0
 
 
 def read_stream(path: str | Path) -> bytes:
@@ -227,12 +271,16 @@ def decode_stream(stream: str | Path, out: str | Path, actor: str | Path | None 
                     mask_only)
     w, h = info.size
     image, shown = np.empty((h, w, 3), np.uint8), np.empty((h, w, 3), np.uint8)
+    updates = Appearance(target.texture, decoder.appearance, decoder.appearance_after)
     with VideoWriter(out, info.fps) as writer:
         for f in progress(frames, len(frames), "decoding"):
+            if updates.due(f.index):
+                puppet.retexture(updates.texture)
             if not f.concealed:
                 if puppet.scene is None:
                     fill(image, BACKGROUND)
                 puppet.render(f.pose, f.offsets, (w, h), out=image, look=f.look)
                 shown[:] = image if f.face else (image * NO_FACE_DIM).astype(np.uint8)
             writer.write(shown)
-    return DecodeResult(len(frames), decoder.stats["concealed"], decoder.stats, time.perf_counter() - t0)
+    return DecodeResult(len(frames), decoder.stats["concealed"], decoder.stats, time.perf_counter() - t0,
+                        updates.applied, updates.refused)

@@ -225,6 +225,12 @@ class MotionDecoder:
     the bytes start at the stream's start (a file); False for a receiver joining a live stream.
     ``max_concealed``: for a file, refuse a stream that conceals more than this many frames per
     frame decoded, and a minute besides (a stream whose sequence numbers jump far ahead).
+
+    ``appearance`` collects the payloads of the stream's appearance chunks (updates of the
+    actor's texture, ``docs/bitstream.md``, "Appearance"), unparsed, in stream order as they are
+    read; ``appearance_after[k]`` is the number of frames the decoder had output (decoded and
+    concealed, over all calls of :meth:`push` and :meth:`finish`) before ``appearance[k]`` was
+    read, so it falls between those frames and the next.
     """
 
     def __init__(self, actor: Actor | None = None, from_start: bool = True, name: str = "the stream",
@@ -236,6 +242,9 @@ class MotionDecoder:
         self.actor: Actor | None = None
         self._last: DecodedFrame | None = None
         self._magic_seen = False
+        self.appearance: list[bytes] = []
+        self.appearance_after: list[int] = []
+        self._output = 0  # frames output so far, decoded and concealed
 
     def _read_header(self) -> None:
         h = self._core.header()
@@ -273,8 +282,17 @@ class MotionDecoder:
             raise StreamError(f"{self.name}'s basis does not fit the {knots} knots of its actor")
         self.actor = actor
 
+    def _collect(self, decoded: tuple) -> tuple:
+        """Takes the appearance payloads out of what the core decoded, noting where they fall."""
+        index, concealed, updates = decoded[0], decoded[4], decoded[5]
+        for before, payload in updates:
+            self.appearance.append(bytes(payload))
+            self.appearance_after.append(self._output + int(before))
+        self._output += len(index) + int(concealed[:, 1].sum())
+        return decoded
+
     def _frames(self, decoded: tuple) -> list[DecodedFrame]:
-        index, face, lost, values, concealed = decoded
+        index, face, lost, values, concealed, _ = decoded
         stats = self._core.stats()
         if (self._max_concealed is not None and self.info is not None
                 and stats["concealed"] > self._max_concealed * stats["frames"] + 60 * self.info.fps):
@@ -317,14 +335,14 @@ class MotionDecoder:
     def push(self, data: bytes) -> list[DecodedFrame]:
         """Reads ``data``; returns the frames it completed, in order (concealed ones included)."""
         self._magic_seen = self._magic_seen or b"FMST" in data
-        decoded = self._core.push(bytes(data))
+        decoded = self._collect(self._core.push(bytes(data)))
         self._read_header()
         self._resolve_actor()
         return self._frames(decoded)
 
     def finish(self) -> list[DecodedFrame]:
         """Reads the end of the stream; raises :class:`StreamError` when nothing was decodable."""
-        decoded = self._core.finish()
+        decoded = self._collect(self._core.finish())
         self._read_header()
         if self.info is None:
             reason = self._core.header_error()
@@ -340,6 +358,6 @@ class MotionDecoder:
 
     @property
     def stats(self) -> dict[str, int]:
-        """What the decoder met: packets, lost_packets, late_packets, undecodable, damaged_runs,
-        damaged_bytes, frames, concealed."""
+        """What the decoder met: packets, lost_packets, late_packets, undecodable, appearance
+        (appearance updates collected), damaged_runs, damaged_bytes, frames, concealed."""
         return self._core.stats()

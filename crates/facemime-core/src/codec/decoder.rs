@@ -10,7 +10,8 @@ use super::packet::{self, State, FACE};
 /// A jump of more packets than this is taken as a new start, not concealed frame by frame.
 pub const MAX_GAP_PACKETS: u64 = 256;
 
-/// What the decoder outputs, in frame order.
+/// What the decoder outputs, in stream order: frames in frame order, and each appearance
+/// update where its chunk was read (before the frames of the packets that follow it).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Output {
     /// A decoded frame: its index from the stream's start, flags and parameter values.
@@ -23,6 +24,10 @@ pub enum Output {
     /// `count` frames from `first` that could not be decoded (lost, damaged, or after a loss
     /// before the next intra packet): show the last good frame for them.
     Concealed { first: u64, count: u64 },
+    /// An appearance chunk's payload (`docs/bitstream.md`, "Appearance"), not parsed: `u32`
+    /// first frame, `u16` x, `u16` y, then a WebP image. At least
+    /// [`chunk::APPEARANCE_PREFIX`] bytes.
+    Appearance(Vec<u8>),
 }
 
 /// What the decoder met.
@@ -34,8 +39,11 @@ pub struct Stats {
     pub lost_packets: u64,
     /// Packets that came after a later one (reordered or repeated), dropped.
     pub late_packets: u64,
-    /// Good chunks whose payload did not decode (and packets before any header).
+    /// Good chunks whose payload did not decode (and packets and appearance updates before any
+    /// header).
     pub undecodable: u64,
+    /// Appearance updates output.
+    pub appearance: u64,
     /// Runs of bytes in which no chunk was found (damage), and their bytes.
     pub damaged_runs: u64,
     pub damaged_bytes: u64,
@@ -92,7 +100,8 @@ impl Decoder {
         self.actor.as_deref()
     }
 
-    /// Reads `bytes` (appended to what is buffered) and returns the frames they completed.
+    /// Reads `bytes` (appended to what is buffered) and returns the frames they completed and
+    /// the appearance updates they held, in stream order.
     pub fn push(&mut self, bytes: &[u8]) -> Vec<Output> {
         self.buf.extend_from_slice(bytes);
         self.drain(false)
@@ -142,7 +151,20 @@ impl Decoder {
             },
             Kind::Actor => self.actor = Some(c.payload),
             Kind::Intra | Kind::Inter => self.packet(c, out),
+            Kind::Appearance => self.appearance(c.payload, out),
         }
+    }
+
+    /// Passes an appearance update on as it is; it touches no coding state, sequence number or
+    /// concealment. One before any header, or too short to hold its frame and place, is
+    /// undecodable.
+    fn appearance(&mut self, payload: Vec<u8>, out: &mut Vec<Output>) {
+        if self.header.is_none() || payload.len() < chunk::APPEARANCE_PREFIX {
+            self.stats.undecodable += 1;
+            return;
+        }
+        self.stats.appearance += 1;
+        out.push(Output::Appearance(payload));
     }
 
     fn packet(&mut self, c: Chunk, out: &mut Vec<Output>) {

@@ -3,7 +3,8 @@
 //! are quantised, predicted from the previous decoded frame, and range coded with adaptive
 //! integer models (the coder is the `constriction` crate's range coder on 16-bit words); frames
 //! travel in packets framed with a length, a sequence number and a CRC-32, with an intra packet
-//! every so often.
+//! every so often. From version 2 on, appearance chunks carry updates of the actor's texture,
+//! passed on to the receiver as they are.
 
 pub mod chunk;
 pub mod decoder;

@@ -1,0 +1,210 @@
+"""Appearance updates: the actor's texture sent again, a rectangle at a time, where the face has
+come to look different from it (light, skin, wrinkles), under a bit budget
+(``docs/bitstream.md``, "Appearance").
+
+An update is a payload of an appearance chunk: ``u32`` F, the first frame drawn with it; ``u16``
+X, ``u16`` Y, where its top-left texel goes in the texture; then a WebP image, pasted there with
+its edges blended over :data:`BLEND` texels (:func:`paste`).
+
+The sender (:class:`AppearanceSender`) looks every :data:`CHECK` frames: the real frame is laid
+back onto the texture through the geometry the receiver draws (each triangle facing the camera
+drawn from the frame into texture space), and the blocks of :data:`BLOCK` texels it covers whole
+are compared with the receiver's texture (mean absolute grey difference). The eyes are left out
+(their look moves them). The rectangle around the blocks that differ by more than
+:data:`THRESHOLD` levels is sent when the bits saved for it allow (a bucket filled at the budget,
+holding at most :data:`WINDOW` seconds of it); otherwise the rectangle around the worst half of
+them is tried, and so on. Texture pixels: (x, y), (0, 0) the centre of the top-left texel.
+"""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from facemime.model.head import HeadModel
+from facemime.render.projection import Pose, project, rotation_matrix
+from facemime.render.texture_map import render_mesh_into
+from facemime.track.eyes import EYES
+
+#: Texels over which an update's edges fade into the texture (the spec's B).
+BLEND = 8
+#: Frames between two looks at the face, texels per side of a compared block, the mean grey
+#: difference (levels) above which a block is sent again, seconds of budget the bucket holds,
+#: WebP quality of an update, and halvings of the block set tried before giving up for now.
+CHECK = 5
+BLOCK = 16
+THRESHOLD = 8.0
+WINDOW = 4.0
+QUALITY = 40
+TRIES = 4
+#: A triangle is laid back onto the texture only when it faces the camera this much (its
+#: normal's z, unit length): a triangle seen edge-on smears few pixels over many texels.
+FACING = 0.3
+HEAD = struct.Struct("<IHH")
+
+
+@dataclass(frozen=True)
+class Update:
+    """One appearance update: from ``frame`` on, ``image`` (H, W, 3) uint8 RGB goes at texel
+    (``x``, ``y``) of the texture."""
+
+    frame: int
+    x: int
+    y: int
+    image: np.ndarray
+
+    def payload(self, quality: int = QUALITY) -> bytes:
+        """The chunk's payload (the image as lossy WebP at ``quality``)."""
+        ok, data = cv2.imencode(".webp", cv2.cvtColor(self.image, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_WEBP_QUALITY, quality])
+        if not ok:
+            raise ValueError("WebP encoding failed")
+        return HEAD.pack(self.frame, self.x, self.y) + data.tobytes()
+
+
+def parse(payload: bytes) -> Update | None:
+    """The update in an appearance chunk's ``payload``; None when its image does not decode."""
+    if len(payload) <= HEAD.size:
+        return None
+    frame, x, y = HEAD.unpack_from(payload)
+    image = cv2.imdecode(np.frombuffer(payload, np.uint8, offset=HEAD.size), cv2.IMREAD_COLOR)
+    if image is None or image.ndim != 3 or image.shape[2] != 3:
+        return None
+    return Update(frame, x, y, cv2.cvtColor(image, cv2.COLOR_BGR2RGB))
+
+
+def paste(texture: np.ndarray, update: Update) -> bool:
+    """Paste ``update`` into ``texture`` ((H, W, 3) uint8, in place), its edges blended as the
+    spec says: a texel at distance d (texels) from the nearest edge of the update that is not on
+    or beyond the texture's border weighs k / 8, k = min(8, d + 1), and becomes
+    ``(k * u + (8 - k) * t + 4) // 8``. Returns False (texture untouched) when the update lies
+    wholly outside the texture."""
+    h, w = texture.shape[:2]
+    uh, uw = update.image.shape[:2]
+    x1, y1 = min(update.x + uw, w), min(update.y + uh, h)
+    if update.x >= w or update.y >= h:
+        return False
+    far = np.full(max(uw, uh), BLEND)
+    i, j = np.arange(uw), np.arange(uh)
+    d = np.minimum(np.minimum(j if update.y > 0 else far[:uh], uh - 1 - j if update.y + uh < h else far[:uh])[:, None],
+                   np.minimum(i if update.x > 0 else far[:uw], uw - 1 - i if update.x + uw < w else far[:uw])[None, :])
+    k = np.minimum(BLEND, d + 1)[: y1 - update.y, : x1 - update.x, None].astype(np.int32)
+    u = update.image[: y1 - update.y, : x1 - update.x].astype(np.int32)
+    t = texture[update.y:y1, update.x:x1].astype(np.int32)
+    texture[update.y:y1, update.x:x1] = ((k * u + (BLEND - k) * t + BLEND // 2) // BLEND).astype(np.uint8)
+    return True
+
+
+def lay_back(frame: np.ndarray, model_uv: np.ndarray, triangles: np.ndarray, points: np.ndarray,
+             facing: np.ndarray, size: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """``frame`` (H, W, 3) laid onto a texture of ``size`` (width, height) through the triangles
+    ``facing`` (indices into ``triangles``) whose vertices are seen at ``points`` (N, 2) px and
+    sit at ``model_uv`` (N, 2) in the texture: (texture, coverage 0..255)."""
+    w, h = size
+    out = np.zeros((h, w, 3), np.uint8)
+    cover = np.zeros((h, w), np.uint8)
+    tris = triangles[facing]
+    tex_px = model_uv * [w, h] - 0.5
+    uv = (points + 0.5) / [frame.shape[1], frame.shape[0]]
+    zero = np.zeros(len(points))
+    render_mesh_into(out, frame, uv, tex_px, zero, tris, cull=False)
+    render_mesh_into(cover, np.full((2, 2), 255, np.uint8), uv, tex_px, zero, tris, filter="nearest", cull=False)
+    return out, cover
+
+
+class AppearanceSender:
+    """Chooses appearance updates for one actor's texture (``texture``: the receiver's copy,
+    kept up to date here) at ``budget`` kbit/s for a video at ``fps`` frames/s. ``model`` is the
+    actor's head model (its ``uv`` address the texture)."""
+
+    def __init__(self, model: HeadModel, texture: np.ndarray, budget: float, fps: float):
+        self.model, self.texture = model, texture.copy()
+        self._per_frame = budget * 1000.0 / fps
+        self._cap = budget * 1000.0 * WINDOW
+        self._bits = 0.0
+        tri = np.asarray(model.triangles)
+        eye = np.zeros(len(model.vertices), bool)
+        for e in EYES:
+            eye[model.groups[e]] = True
+        self._triangles = tri[~eye[tri].all(axis=1)]  # the eye openings: the look moves them
+        v = model.vertices
+        n = np.cross(v[self._triangles[:, 1]] - v[self._triangles[:, 0]], v[self._triangles[:, 2]] - v[self._triangles[:, 0]])
+        self._normals = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
+        h, w = texture.shape[:2]
+        self._eyes = np.zeros((h, w), np.uint8)  # the eyes and a margin: never sent
+        for e in EYES:
+            ring = np.round((model.uv[model.groups[e]] * [w, h] - 0.5) * 16).astype(np.int32)
+            cv2.fillPoly(self._eyes, [ring], 255, cv2.LINE_AA, 4)
+        grow = 2 * BLEND + 1
+        self._eyes = cv2.dilate(self._eyes, np.ones((grow, grow), np.uint8))
+        self.sent_bytes = 0
+        self.updates = 0
+
+    def update(self, index: int, frame: np.ndarray, vertices: np.ndarray, pose: Pose) -> bytes | None:
+        """Look at frame ``index`` (RGB (H, W, 3) uint8), drawn by the receiver with ``vertices``
+        (N, 3) in ``pose``; returns an appearance payload to send before it, or None."""
+        self._bits = min(self._cap, self._bits + self._per_frame)
+        if index % CHECK:
+            return None
+        facing = (self._normals @ rotation_matrix(pose.yaw, pose.pitch, pose.roll).T)[:, 2] >= FACING
+        if not facing.any():
+            return None
+        points = project(vertices, pose)[0]
+        h, w = self.texture.shape[:2]
+        laid, cover = lay_back(frame, self.model.uv, self._triangles, points, facing, (w, h))
+        cover[self._eyes > 0] = 0
+        bh, bw = h // BLOCK, w // BLOCK
+        if bh == 0 or bw == 0:
+            return None
+        crop = (slice(0, bh * BLOCK), slice(0, bw * BLOCK))
+        grey = lambda t: t[crop].astype(np.float32) @ np.float32([0.299, 0.587, 0.114])  # noqa: E731
+        diff = np.abs(grey(laid) - grey(self.texture)).reshape(bh, BLOCK, bw, BLOCK).mean(axis=(1, 3))
+        whole = cover[crop].reshape(bh, BLOCK, bw, BLOCK).min(axis=(1, 3)) == 255
+        rows, cols = np.nonzero(whole & (diff > THRESHOLD))
+        if not len(rows):
+            return None
+        order = np.argsort(-diff[rows, cols])
+        rows, cols = rows[order], cols[order]
+        for _ in range(TRIES):
+            y0, y1 = rows.min() * BLOCK, (rows.max() + 1) * BLOCK
+            x0, x1 = cols.min() * BLOCK, (cols.max() + 1) * BLOCK
+            # texels the frame does not cover keep the receiver's
+            region = np.where(cover[y0:y1, x0:x1, None] == 255, laid[y0:y1, x0:x1], self.texture[y0:y1, x0:x1])
+            payload = Update(index, int(x0), int(y0), np.ascontiguousarray(region)).payload()
+            if 8 * len(payload) <= self._bits:
+                self._bits -= 8 * len(payload)
+                paste(self.texture, parse(payload))
+                self.sent_bytes += len(payload)
+                self.updates += 1
+                return payload
+            keep = max(1, len(rows) // 2)
+            rows, cols = rows[:keep], cols[:keep]
+        return None
+
+
+class Appearance:
+    """The receiver's side: the actor's ``texture`` as the stream's appearance updates change it,
+    frame by frame. ``payloads``: the appearance chunks' payloads in stream order; ``after``: for
+    each, how many frames the decoder had output before it (an update applies from its frame F,
+    or from the first frame output after it when it comes late)."""
+
+    def __init__(self, texture: np.ndarray, payloads: list[bytes], after: list[int]):
+        self.texture = texture.copy()
+        parsed = [(parse(p), a) for p, a in zip(payloads, after)]
+        self.refused = sum(u is None for u, _ in parsed)
+        self._pending = [(max(u.frame, a), u) for u, a in parsed if u is not None]
+        self.applied = 0
+
+    def due(self, frame: int) -> bool:
+        """Apply, in stream order, the updates that apply from ``frame`` or before; returns
+        whether :attr:`texture` changed."""
+        changed = False
+        while self._pending and self._pending[0][0] <= frame:
+            if paste(self.texture, self._pending.pop(0)[1]):
+                self.applied += 1
+                changed = True
+            else:
+                self.refused += 1
+        return changed
