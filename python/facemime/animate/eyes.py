@@ -22,6 +22,8 @@ from facemime.track.eyes import EYES, LID_EDGE, SPAN_U, SPAN_V, EyeFrame, find_i
 #: The ring positions of the upper-lid vertices and of the lower-lid vertices below them.
 UPPER_LID = (1, 2, 3)
 LOWER_LID = (7, 6, 5)
+#: An iris shifted less than this (texture px) is drawn as on the key frame.
+STILL = 0.25
 #: The iris pasted is this many times the measured radius (its dark rim included).
 IRIS_REACH = 1.15
 
@@ -68,25 +70,32 @@ class _Eye:
         self.disc *= inner
         hole = self.disc > 0
         inside = inner > 0.5
-        # the sclera: the brighter half of the opening's pixels beside the iris
+        # the sclera: the brightest quarter of the opening's pixels beside the iris
         beside = region[inside & ~hole].reshape(-1, 3)
         if len(beside) == 0:
             beside = region[inside].reshape(-1, 3) if inside.any() else region.reshape(-1, 3)
         grey = beside.astype(np.float64) @ (0.299, 0.587, 0.114)
-        sclera = np.median(beside[grey >= np.median(grey)], axis=0)
-        # the hole is filled from the sclera beside it, and from sclera colour at and beyond the lids
+        sclera = np.median(beside[grey >= np.percentile(grey, 75)], axis=0)
+        # the hole is filled from the sclera beside it and from sclera colour at and beyond the
+        # lids, smoothed, and blended in over a few texels so that no outline shows
         source = region.copy()
         source[~inside] = np.round(sclera).astype(np.uint8)
-        self.clean = cv2.inpaint(source, cv2.dilate(hole.astype(np.uint8) * 255, np.ones((3, 3), np.uint8)),
-                                 max(2.0, self.radius / 3), cv2.INPAINT_TELEA).astype(np.float32)
-        self.clean[~hole] = region[~hole]  # the key frame as it is wherever no iris is taken from
+        fill = cv2.inpaint(source, cv2.dilate(hole.astype(np.uint8) * 255, np.ones((3, 3), np.uint8)),
+                           max(2.0, self.radius / 3), cv2.INPAINT_TELEA).astype(np.float32)
+        fill = cv2.GaussianBlur(fill, (0, 0), max(1.0, self.radius / 4))
+        blend = cv2.GaussianBlur(hole.astype(np.float32), (0, 0), max(1.0, self.radius / 8)) * self.opening
+        blend = np.maximum(blend, hole)[:, :, None]
         self.iris = region.astype(np.float32)
+        self.clean = self.iris + blend * (fill - self.iris)
 
     def paint(self, out: np.ndarray, shift: np.ndarray) -> None:
         """Paint the eye into ``out`` (the texture's working copy) with the iris shifted by
         ``shift`` (u, v) eye widths."""
         x0, y0, x1, y1 = self.box
         d = np.asarray(shift, np.float64) @ self.frame.axes  # texture px
+        if np.abs(d).max() < STILL:
+            out[y0:y1, x0:x1] = self.iris  # the key frame's eye as it was
+            return
         m = np.float32([[1, 0, d[0]], [0, 1, d[1]]])
         size = (x1 - x0, y1 - y0)
         iris = cv2.warpAffine(self.iris, m, size, borderMode=cv2.BORDER_REPLICATE)
