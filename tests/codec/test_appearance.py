@@ -119,7 +119,7 @@ def test_a_face_whose_cheek_reddens_is_sent_again_through_the_stream(tmp_path):
     free = np.setdiff1d(np.arange(len(actor.model.uv)), taken)
     cheek = free[np.argmin(np.linalg.norm(actor.model.uv[free] - middle, axis=1))]
     tx, ty = np.round(actor.model.uv[cheek] * [w, h]).astype(int)
-    x0, x1, y0, y1 = tx - 10, tx + 11, ty - 10, ty + 11
+    x0, x1, y0, y1 = tx - 16, tx + 17, ty - 16, ty + 17  # a patch of light, larger than the smoothing
     red = actor.texture.copy()
     red[y0:y1, x0:x1, 1:] = np.maximum(0, red[y0:y1, x0:x1, 1:].astype(int) - 60)  # redder, not brighter
     tinted = replace(actor, texture=red)

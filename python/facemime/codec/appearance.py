@@ -8,8 +8,12 @@ its edges blended over :data:`BLEND` texels (:func:`paste`).
 
 The sender (:class:`AppearanceSender`) looks every :data:`CHECK` frames: the real frame is laid
 back onto the texture through the geometry the receiver draws (each triangle facing the camera
-drawn from the frame into texture space), and the blocks of :data:`BLOCK` texels it covers whole
-are compared with the receiver's texture (mean absolute grey difference). The eyes are left out
+drawn from the frame into texture space), and only its change at low frequencies is kept (the
+receiver's texture plus the smoothed difference, :data:`SMOOTH`): where the geometry errs by a
+few texels, the frame's details land beside the texture's, and sending them made the face worse
+(lp_d3, 8 kbit/s: 23.2 dB against 23.5 without updates; smoothed, 23.7). The blocks of
+:data:`BLOCK` texels it covers whole are compared with the receiver's texture (mean absolute grey
+difference). The eyes are left out
 (their look moves them). The rectangle around the blocks that differ by more than
 :data:`THRESHOLD` levels is sent when the bits saved for it allow (a bucket filled at the budget,
 holding at most :data:`WINDOW` seconds of it); otherwise the rectangle around the worst half of
@@ -40,6 +44,8 @@ THRESHOLD = 8.0
 WINDOW = 4.0
 QUALITY = 40
 TRIES = 4
+#: The change sent is smoothed over this many texels (Gaussian sigma).
+SMOOTH = 4.0
 #: A triangle is laid back onto the texture only when it faces the camera this much (its
 #: normal's z, unit length): a triangle seen edge-on smears few pixels over many texels.
 FACING = 0.3
@@ -159,6 +165,13 @@ class AppearanceSender:
         if bh == 0 or bw == 0:
             return None
         crop = (slice(0, bh * BLOCK), slice(0, bw * BLOCK))
+        # the change at low frequencies only: where the geometry errs by a few texels the
+        # texture's details land beside themselves, but their local means stay
+        covered = (cover == 255).astype(np.float32)
+        weight = np.maximum(cv2.GaussianBlur(covered, (0, 0), SMOOTH), 1e-3)
+        change = (laid.astype(np.float32) - self.texture) * covered[:, :, None]
+        change = cv2.GaussianBlur(change, (0, 0), SMOOTH) / weight[:, :, None]
+        laid = np.clip(self.texture + change + 0.5, 0, 255).astype(np.uint8)
         grey = lambda t: t[crop].astype(np.float32) @ np.float32([0.299, 0.587, 0.114])  # noqa: E731
         diff = np.abs(grey(laid) - grey(self.texture)).reshape(bh, BLOCK, bw, BLOCK).mean(axis=(1, 3))
         whole = cover[crop].reshape(bh, BLOCK, bw, BLOCK).min(axis=(1, 3)) == 255
