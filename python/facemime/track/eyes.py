@@ -254,6 +254,10 @@ class EyeState:
         return self.opening * np.array([f.width for f in self.frames])
 
 
+#: Iris shifts are shrunk by this much (eye widths) towards none, so that an iris that does not
+#: move is drawn as on the key frame (repainting it for the measure's noise cost the eyes of
+#: still faces up to 2 dB: mt_sun 26.1 dB against 24.0).
+IRIS_STILL = 0.03
 #: An iris counts as seen when its contrast is at least this share of the key frame's.
 IRIS_SEEN = 0.4
 #: An eye closed more than this (share of its key-frame opening) shows too little iris to find:
@@ -313,6 +317,7 @@ class EyeTracker:
         it was last seen."""
         closure = 1.0 - state.opening / np.maximum(self.key.opening, 1e-6)
         shift = state.iris - state.rest
+        shift = np.sign(shift) * np.maximum(np.abs(shift) - IRIS_STILL, 0.0)  # the measure's noise: still
         seen = state.seen & (closure <= IRIS_HIDDEN)
         self._shift[seen] = shift[seen]
         return closure, self._shift.copy()
