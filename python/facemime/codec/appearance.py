@@ -50,6 +50,9 @@ SMOOTH = 4.0
 #: normal's z, unit length): a triangle seen edge-on smears few pixels over many texels.
 FACING = 0.3
 HEAD = struct.Struct("<IHH")
+#: A chunk's bytes beside its payload, at most (tag, sequence number, length, CRC-32): counted in
+#: the budget.
+FRAMING = 11
 
 
 @dataclass(frozen=True)
@@ -145,7 +148,6 @@ class AppearanceSender:
             cv2.fillPoly(self._eyes, [ring], 255, cv2.LINE_AA, 4)
         grow = 2 * BLEND + 1
         self._eyes = cv2.dilate(self._eyes, np.ones((grow, grow), np.uint8))
-        self.sent_bytes = 0
         self.updates = 0
 
     def update(self, index: int, frame: np.ndarray, vertices: np.ndarray, pose: Pose) -> bytes | None:
@@ -186,10 +188,10 @@ class AppearanceSender:
             # texels the frame does not cover keep the receiver's
             region = np.where(cover[y0:y1, x0:x1, None] == 255, laid[y0:y1, x0:x1], self.texture[y0:y1, x0:x1])
             payload = Update(index, int(x0), int(y0), np.ascontiguousarray(region)).payload()
-            if 8 * len(payload) <= self._bits:
-                self._bits -= 8 * len(payload)
+            cost = 8 * (len(payload) + FRAMING)
+            if cost <= self._bits:
+                self._bits -= cost
                 paste(self.texture, parse(payload))
-                self.sent_bytes += len(payload)
                 self.updates += 1
                 return payload
             keep = max(1, len(rows) // 2)
