@@ -34,11 +34,15 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import argparse
 import json
+import sys
 from dataclasses import replace
 from pathlib import Path
 
 import cv2
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from synthesis import ssim_map  # noqa: E402
 
 from facemime.animate.analysis import Analysis
 from facemime.animate.look import Look
@@ -62,14 +66,6 @@ VARIANTS = ("look", "none")
 
 def luma(image: np.ndarray) -> np.ndarray:
     return image.astype(np.float64) @ np.array([0.299, 0.587, 0.114])
-
-
-def ssim_map(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    c1, c2 = (0.01 * 255) ** 2, (0.03 * 255) ** 2
-    blur = lambda x: cv2.GaussianBlur(x, (11, 11), 1.5)  # noqa: E731
-    ma, mb = blur(a), blur(b)
-    va, vb, cov = blur(a * a) - ma * ma, blur(b * b) - mb * mb, blur(a * b) - ma * mb
-    return ((2 * ma * mb + c1) * (2 * cov + c2)) / ((ma * ma + mb * mb + c1) * (va + vb + c2))
 
 
 def regions(points: np.ndarray, iod: float, shape: tuple[int, int]) -> dict[str, np.ndarray]:
