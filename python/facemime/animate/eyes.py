@@ -47,10 +47,8 @@ class _Eye:
         frame = EyeFrame.of(ring_px)
         self.frame = frame
         w = frame.width
-        lo = np.floor(frame.to_image(np.array([[SPAN_U[0], SPAN_V[0]], [SPAN_U[1], SPAN_V[1]],
-                                               [SPAN_U[0], SPAN_V[1]], [SPAN_U[1], SPAN_V[0]]])).min(axis=0))
-        hi = np.ceil(frame.to_image(np.array([[SPAN_U[0], SPAN_V[0]], [SPAN_U[1], SPAN_V[1]],
-                                              [SPAN_U[0], SPAN_V[1]], [SPAN_U[1], SPAN_V[0]]])).max(axis=0))
+        corners = frame.to_image(np.array([[u, v] for u in SPAN_U for v in SPAN_V]))  # the patch's, texture px
+        lo, hi = np.floor(corners.min(axis=0)), np.ceil(corners.max(axis=0))
         x0, y0 = np.maximum(lo.astype(int), 0)
         x1, y1 = np.minimum(hi.astype(int) + 1, [texture.shape[1], texture.shape[0]])
         self.box = (x0, y0, x1, y1)

@@ -274,6 +274,10 @@ class EyeTracker:
         self._rings = [model.vertices[model.groups[e]] for e in EYES]
         frames = self._frames(key_pose)
         self._models, self._opening, self._contrast = [], np.zeros(2), np.zeros(2)
+        # the key frame's irises on the head: at the depth of the lids, they turn with it (an
+        # eye's surface bulges in front of its corners, so a turned head moves the iris across
+        # the eye by itself; the synthesis's mesh does the same)
+        self._irises = np.zeros((2, 3))
         for k, (f, r) in enumerate(zip(frames, self._rings)):
             # the lids as fitted, in the eye's frame: upper and lower, corner to corner
             uv = f.to_eye(project(r, key_pose)[0])
@@ -282,15 +286,9 @@ class EyeTracker:
             patch = f.patch(key)
             self._models.append(LidModel(profiles(patch), at(np.array(COLUMNS), upper), at(np.array(COLUMNS), lower)))
             self._opening[k] = at(0.0, lower) - at(0.0, upper)
-            self._contrast[k] = find_iris(patch)[1]
-        # the key frame's irises on the head: at the depth of the lids, they turn with it (an
-        # eye's surface bulges in front of its corners, so a turned head moves the iris across
-        # the eye by itself; the synthesis's mesh does the same)
-        self._irises = np.zeros((2, 3))
-        iris = np.array([f.to_image(find_iris(f.patch(key))[0]) for f in frames])
-        for k, r in enumerate(self._rings):
+            iris, self._contrast[k] = find_iris(patch)
             depth = r[[1, 2, 3, 5, 6, 7], 2].mean()
-            self._irises[k] = [*head_plane(iris[[k]], np.array([depth]), key_pose)[0], depth]
+            self._irises[k] = [*head_plane(f.to_image(iris)[None], np.array([depth]), key_pose)[0], depth]
         self.key = self.update(key, key_pose)
         self._shift = np.zeros((2, 2))
 
