@@ -174,6 +174,41 @@ fn a_lost_packet_is_concealed_until_the_next_intra_packet() {
 }
 
 #[test]
+fn an_intra_packet_on_request_resynchronises_a_receiver_before_the_schedule_would() {
+    let h = header(2, 10);
+    let frames = clip(58, 5);
+    let mut enc = Encoder::new(h.clone(), 0.3).unwrap();
+    let mut chunks = vec![enc.header_chunk()];
+    let mut recon = Vec::new();
+    for (t, (face, lost, v)) in frames.iter().enumerate() {
+        if t == 8 {
+            // the receiver lost packet 2 and asks: packet 4 (frames 8-9) is intra, not 10
+            enc.request_intra();
+            assert!(enc.next_is_intra());
+        }
+        let (r, packet) = enc.push(*face, *lost, v).unwrap();
+        recon.push(r);
+        chunks.extend(packet);
+    }
+    assert!(!enc.next_is_intra(), "a request is answered once");
+    let kinds: Vec<u8> = chunks[1..].iter().map(|c| c[0] >> 5).collect();
+    let intra: Vec<usize> = (0..kinds.len())
+        .filter(|&i| kinds[i] == Kind::Intra as u8)
+        .collect();
+    assert_eq!(intra, vec![0, 4, 10, 20], "the schedule goes on as before");
+    let bytes: Vec<u8> = chunks
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| *i != 3)
+        .flat_map(|(_, c)| c.clone())
+        .collect();
+    let (d, out) = decode(&bytes, true);
+    // packets 2 and 3 (4 frames) are concealed; the requested intra packet 4 resynchronises
+    assert_eq!(check(&out, &recon), (54, 4));
+    assert_eq!((d.stats.lost_packets, d.stats.concealed), (1, 4));
+}
+
+#[test]
 fn late_and_repeated_packets_are_dropped_and_a_receiver_can_join_mid_stream() {
     let h = header(4, 3);
     let (chunks, recon) = encode(&h, &clip(120, 3));

@@ -118,6 +118,11 @@ impl StreamEncoder {
     fn next_is_intra(&self) -> bool {
         self.enc.next_is_intra()
     }
+
+    /// Makes the next packet an intra packet, whatever its number.
+    fn request_intra(&mut self) {
+        self.enc.request_intra()
+    }
 }
 
 /// The actor chunk carrying `payload`.

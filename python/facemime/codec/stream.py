@@ -175,6 +175,11 @@ class MotionEncoder:
                             self.basis.offsets(recon[POSE_PARAMETERS:POSE_PARAMETERS + m]), packet or b"",
                             look_from_extras(LOOK_KINDS, coded) if self.look else Look())
 
+    def request_intra(self) -> None:
+        """Makes the next packet an intra packet, whatever its number (a live receiver that
+        joined, or lost a packet, asks for one); the regular schedule goes on as before."""
+        self._core.request_intra()
+
     def finish(self) -> bytes:
         """The last packet's bytes (empty when none is pending)."""
         return self._core.finish() or b""

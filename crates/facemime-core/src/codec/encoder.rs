@@ -112,6 +112,8 @@ pub struct Encoder {
     /// The last reconstruction with a face (what a frame without one shows).
     shown: Vec<i32>,
     packets: u64,
+    /// The next packet is intra whatever its number (a receiver asked for one).
+    forced: bool,
 }
 
 impl Encoder {
@@ -131,6 +133,7 @@ impl Encoder {
             pending: Vec::new(),
             shown,
             packets: 0,
+            forced: false,
         })
     }
 
@@ -181,16 +184,26 @@ impl Encoder {
         self.flush().map(Some)
     }
 
-    /// Whether the next packet is an intra packet.
+    /// Whether the next packet is an intra packet: every `keyframe_packets`-th, and the next
+    /// one after [`Encoder::request_intra`].
     pub fn next_is_intra(&self) -> bool {
-        self.packets
-            .is_multiple_of(self.header.keyframe_packets as u64)
+        self.forced
+            || self
+                .packets
+                .is_multiple_of(self.header.keyframe_packets as u64)
+    }
+
+    /// Makes the next packet an intra packet (a live receiver that joined or lost a packet asks
+    /// for one); the regular schedule goes on as before.
+    pub fn request_intra(&mut self) {
+        self.forced = true;
     }
 
     fn flush(&mut self) -> Result<Vec<u8>> {
         let intra = self.next_is_intra();
         if intra {
             self.state = State::new(&self.header);
+            self.forced = false;
         }
         let frames = std::mem::take(&mut self.pending);
         let payload = packet::encode(&mut self.state, &frames)?;
