@@ -1,0 +1,289 @@
+"""The sending end of ``facemime call``: frames read at their own pace (a video file at its frame
+rate, a camera as frames come), analysed live, and coded into one live stream
+(:class:`~facemime.codec.stream.MotionEncoder`) whose chunks go to a :class:`Sink` (the server's
+clients, and the recording).
+
+The basis of the knot offsets cannot be learned from the whole clip live: it is learned from the
+first :data:`WARMUP` seconds of analysed frames, which are analysed but not streamed; the stream
+(header, actor, packets) starts after them. Frame indices in the messages count the streamed
+frames from the stream's start (packet s holds frames s × P ...), as ``docs/bitstream.md`` does.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Protocol
+
+import numpy as np
+
+from facemime import _core
+from facemime.animate.analysis import Analysis, FrameMotion
+from facemime.codec.params import Basis, pose_vector
+from facemime.codec.stream import MotionEncoder, Settings
+from facemime.errors import InputFileError, InvalidInputError, NoFaceError
+from facemime.fit.actor import Actor
+from facemime.io.video import VideoReader
+
+#: Seconds of analysed frames the basis is learned from before the stream starts (not streamed).
+WARMUP = 2.0
+# The defaults below were measured on the ten shared videos with the basis from the first 2 s,
+# motion rate at P = 2 frames a packet: quality 3 mean 1.80, max 2.49 kbit/s; quality 4 mean 1.95,
+# max 2.76; quality 5 mean 2.19, max 3.15 (a keyframe of 2 s instead of 5 s changes them by ~0.03).
+# A packet of 2 frames waits one frame for its second frame: more frames a packet cost latency,
+# fewer cost framing (8 bytes a packet).
+#: The stream's quality (0-10, ``facemime.codec.stream.LADDER``).
+QUALITY = 4
+#: Frames per packet.
+PACKET_FRAMES = 2
+#: Seconds between scheduled intra packets (a receiver can also ask for one).
+KEYFRAME = 5.0
+#: Frame rate assumed for a camera that does not tell its own, frames/s.
+CAMERA_FPS = 30.0
+
+
+class Sink(Protocol):
+    """Where the sender's stream goes (the server's :class:`~facemime.call.server.Hub`)."""
+
+    def start_stream(self, header: bytes, actor: bytes) -> None:
+        """A stream starts: its header chunk and actor chunk."""
+
+    def packet(self, first: int, arrived: list[float], data: bytes) -> None:
+        """A packet chunk ``data`` holding frames ``first`` ... (their arrival, ms since the epoch)."""
+
+    def end(self, error: str | None) -> None:
+        """The source has ended (``error``: why, when it failed)."""
+
+
+class FileSource:
+    """A video file played at its own frame rate: frame i is due ``i / fps`` seconds after the
+    first was analysed; ``loop`` plays it again and again (the indices keep counting)."""
+
+    def __init__(self, path: str | Path, loop: bool = False):
+        self.path, self.loop = Path(path), loop
+        self._reader = VideoReader(self.path)
+        self.name, self.fps = self.path.name, self._reader.fps
+        self.size = (self._reader.width, self._reader.height)
+
+    def frames(self, stop: threading.Event) -> Iterator[tuple[np.ndarray, float]]:
+        """(RGB frame, arrival) for each frame when due, until ``stop`` is set. The arrival is
+        when the frame was due, ms since the epoch (a frame read late, the reader being behind,
+        arrived when due, as from a camera)."""
+        reader, i, base = self._reader, 0, None
+        while True:
+            with reader:
+                for frame in reader:
+                    late = 0.0
+                    if base is not None:
+                        wait = base + i / self.fps - time.monotonic()
+                        if wait > 0 and stop.wait(wait):
+                            return
+                        late = max(0.0, -wait)
+                    if stop.is_set():
+                        return
+                    yield frame, (time.time() - late) * 1000
+                    if base is None:  # the pace starts once the first frame (the actor's fit) is done
+                        base = time.monotonic() - 1 / self.fps
+                    i += 1
+            if not self.loop:
+                return
+            reader = VideoReader(self.path)
+            if (reader.width, reader.height) != self.size:
+                reader.close()
+                raise InputFileError(f"video {self.path} changed its frame size while playing")
+
+    def close(self) -> None:
+        self._reader.close()
+
+
+class CameraSource:
+    """A camera (OpenCV's device ``index``), its frames as they come."""
+
+    def __init__(self, index: int):
+        import cv2
+
+        self._cv2 = cv2
+        level = cv2.utils.logging.getLogLevel()
+        cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_SILENT)  # no lines of OpenCV's on a failure
+        try:
+            self._cap = cv2.VideoCapture(index)
+            ok, frame = self._cap.read() if self._cap.isOpened() else (False, None)
+        finally:
+            cv2.utils.logging.setLogLevel(level)
+        if not ok:
+            self._cap.release()
+            raise InputFileError(f"camera {index} cannot be opened (no such camera, or it is busy)")
+        self._first, self._arrived = frame, time.time() * 1000
+        self.name = f"camera {index}"
+        fps = self._cap.get(cv2.CAP_PROP_FPS)
+        self.fps = float(fps) if 1 <= fps <= 240 else CAMERA_FPS
+        self.size = (frame.shape[1], frame.shape[0])
+
+    def frames(self, stop: threading.Event) -> Iterator[tuple[np.ndarray, float]]:
+        """(RGB frame, arrival: when it was read, ms since the epoch) until ``stop`` is set."""
+        frame, arrived = self._first, self._arrived
+        while frame is not None and not stop.is_set():
+            yield self._cv2.cvtColor(frame, self._cv2.COLOR_BGR2RGB), arrived
+            ok, frame = self._cap.read()
+            arrived = time.time() * 1000
+            if not ok:
+                raise InputFileError(f"{self.name} stopped giving frames")
+
+    def close(self) -> None:
+        self._cap.release()
+
+
+def open_source(source: str, loop: bool = False) -> FileSource | CameraSource:
+    """A video file, or a camera where ``source`` is a whole number naming no file."""
+    if source.isdigit() and not Path(source).exists():
+        return CameraSource(int(source))
+    return FileSource(source, loop)
+
+
+@dataclass
+class SenderStats:
+    """What the sender did: frames analysed in the warm-up and streamed, bytes of the header,
+    actor and packets, intra requests (asked, honoured), and per packet the seconds from its
+    first and last frame's arrival to its hand-over to the clients."""
+
+    warmup_frames: int = 0
+    frames: int = 0
+    header_bytes: int = 0
+    actor_bytes: int = 0
+    packet_bytes: int = 0
+    packets: int = 0
+    intra_asked: int = 0
+    intra_honoured: int = 0
+    delays: list[tuple[float, float]] = field(default_factory=list)
+
+    def motion_kbit_s(self, fps: float) -> float:
+        """The packets' rate over the streamed frames, kbit/s."""
+        return self.packet_bytes * 8 / 1000 / (self.frames / fps) if self.frames else 0.0
+
+
+class Sender(threading.Thread):
+    """Reads, analyses and codes a source's frames into ``sink`` until the source ends or
+    :meth:`stop` is called. The first frame is read and the actor fitted (or ``actor`` placed) in
+    the constructor, so that a source without a face fails there, in one line; :attr:`error` is
+    what stopped the thread otherwise (None: the source ended, or it was stopped)."""
+
+    def __init__(self, source: FileSource | CameraSource, sink: Sink, actor: Actor | None = None,
+                 quality: int = QUALITY, packet_frames: int = PACKET_FRAMES, keyframe: float = KEYFRAME,
+                 warmup: float = WARMUP):
+        super().__init__(name="call sender", daemon=True)
+        if not 1 <= packet_frames <= 32:
+            raise InvalidInputError(f"frames per packet must be 1-32, got {packet_frames}")
+        self.source, self.sink, self.fps = source, sink, source.fps
+        packet = packet_frames / self.fps
+        self.settings = Settings(quality=quality, packet=packet, keyframe=max(keyframe, packet))
+        self.packet_frames, self.keyframe_packets = self.settings.framing(self.fps)
+        self.warmup_frames = max(1, round(warmup * self.fps))
+        self.stats = SenderStats()
+        self.error: BaseException | None = None
+        self._stopping = threading.Event()
+        self.finished = threading.Event()  # set when the thread has ended
+        self._lock = threading.Lock()  # the intra requests' state, shared with the clients' threads
+        self._forced = False  # an intra packet was asked for and is not made yet
+        self._packets_made = 0
+        self._frames = source.frames(self._stopping)
+        first, arrived = next(self._frames, (None, 0.0))
+        if first is None:
+            raise InputFileError(f"{source.name} has no frames")
+        try:
+            self.analysis = Analysis(first, f"the first frame of {source.name}", actor=actor)
+        except NoFaceError as e:
+            raise NoFaceError(f"{e}; the video must start with a frontal face") from None
+        self.actor = actor or self.analysis.actor
+        self._warm: list[tuple[FrameMotion, float]] = [(self.analysis.last, arrived)]
+        self.encoder: MotionEncoder | None = None
+
+    def stop(self) -> None:
+        """Ask the thread to end (it does within a frame)."""
+        self._stopping.set()
+
+    def request_intra(self) -> bool:
+        """A receiver asks for an intra packet: the next packet is made one, unless it is one
+        already. Returns whether the request changed anything (it is honoured)."""
+        with self._lock:
+            self.stats.intra_asked += 1
+            if self.encoder is None or self._forced or self._packets_made % self.keyframe_packets == 0:
+                return False
+            self._forced = True
+            self.stats.intra_honoured += 1
+            return True
+
+    def run(self) -> None:
+        error = None
+        try:
+            self._run()
+        except Exception as e:  # noqa: BLE001 (told by the caller, in one line)
+            self.error, error = e, e
+        finally:
+            self._frames.close()
+            self.source.close()
+            try:
+                if error is not None or not self._stopping.is_set():  # the source has ended, or failed
+                    self.sink.end(None if error is None else str(error))
+            finally:
+                self.finished.set()
+
+    def _run(self) -> None:
+        for frame, arrived in self._frames:
+            motion = self.analysis.update(frame)
+            if self.encoder is None:
+                self._warm.append((motion, arrived))
+                if len(self._warm) >= self.warmup_frames:
+                    self._start()
+            else:
+                self._push(motion, arrived)
+        if self.encoder is None:  # the source ended within the warm-up: a stream of no frames
+            self._start()
+        if not self._stopping.is_set():
+            self._send(self.encoder.finish())
+
+    def _start(self) -> None:
+        """The warm-up is over: learn the basis and the tables' classes, start the stream."""
+        faces = [m for m, _ in self._warm if m.face]
+        m = self.settings.basis_size
+        basis = Basis.learn(np.array([f.offsets for f in faces]).reshape(len(faces), -1, 2), m)
+        steps = self.settings.steps(len(basis.raw), True)
+        values = np.array([np.concatenate([pose_vector(f.pose), basis.coefficients(f.offsets), f.look.vector()])
+                           for f in faces])
+        classes = _core.choose_classes(steps, self.settings.hysteresis, values.reshape(len(faces), len(steps)))
+        encoder = MotionEncoder(self.actor, self.fps, self.source.size, basis, self.settings, True, classes,
+                                reference=self._warm[0][0].pose, look=True)
+        start = encoder.start()
+        header = encoder.header
+        self.stats.warmup_frames, self.stats.header_bytes = len(self._warm), len(header)
+        self.stats.actor_bytes = len(start) - len(header)
+        self._pending: list[float] = []  # arrival times of the frames of the packet being filled
+        with self._lock:
+            self.encoder = encoder
+        self.sink.start_stream(header, start[len(header):])
+
+    def _push(self, motion: FrameMotion, arrived: float) -> None:
+        with self._lock:
+            if self._forced:
+                self.encoder.request_intra()
+        self._pending.append(arrived)
+        self._send(self.encoder.push(motion.face, motion.lost, motion.pose, motion.offsets, motion.look).data)
+
+    def _send(self, data: bytes) -> None:
+        if not data:
+            return
+        frames = (data[0] & 31) + 1
+        arrived, self._pending = self._pending[:frames], self._pending[frames:]
+        first = self.stats.frames
+        self.stats.frames += frames
+        self.stats.packets += 1
+        self.stats.packet_bytes += len(data)
+        with self._lock:
+            self._packets_made += 1
+            if data[0] >> 5 == 3:
+                self._forced = False
+        now = time.time() * 1000
+        self.stats.delays.append(((now - arrived[0]) / 1000, (now - arrived[-1]) / 1000))
+        self.sink.packet(first, arrived, data)
