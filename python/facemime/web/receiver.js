@@ -1,0 +1,2930 @@
+"use strict";
+(() => {
+  // node_modules/fflate/esm/browser.js
+  var u8 = Uint8Array;
+  var u16 = Uint16Array;
+  var i32 = Int32Array;
+  var fleb = new u8([
+    0,
+    0,
+    0,
+    0,
+    0,
+    0,
+    0,
+    0,
+    1,
+    1,
+    1,
+    1,
+    2,
+    2,
+    2,
+    2,
+    3,
+    3,
+    3,
+    3,
+    4,
+    4,
+    4,
+    4,
+    5,
+    5,
+    5,
+    5,
+    0,
+    /* unused */
+    0,
+    0,
+    /* impossible */
+    0
+  ]);
+  var fdeb = new u8([
+    0,
+    0,
+    0,
+    0,
+    1,
+    1,
+    2,
+    2,
+    3,
+    3,
+    4,
+    4,
+    5,
+    5,
+    6,
+    6,
+    7,
+    7,
+    8,
+    8,
+    9,
+    9,
+    10,
+    10,
+    11,
+    11,
+    12,
+    12,
+    13,
+    13,
+    /* unused */
+    0,
+    0
+  ]);
+  var clim = new u8([16, 17, 18, 0, 8, 7, 9, 6, 10, 5, 11, 4, 12, 3, 13, 2, 14, 1, 15]);
+  var freb = function(eb2, start) {
+    var b = new u16(31);
+    for (var i2 = 0; i2 < 31; ++i2) {
+      b[i2] = start += 1 << eb2[i2 - 1];
+    }
+    var r = new i32(b[30]);
+    for (var i2 = 1; i2 < 30; ++i2) {
+      for (var j = b[i2]; j < b[i2 + 1]; ++j) {
+        r[j] = j - b[i2] << 5 | i2;
+      }
+    }
+    return { b, r };
+  };
+  var _a = freb(fleb, 2);
+  var fl = _a.b;
+  var revfl = _a.r;
+  fl[28] = 258, revfl[258] = 28;
+  var _b = freb(fdeb, 0);
+  var fd = _b.b;
+  var revfd = _b.r;
+  var rev = new u16(32768);
+  for (i = 0; i < 32768; ++i) {
+    x = (i & 43690) >> 1 | (i & 21845) << 1;
+    x = (x & 52428) >> 2 | (x & 13107) << 2;
+    x = (x & 61680) >> 4 | (x & 3855) << 4;
+    rev[i] = ((x & 65280) >> 8 | (x & 255) << 8) >> 1;
+  }
+  var x;
+  var i;
+  var hMap = (function(cd2, mb, r) {
+    var s = cd2.length;
+    var i2 = 0;
+    var l = new u16(mb);
+    for (; i2 < s; ++i2) {
+      if (cd2[i2])
+        ++l[cd2[i2] - 1];
+    }
+    var le = new u16(mb);
+    for (i2 = 1; i2 < mb; ++i2) {
+      le[i2] = le[i2 - 1] + l[i2 - 1] << 1;
+    }
+    var co;
+    if (r) {
+      co = new u16(1 << mb);
+      var rvb = 15 - mb;
+      for (i2 = 0; i2 < s; ++i2) {
+        if (cd2[i2]) {
+          var sv = i2 << 4 | cd2[i2];
+          var r_1 = mb - cd2[i2];
+          var v2 = le[cd2[i2] - 1]++ << r_1;
+          for (var m = v2 | (1 << r_1) - 1; v2 <= m; ++v2) {
+            co[rev[v2] >> rvb] = sv;
+          }
+        }
+      }
+    } else {
+      co = new u16(s);
+      for (i2 = 0; i2 < s; ++i2) {
+        if (cd2[i2]) {
+          co[i2] = rev[le[cd2[i2] - 1]++] >> 15 - cd2[i2];
+        }
+      }
+    }
+    return co;
+  });
+  var flt = new u8(288);
+  for (i = 0; i < 144; ++i)
+    flt[i] = 8;
+  var i;
+  for (i = 144; i < 256; ++i)
+    flt[i] = 9;
+  var i;
+  for (i = 256; i < 280; ++i)
+    flt[i] = 7;
+  var i;
+  for (i = 280; i < 288; ++i)
+    flt[i] = 8;
+  var i;
+  var fdt = new u8(32);
+  for (i = 0; i < 32; ++i)
+    fdt[i] = 5;
+  var i;
+  var flrm = /* @__PURE__ */ hMap(flt, 9, 1);
+  var fdrm = /* @__PURE__ */ hMap(fdt, 5, 1);
+  var max = function(a) {
+    var m = a[0];
+    for (var i2 = 1; i2 < a.length; ++i2) {
+      if (a[i2] > m)
+        m = a[i2];
+    }
+    return m;
+  };
+  var bits = function(d, p, m) {
+    var o = p / 8 | 0;
+    return (d[o] | d[o + 1] << 8) >> (p & 7) & m;
+  };
+  var bits16 = function(d, p) {
+    var o = p / 8 | 0;
+    return (d[o] | d[o + 1] << 8 | d[o + 2] << 16) >> (p & 7);
+  };
+  var shft = function(p) {
+    return (p + 7) / 8 | 0;
+  };
+  var slc = function(v2, s, e) {
+    if (s == null || s < 0)
+      s = 0;
+    if (e == null || e > v2.length)
+      e = v2.length;
+    return new u8(v2.subarray(s, e));
+  };
+  var ec = [
+    "unexpected EOF",
+    "invalid block type",
+    "invalid length/literal",
+    "invalid distance",
+    "stream finished",
+    "no stream handler",
+    ,
+    // determined by compression function
+    "no callback",
+    "invalid UTF-8 data",
+    "extra field too long",
+    "date not in range 1980-2099",
+    "filename too long",
+    "stream finishing",
+    "invalid zip data"
+    // determined by unknown compression method
+  ];
+  var err = function(ind, msg, nt) {
+    var e = new Error(msg || ec[ind]);
+    e.code = ind;
+    if (Error.captureStackTrace)
+      Error.captureStackTrace(e, err);
+    if (!nt)
+      throw e;
+    return e;
+  };
+  var inflt = function(dat, st, buf, dict) {
+    var sl = dat.length, dl = dict ? dict.length : 0;
+    if (!sl || st.f && !st.l)
+      return buf || new u8(0);
+    var noBuf = !buf;
+    var resize = noBuf || st.i != 2;
+    var noSt = st.i;
+    if (noBuf)
+      buf = new u8(sl * 3);
+    var cbuf = function(l2) {
+      var bl = buf.length;
+      if (l2 > bl) {
+        var nbuf = new u8(Math.max(bl * 2, l2));
+        nbuf.set(buf);
+        buf = nbuf;
+      }
+    };
+    var final = st.f || 0, pos = st.p || 0, bt = st.b || 0, lm = st.l, dm = st.d, lbt = st.m, dbt = st.n;
+    var tbts = sl * 8;
+    do {
+      if (!lm) {
+        final = bits(dat, pos, 1);
+        var type = bits(dat, pos + 1, 3);
+        pos += 3;
+        if (!type) {
+          var s = shft(pos) + 4, l = dat[s - 4] | dat[s - 3] << 8, t = s + l;
+          if (t > sl) {
+            if (noSt)
+              err(0);
+            break;
+          }
+          if (resize)
+            cbuf(bt + l);
+          buf.set(dat.subarray(s, t), bt);
+          st.b = bt += l, st.p = pos = t * 8, st.f = final;
+          continue;
+        } else if (type == 1)
+          lm = flrm, dm = fdrm, lbt = 9, dbt = 5;
+        else if (type == 2) {
+          var hLit = bits(dat, pos, 31) + 257, hcLen = bits(dat, pos + 10, 15) + 4;
+          var tl = hLit + bits(dat, pos + 5, 31) + 1;
+          pos += 14;
+          var ldt = new u8(tl);
+          var clt = new u8(19);
+          for (var i2 = 0; i2 < hcLen; ++i2) {
+            clt[clim[i2]] = bits(dat, pos + i2 * 3, 7);
+          }
+          pos += hcLen * 3;
+          var clb = max(clt), clbmsk = (1 << clb) - 1;
+          var clm = hMap(clt, clb, 1);
+          for (var i2 = 0; i2 < tl; ) {
+            var r = clm[bits(dat, pos, clbmsk)];
+            pos += r & 15;
+            var s = r >> 4;
+            if (s < 16) {
+              ldt[i2++] = s;
+            } else {
+              var c = 0, n = 0;
+              if (s == 16)
+                n = 3 + bits(dat, pos, 3), pos += 2, c = ldt[i2 - 1];
+              else if (s == 17)
+                n = 3 + bits(dat, pos, 7), pos += 3;
+              else if (s == 18)
+                n = 11 + bits(dat, pos, 127), pos += 7;
+              while (n--)
+                ldt[i2++] = c;
+            }
+          }
+          var lt = ldt.subarray(0, hLit), dt = ldt.subarray(hLit);
+          lbt = max(lt);
+          dbt = max(dt);
+          lm = hMap(lt, lbt, 1);
+          dm = hMap(dt, dbt, 1);
+        } else
+          err(1);
+        if (pos > tbts) {
+          if (noSt)
+            err(0);
+          break;
+        }
+      }
+      if (resize)
+        cbuf(bt + 131072);
+      var lms = (1 << lbt) - 1, dms = (1 << dbt) - 1;
+      var lpos = pos;
+      for (; ; lpos = pos) {
+        var c = lm[bits16(dat, pos) & lms], sym = c >> 4;
+        pos += c & 15;
+        if (pos > tbts) {
+          if (noSt)
+            err(0);
+          break;
+        }
+        if (!c)
+          err(2);
+        if (sym < 256)
+          buf[bt++] = sym;
+        else if (sym == 256) {
+          lpos = pos, lm = null;
+          break;
+        } else {
+          var add = sym - 254;
+          if (sym > 264) {
+            var i2 = sym - 257, b = fleb[i2];
+            add = bits(dat, pos, (1 << b) - 1) + fl[i2];
+            pos += b;
+          }
+          var d = dm[bits16(dat, pos) & dms], dsym = d >> 4;
+          if (!d)
+            err(3);
+          pos += d & 15;
+          var dt = fd[dsym];
+          if (dsym > 3) {
+            var b = fdeb[dsym];
+            dt += bits16(dat, pos) & (1 << b) - 1, pos += b;
+          }
+          if (pos > tbts) {
+            if (noSt)
+              err(0);
+            break;
+          }
+          if (resize)
+            cbuf(bt + 131072);
+          var end = bt + add;
+          if (bt < dt) {
+            var shift = dl - dt, dend = Math.min(dt, end);
+            if (shift + bt < 0)
+              err(3);
+            for (; bt < dend; ++bt)
+              buf[bt] = dict[shift + bt];
+          }
+          for (; bt < end; ++bt)
+            buf[bt] = buf[bt - dt];
+        }
+      }
+      st.l = lm, st.p = lpos, st.b = bt, st.f = final;
+      if (lm)
+        final = 1, st.m = lbt, st.d = dm, st.n = dbt;
+    } while (!final);
+    return bt != buf.length && noBuf ? slc(buf, 0, bt) : buf.subarray(0, bt);
+  };
+  var et = /* @__PURE__ */ new u8(0);
+  var b2 = function(d, b) {
+    return d[b] | d[b + 1] << 8;
+  };
+  var b4 = function(d, b) {
+    return (d[b] | d[b + 1] << 8 | d[b + 2] << 16 | d[b + 3] << 24) >>> 0;
+  };
+  var b8 = function(d, b) {
+    return b4(d, b) + b4(d, b + 4) * 4294967296;
+  };
+  function inflateSync(data, opts) {
+    return inflt(data, { i: 2 }, opts && opts.out, opts && opts.dictionary);
+  }
+  var td = typeof TextDecoder != "undefined" && /* @__PURE__ */ new TextDecoder();
+  var tds = 0;
+  try {
+    td.decode(et, { stream: true });
+    tds = 1;
+  } catch (e) {
+  }
+  var dutf8 = function(d) {
+    for (var r = "", i2 = 0; ; ) {
+      var c = d[i2++];
+      var eb2 = (c > 127) + (c > 223) + (c > 239);
+      if (i2 + eb2 > d.length)
+        return { s: r, r: slc(d, i2 - 1) };
+      if (!eb2)
+        r += String.fromCharCode(c);
+      else if (eb2 == 3) {
+        c = ((c & 15) << 18 | (d[i2++] & 63) << 12 | (d[i2++] & 63) << 6 | d[i2++] & 63) - 65536, r += String.fromCharCode(55296 | c >> 10, 56320 | c & 1023);
+      } else if (eb2 & 1)
+        r += String.fromCharCode((c & 31) << 6 | d[i2++] & 63);
+      else
+        r += String.fromCharCode((c & 15) << 12 | (d[i2++] & 63) << 6 | d[i2++] & 63);
+    }
+  };
+  function strFromU8(dat, latin1) {
+    if (latin1) {
+      var r = "";
+      for (var i2 = 0; i2 < dat.length; i2 += 16384)
+        r += String.fromCharCode.apply(null, dat.subarray(i2, i2 + 16384));
+      return r;
+    } else if (td) {
+      return td.decode(dat);
+    } else {
+      var _a2 = dutf8(dat), s = _a2.s, r = _a2.r;
+      if (r.length)
+        err(8);
+      return s;
+    }
+  }
+  var slzh = function(d, b) {
+    return b + 30 + b2(d, b + 26) + b2(d, b + 28);
+  };
+  var zh = function(d, b, z) {
+    var fnl = b2(d, b + 28), efl = b2(d, b + 30), fn = strFromU8(d.subarray(b + 46, b + 46 + fnl), !(b2(d, b + 8) & 2048)), es = b + 46 + fnl;
+    var _a2 = z64hs(d, es, efl, z, b4(d, b + 20), b4(d, b + 24), b4(d, b + 42)), sc = _a2[0], su = _a2[1], off = _a2[2];
+    return [b2(d, b + 10), sc, su, fn, es + efl + b2(d, b + 32), off];
+  };
+  var z64hs = function(d, b, l, z, sc, su, off) {
+    var nsc = sc == 4294967295, nsu = su == 4294967295, noff = off == 4294967295, e = b + l;
+    var nf = nsc + nsu + noff;
+    if (z && nf) {
+      for (; b + 4 < e; b += 4 + b2(d, b + 2)) {
+        if (b2(d, b) == 1) {
+          return [
+            nsc ? b8(d, b + 4 + 8 * nsu) : sc,
+            nsu ? b8(d, b + 4) : su,
+            noff ? b8(d, b + 4 + 8 * (nsu + nsc)) : off,
+            1
+          ];
+        }
+      }
+      if (z < 2)
+        err(13);
+    }
+    return [sc, su, off, 0];
+  };
+  function unzipSync(data, opts) {
+    var files = {};
+    var e = data.length - 22;
+    for (; b4(data, e) != 101010256; --e) {
+      if (!e || data.length - e > 65558)
+        err(13);
+    }
+    ;
+    var c = b2(data, e + 8);
+    if (!c)
+      return {};
+    var o = b4(data, e + 16);
+    var z = b4(data, e - 20) == 117853008;
+    if (z) {
+      var ze = b4(data, e - 12);
+      z = b4(data, ze) == 101075792;
+      if (z) {
+        c = b4(data, ze + 32);
+        o = b4(data, ze + 48);
+      }
+    }
+    var fltr = opts && opts.filter;
+    for (var i2 = 0; i2 < c; ++i2) {
+      var _a2 = zh(data, o, z), c_2 = _a2[0], sc = _a2[1], su = _a2[2], fn = _a2[3], no = _a2[4], off = _a2[5], b = slzh(data, off);
+      o = no;
+      if (!fltr || fltr({
+        name: fn,
+        size: sc,
+        originalSize: su,
+        compression: c_2
+      })) {
+        if (!c_2)
+          files[fn] = slc(data, b, b + sc);
+        else if (c_2 == 8)
+          files[fn] = inflateSync(data.subarray(b, b + sc), { out: new u8(su) });
+        else
+          err(14, "unknown compression type " + c_2);
+      }
+    }
+    return files;
+  }
+
+  // src/render/actor.ts
+  var MAX_MEMBER = 64 << 20;
+  async function decodeImage(bytes, type) {
+    const bitmap = await createImageBitmap(
+      new Blob([bytes], { type }),
+      { colorSpaceConversion: "none", premultiplyAlpha: "none" }
+    );
+    const canvas2 = document.createElement("canvas");
+    canvas2.width = bitmap.width;
+    canvas2.height = bitmap.height;
+    const ctx = canvas2.getContext("2d", { willReadFrequently: true });
+    ctx.drawImage(bitmap, 0, 0);
+    const data = ctx.getImageData(0, 0, bitmap.width, bitmap.height).data;
+    bitmap.close();
+    return { width: canvas2.width, height: canvas2.height, rgba: new Uint8Array(data.buffer) };
+  }
+  var numbers = (a, what) => {
+    const flat = a.flat(2);
+    if (!Array.isArray(a) || flat.some((x2) => typeof x2 !== "number" || !Number.isFinite(x2))) {
+      throw new Error(`the actor's ${what} are malformed`);
+    }
+    return flat;
+  };
+  async function readActor(data) {
+    let files;
+    try {
+      files = unzipSync(data, { filter: (f) => f.originalSize <= MAX_MEMBER });
+    } catch (e) {
+      throw new Error(`the actor is not a facemime actor file (${e.message})`);
+    }
+    const text = files["actor.json"];
+    if (!text) throw new Error("the actor has no actor.json");
+    const doc = JSON.parse(new TextDecoder().decode(text));
+    if (doc?.format !== "facemime.actor/1") throw new Error(`the actor's format is ${JSON.stringify(doc?.format)}`);
+    const m = doc.model;
+    const vertices = Float64Array.from(numbers(m.vertices, "vertices"));
+    const model = {
+      vertices,
+      triangles: Uint32Array.from(numbers(m.triangles, "triangles")),
+      uv: Float64Array.from(numbers(m.uv, "texture coordinates")),
+      groups: m.groups
+    };
+    const n = vertices.length / 3;
+    if (model.uv.length !== 2 * n || model.triangles.some((i2) => i2 >= n)) throw new Error("the actor's model is inconsistent");
+    const picture = async (stem) => {
+      for (const [ext, type] of [["webp", "image/webp"], ["png", "image/png"]]) {
+        const bytes = files[`${stem}.${ext}`];
+        if (bytes) return decodeImage(bytes, type);
+      }
+      return null;
+    };
+    const texture = await picture("texture");
+    if (!texture) throw new Error("the actor has no texture");
+    const scene = doc.scene ? await picture("scene") : null;
+    return { model, pose: doc.pose, source: doc.source, texture, scene };
+  }
+
+  // src/render/appearance.ts
+  async function readUpdate(payload) {
+    if (payload.length < 8) return null;
+    const view = new DataView(payload.buffer, payload.byteOffset, payload.byteLength);
+    try {
+      const image = await decodeImage(payload.subarray(8), "image/webp");
+      return { frame: view.getUint32(0, true), x: view.getUint16(4, true), y: view.getUint16(6, true), image };
+    } catch {
+      return null;
+    }
+  }
+  function applyUpdate(texture, u4) {
+    const tw = texture.width, th = texture.height, w = u4.image.width, h = u4.image.height;
+    if (u4.x >= tw || u4.y >= th) return false;
+    const fadeLeft = u4.x > 0, fadeTop = u4.y > 0, fadeRight = u4.x + w < tw, fadeBottom = u4.y + h < th;
+    for (let j = 0; j < h && u4.y + j < th; j++) {
+      for (let i2 = 0; i2 < w && u4.x + i2 < tw; i2++) {
+        let d = Infinity;
+        if (fadeLeft) d = Math.min(d, i2);
+        if (fadeRight) d = Math.min(d, w - 1 - i2);
+        if (fadeTop) d = Math.min(d, j);
+        if (fadeBottom) d = Math.min(d, h - 1 - j);
+        const k = Math.min(8, d + 1);
+        const s = 4 * (j * w + i2), t = 4 * ((u4.y + j) * tw + u4.x + i2);
+        for (let c = 0; c < 3; c++) {
+          texture.rgba[t + c] = Math.floor((k * u4.image.rgba[s + c] + (8 - k) * texture.rgba[t + c] + 4) / 8);
+        }
+      }
+    }
+    return true;
+  }
+
+  // src/render/gl.ts
+  var VERTEX = `#version 300 es
+in vec2 position;
+in vec2 uv;
+uniform vec2 size;
+out vec2 v_uv;
+void main() {
+  vec2 c = (position + 0.5) / size * 2.0 - 1.0;
+  gl_Position = vec4(c.x, -c.y, 0.0, 1.0);
+  v_uv = uv;
+}`;
+  var FRAGMENT = `#version 300 es
+precision highp float;
+in vec2 v_uv;
+uniform sampler2D image;
+uniform vec4 tint;
+out vec4 colour;
+void main() {
+  colour = tint.a < 0.0 ? texture(image, v_uv) : tint;
+}`;
+  var Renderer = class {
+    constructor(canvas2) {
+      this.canvas = canvas2;
+      const gl = canvas2.getContext("webgl2", { antialias: false, preserveDrawingBuffer: true, premultipliedAlpha: false, alpha: false });
+      if (!gl) throw new Error("this browser has no WebGL2");
+      this.gl = gl;
+      const shader = (type, text) => {
+        const s = gl.createShader(type);
+        gl.shaderSource(s, text);
+        gl.compileShader(s);
+        if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(s) ?? "shader");
+        return s;
+      };
+      const p = gl.createProgram();
+      gl.attachShader(p, shader(gl.VERTEX_SHADER, VERTEX));
+      gl.attachShader(p, shader(gl.FRAGMENT_SHADER, FRAGMENT));
+      gl.linkProgram(p);
+      if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(p) ?? "program");
+      this.program = p;
+      this.loc = {
+        position: gl.getAttribLocation(p, "position"),
+        uv: gl.getAttribLocation(p, "uv"),
+        size: gl.getUniformLocation(p, "size"),
+        tint: gl.getUniformLocation(p, "tint")
+      };
+      this.positions = gl.createBuffer();
+      this.uvs = gl.createBuffer();
+      this.indices = gl.createBuffer();
+      const sampler = (filter) => {
+        const s = gl.createSampler();
+        gl.samplerParameteri(s, gl.TEXTURE_MIN_FILTER, filter);
+        gl.samplerParameteri(s, gl.TEXTURE_MAG_FILTER, filter);
+        gl.samplerParameteri(s, gl.TEXTURE_WRAP_S, gl.CLAMP_TO_EDGE);
+        gl.samplerParameteri(s, gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE);
+        return s;
+      };
+      this.nearest = sampler(gl.NEAREST);
+      this.linear = sampler(gl.LINEAR);
+      this.mouth = gl.createTexture();
+      gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+      gl.pixelStorei(gl.PACK_ALIGNMENT, 1);
+    }
+    /** A texture of ``picture`` (replaced in place when ``into`` is given). */
+    upload(picture, into) {
+      const gl = this.gl;
+      const texture = into?.texture ?? gl.createTexture();
+      gl.bindTexture(gl.TEXTURE_2D, texture);
+      if (into && into.width === picture.width && into.height === picture.height) {
+        gl.texSubImage2D(gl.TEXTURE_2D, 0, 0, 0, picture.width, picture.height, gl.RGBA, gl.UNSIGNED_BYTE, picture.rgba);
+      } else {
+        gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA8, picture.width, picture.height, 0, gl.RGBA, gl.UNSIGNED_BYTE, picture.rgba);
+      }
+      return { texture, width: picture.width, height: picture.height };
+    }
+    /** Starts a picture of ``width`` x ``height`` px drawn into the viewport rectangle ``view``
+     * ([x, y, w, h] of the canvas, y from the top), cleared to ``background`` (RGB 0-255). */
+    begin(width, height, background, view = [0, 0, width, height]) {
+      const gl = this.gl;
+      gl.viewport(view[0], this.canvas.height - view[1] - view[3], view[2], view[3]);
+      gl.disable(gl.SCISSOR_TEST);
+      gl.clearColor(background[0] / 255, background[1] / 255, background[2] / 255, 1);
+      gl.clear(gl.COLOR_BUFFER_BIT);
+      gl.useProgram(this.program);
+      gl.uniform2f(this.loc.size, width, height);
+    }
+    /** Draws ``triangles`` (vertex index triples) of a mesh at ``points`` (px) textured by
+     * ``layer`` at ``uv``, sampled nearest or bilinear; with ``cull``, triangles that run clockwise
+     * in the image (back-facing) are skipped. */
+    mesh(layer, points, uv, triangles, bilinear, cull) {
+      if (triangles.length === 0) return;
+      const gl = this.gl;
+      this.attributes(points, uv);
+      gl.activeTexture(gl.TEXTURE0);
+      gl.bindTexture(gl.TEXTURE_2D, layer.texture);
+      gl.bindSampler(0, bilinear ? this.linear : this.nearest);
+      gl.uniform4f(this.loc.tint, 0, 0, 0, -1);
+      gl.disable(gl.BLEND);
+      if (cull) {
+        gl.enable(gl.CULL_FACE);
+        gl.frontFace(gl.CW);
+        gl.cullFace(gl.BACK);
+      } else {
+        gl.disable(gl.CULL_FACE);
+      }
+      gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.indices);
+      gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, triangles, gl.STREAM_DRAW);
+      gl.drawElements(gl.TRIANGLES, triangles.length, gl.UNSIGNED_INT, 0);
+    }
+    /** Blends the mouth interior ``patch`` in (its alpha the opening). */
+    mouthPatch(patch) {
+      const gl = this.gl;
+      gl.bindTexture(gl.TEXTURE_2D, this.mouth);
+      gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA8, patch.width, patch.height, 0, gl.RGBA, gl.UNSIGNED_BYTE, patch.rgba);
+      const x0 = patch.x0 - 0.5, y0 = patch.y0 - 0.5, x1 = x0 + patch.width, y1 = y0 + patch.height;
+      this.quad([x0, y0, x1, y0, x1, y1, x0, y1], { texture: this.mouth, width: patch.width, height: patch.height });
+    }
+    /** Darkens the whole picture to ``factor`` of its brightness (a frame without a face). */
+    dim(factor, width, height) {
+      this.quad([-0.5, -0.5, width - 0.5, -0.5, width - 0.5, height - 0.5, -0.5, height - 0.5], null, [0, 0, 0, 1 - factor]);
+    }
+    quad(corners, layer, tint = [0, 0, 0, -1]) {
+      const gl = this.gl;
+      this.attributes(corners, [0, 0, 1, 0, 1, 1, 0, 1]);
+      gl.activeTexture(gl.TEXTURE0);
+      gl.bindTexture(gl.TEXTURE_2D, layer ? layer.texture : null);
+      gl.bindSampler(0, this.nearest);
+      gl.uniform4f(this.loc.tint, tint[0], tint[1], tint[2], tint[3]);
+      gl.enable(gl.BLEND);
+      gl.blendFunc(gl.SRC_ALPHA, gl.ONE_MINUS_SRC_ALPHA);
+      gl.disable(gl.CULL_FACE);
+      gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.indices);
+      gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, new Uint32Array([0, 1, 2, 0, 2, 3]), gl.STREAM_DRAW);
+      gl.drawElements(gl.TRIANGLES, 6, gl.UNSIGNED_INT, 0);
+      gl.disable(gl.BLEND);
+    }
+    attributes(points, uv) {
+      const gl = this.gl;
+      gl.bindBuffer(gl.ARRAY_BUFFER, this.positions);
+      gl.bufferData(gl.ARRAY_BUFFER, Float32Array.from(points), gl.STREAM_DRAW);
+      gl.enableVertexAttribArray(this.loc.position);
+      gl.vertexAttribPointer(this.loc.position, 2, gl.FLOAT, false, 0, 0);
+      gl.bindBuffer(gl.ARRAY_BUFFER, this.uvs);
+      gl.bufferData(gl.ARRAY_BUFFER, Float32Array.from(uv), gl.STREAM_DRAW);
+      gl.enableVertexAttribArray(this.loc.uv);
+      gl.vertexAttribPointer(this.loc.uv, 2, gl.FLOAT, false, 0, 0);
+    }
+    /** The canvas's pixels, RGBA row-major from the top-left. */
+    pixels() {
+      const gl = this.gl, w = this.canvas.width, h = this.canvas.height;
+      const raw = new Uint8Array(w * h * 4);
+      gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, raw);
+      const out = new Uint8Array(raw.length);
+      for (let y = 0; y < h; y++) out.set(raw.subarray((h - 1 - y) * w * 4, (h - y) * w * 4), y * w * 4);
+      return out;
+    }
+  };
+
+  // src/render/geometry.ts
+  var CONTOUR_GROUPS = [
+    "mouth_outer_upper",
+    "mouth_outer_lower",
+    "mouth_inner_upper",
+    "mouth_inner_lower",
+    "brow_left_upper",
+    "brow_left_lower",
+    "brow_right_upper",
+    "brow_right_lower"
+  ];
+  var SOFTEN = 0.02;
+  var REACH = 0.45;
+  var SEAL = 0.05;
+  var UPPER_LID = [1, 2, 3];
+  var LOWER_LID = [7, 6, 5];
+  function rotation(yaw, pitch, roll) {
+    const [y, p, r] = [yaw, pitch, roll].map((a) => a * Math.PI / 180);
+    const ry = [Math.cos(y), 0, Math.sin(y), 0, 1, 0, -Math.sin(y), 0, Math.cos(y)];
+    const rx = [1, 0, 0, 0, Math.cos(p), -Math.sin(p), 0, Math.sin(p), Math.cos(p)];
+    const rz = [Math.cos(r), -Math.sin(r), 0, Math.sin(r), Math.cos(r), 0, 0, 0, 1];
+    return mul3(rz, mul3(rx, ry));
+  }
+  function mul3(a, b) {
+    const out = new Array(9).fill(0);
+    for (let i2 = 0; i2 < 3; i2++) for (let j = 0; j < 3; j++) for (let k = 0; k < 3; k++) out[i2 * 3 + j] += a[i2 * 3 + k] * b[k * 3 + j];
+    return out;
+  }
+  function project(vertices, pose) {
+    const r = rotation(pose.yaw, pose.pitch, pose.roll);
+    const n = vertices.length / 3;
+    const points = new Float64Array(n * 2);
+    const depth = new Float64Array(n);
+    for (let i2 = 0; i2 < n; i2++) {
+      const x2 = vertices[3 * i2], y = vertices[3 * i2 + 1], z = vertices[3 * i2 + 2];
+      points[2 * i2] = pose.tx + pose.scale * (r[0] * x2 + r[1] * y + r[2] * z);
+      points[2 * i2 + 1] = pose.ty - pose.scale * (r[3] * x2 + r[4] * y + r[5] * z);
+      depth[i2] = pose.scale * (r[6] * x2 + r[7] * y + r[8] * z);
+    }
+    return { points, depth };
+  }
+  function modelIod(m) {
+    const a = m.groups.eye_right[0], b = m.groups.eye_left[4];
+    return Math.hypot(m.vertices[3 * a] - m.vertices[3 * b], m.vertices[3 * a + 1] - m.vertices[3 * b + 1]);
+  }
+  function mouthWidth(m, vertices) {
+    const g = m.groups.mouth_outer_upper;
+    const a = g[0], b = g[g.length - 1];
+    return Math.hypot(vertices[3 * b] - vertices[3 * a], vertices[3 * b + 1] - vertices[3 * a + 1]);
+  }
+  var Deformer = class {
+    constructor(model) {
+      this.model = model;
+      this.slot = /* @__PURE__ */ new Map();
+      const g = model.groups;
+      for (const name of [...CONTOUR_GROUPS, "eye_left", "eye_right"]) {
+        if (!g[name]) throw new Error(`the actor's head model lacks the group ${name}`);
+      }
+      this.knots = [...new Set(CONTOUR_GROUPS.flatMap((n) => g[n]))].sort((a, b) => a - b);
+      this.knots.forEach((v2, k) => this.slot.set(v2, k));
+      const u4 = g.mouth_inner_upper, l = g.mouth_inner_lower;
+      this.inner = [u4.slice(1, -1), l.slice(1, -1)];
+      this.weights = this.spread();
+    }
+    spread() {
+      const m = this.model, g = m.groups, v2 = m.vertices;
+      const n = v2.length / 3, k = this.knots.length;
+      const iod = modelIod(m);
+      const eyes = [...g.eye_left, ...g.eye_right];
+      const eyeY = eyes.reduce((s, i2) => s + v2[3 * i2 + 1], 0) / eyes.length;
+      const mu = g.mouth_outer_upper;
+      const mouthY = (v2[3 * mu[0] + 1] + v2[3 * mu[mu.length - 1] + 1]) / 2;
+      const slots = (names) => [...new Set(names.flatMap((x2) => g[x2]))].sort((a, b) => a - b).map((i2) => this.slot.get(i2));
+      const sets = {
+        upper: slots(["mouth_outer_upper", "mouth_inner_upper"]),
+        lower: slots(["mouth_outer_lower", "mouth_inner_lower"]),
+        brows: slots(CONTOUR_GROUPS.filter((x2) => x2.startsWith("brow")))
+      };
+      const anchorList = [];
+      for (const name of ["eye_left", "eye_right", "nose"]) if (g[name]) anchorList.push(...g[name]);
+      if (g.face_outline) anchorList.push(...g.face_outline.filter((i2) => v2[3 * i2 + 1] > mouthY));
+      const knotSet = new Set(this.knots);
+      const anchors = [...new Set(anchorList)].filter((i2) => !knotSet.has(i2)).sort((a, b) => a - b);
+      const soft2 = (SOFTEN * iod) ** 2, far = 1 / (REACH * iod) ** 2;
+      const d2 = (a, b) => (v2[3 * a] - v2[3 * b]) ** 2 + (v2[3 * a + 1] - v2[3 * b + 1]) ** 2 + (v2[3 * a + 2] - v2[3 * b + 2]) ** 2;
+      const w = new Float64Array(n * k);
+      for (let j = 0; j < n; j++) {
+        const own = this.slot.get(j);
+        if (own !== void 0) {
+          w[j * k + own] = 1;
+          continue;
+        }
+        const y = v2[3 * j + 1];
+        const chosen = y > eyeY ? sets.brows : y >= mouthY ? sets.upper : sets.lower;
+        const ws = chosen.map((s) => 1 / (d2(this.knots[s], j) + soft2));
+        let rest = far;
+        for (const a of anchors) if (a !== j) rest += 1 / (d2(a, j) + soft2);
+        const total = ws.reduce((s, x2) => s + x2, 0) + rest;
+        chosen.forEach((s, i2) => {
+          w[j * k + s] = ws[i2] / total;
+        });
+      }
+      return w;
+    }
+    /** The model's vertices moved by knot ``offsets`` (K*2, model units) times ``gain``. */
+    vertices(offsets, gain = 1) {
+      const out = Float64Array.from(this.model.vertices);
+      this.add(out, offsets, gain);
+      return out;
+    }
+    add(out, offsets, gain) {
+      const k = this.knots.length, n = out.length / 3, w = this.weights;
+      for (let j = 0; j < n; j++) {
+        let dx = 0, dy = 0;
+        for (let s = 0; s < k; s++) {
+          const c = w[j * k + s];
+          if (c !== 0) {
+            dx += c * offsets[2 * s];
+            dy += c * offsets[2 * s + 1];
+          }
+        }
+        out[3 * j] += gain * dx;
+        out[3 * j + 1] += gain * dy;
+      }
+    }
+    /** ``vertices`` with the lips shut where the inner lips lie closer than ``closed`` times the
+     * mouth's width (Deformer.sealed): a copy. */
+    sealed(vertices, closed) {
+      const [upper, lower] = this.inner;
+      const g = this.model.groups.mouth_outer_upper;
+      const c0 = g[0], c1 = g[g.length - 1];
+      const ax = vertices[3 * c1] - vertices[3 * c0], ay = vertices[3 * c1 + 1] - vertices[3 * c0 + 1];
+      const width = mouthWidth(this.model, vertices);
+      if (upper.length !== lower.length || width <= 0) return vertices;
+      const ux = -ay / width, uy = ax / width;
+      const limit = closed * width;
+      const close = new Float64Array(this.knots.length * 2);
+      upper.forEach((u4, i2) => {
+        const l = lower[i2];
+        const gap = (vertices[3 * u4] - vertices[3 * l]) * ux + (vertices[3 * u4 + 1] - vertices[3 * l + 1]) * uy;
+        const shown2 = gap < limit ? 0 : gap < 2 * limit ? 2 * (gap - limit) : gap;
+        const half = 0.5 * (gap - shown2);
+        const su = this.slot.get(u4), sl = this.slot.get(l);
+        close[2 * su] = -half * ux;
+        close[2 * su + 1] = -half * uy;
+        close[2 * sl] = half * ux;
+        close[2 * sl + 1] = half * uy;
+      });
+      const out = Float64Array.from(vertices);
+      this.add(out, close, 1);
+      return out;
+    }
+  };
+  function closeLids(m, vertices, closure) {
+    const out = Float64Array.from(vertices);
+    ["eye_right", "eye_left"].forEach((name, e) => {
+      const c = closure[e], ring = m.groups[name];
+      if (!c) return;
+      UPPER_LID.forEach((p, i2) => {
+        const up = ring[p], low = ring[LOWER_LID[i2]];
+        for (let d = 0; d < 3; d++) out[3 * up + d] = vertices[3 * up + d] + c * (vertices[3 * low + d] - vertices[3 * up + d]);
+      });
+    });
+    return out;
+  }
+  function shownPose(measured, rest, key, inScene) {
+    if (!inScene) return { ...measured };
+    const ratio = rest.scale / key.scale;
+    return {
+      yaw: rest.yaw + measured.yaw - key.yaw,
+      pitch: rest.pitch + measured.pitch - key.pitch,
+      roll: rest.roll + measured.roll - key.roll,
+      scale: rest.scale * measured.scale / key.scale,
+      tx: rest.tx + ratio * (measured.tx - key.tx),
+      ty: rest.ty + ratio * (measured.ty - key.ty)
+    };
+  }
+  function poseFromValues(v2) {
+    return { yaw: v2[0], pitch: v2[1], roll: v2[2], scale: Math.exp(v2[3]), tx: v2[4], ty: v2[5] };
+  }
+
+  // src/render/mouth.ts
+  var CAVITY = [52, 18, 22];
+  var TEETH = [185, 165, 150];
+  var GAPS = [150, 140, 128];
+  var UPPER_TEETH = 0.11;
+  var LOWER_TEETH = 0.07;
+  var TEETH_SPAN = 0.72;
+  var UPPER_SHARE = 0.6;
+  var LOWER_SHARE = 0.4;
+  var TEETH_FROM = 0.04;
+  var TEETH_SPREAD = [0.9, 1.05];
+  var UPPER_MIN = 0.5;
+  function teethUncovered(spread) {
+    return Math.min(Math.max((spread - TEETH_SPREAD[0]) / (TEETH_SPREAD[1] - TEETH_SPREAD[0]), 0), 1);
+  }
+  var css = (c) => `rgb(${c[0]},${c[1]},${c[2]})`;
+  function mouthPatch(upper, lower, uncovered, size, canvas2) {
+    const k = upper.length / 2, kl = lower.length / 2;
+    const poly = [];
+    for (let i2 = 0; i2 < k; i2++) poly.push(upper[2 * i2], upper[2 * i2 + 1]);
+    for (let i2 = kl - 1; i2 >= 0; i2--) poly.push(lower[2 * i2], lower[2 * i2 + 1]);
+    let minX = Infinity, minY = Infinity, maxX = -Infinity, maxY = -Infinity;
+    for (let i2 = 0; i2 < poly.length; i2 += 2) {
+      minX = Math.min(minX, poly[i2]);
+      maxX = Math.max(maxX, poly[i2]);
+      minY = Math.min(minY, poly[i2 + 1]);
+      maxY = Math.max(maxY, poly[i2 + 1]);
+    }
+    const x0 = Math.max(Math.floor(minX) - 1, 0), y0 = Math.max(Math.floor(minY) - 1, 0);
+    const x1 = Math.min(Math.ceil(maxX) + 2, size[0]), y1 = Math.min(Math.ceil(maxY) + 2, size[1]);
+    if (x1 - x0 < 2 || y1 - y0 < 2) return null;
+    const w = x1 - x0, h = y1 - y0;
+    canvas2.width = w;
+    canvas2.height = h;
+    const ctx = canvas2.getContext("2d", { willReadFrequently: true });
+    const path = (pts) => {
+      ctx.beginPath();
+      for (let i2 = 0; i2 < pts.length; i2 += 2) {
+        const q = fix(pts[i2], pts[i2 + 1]);
+        if (i2 === 0) ctx.moveTo(q[0], q[1]);
+        else ctx.lineTo(q[0], q[1]);
+      }
+      ctx.closePath();
+    };
+    const fix = (x2, y) => [Math.round((x2 - x0) * 16) / 16 + 0.5, Math.round((y - y0) * 16) / 16 + 0.5];
+    ctx.clearRect(0, 0, w, h);
+    ctx.fillStyle = "#fff";
+    path(poly);
+    ctx.fill();
+    const mask = ctx.getImageData(0, 0, w, h).data;
+    let any = false;
+    for (let i2 = 3; i2 < mask.length; i2 += 4) if (mask[i2]) {
+      any = true;
+      break;
+    }
+    if (!any) return null;
+    ctx.fillStyle = css(CAVITY);
+    ctx.fillRect(0, 0, w, h);
+    const ax = upper[2 * (k - 1)] - upper[0], ay = upper[2 * (k - 1) + 1] - upper[1];
+    const width = Math.hypot(ax, ay);
+    const downX = -ay / Math.max(width, 1e-9), downY = ax / Math.max(width, 1e-9);
+    const same2 = k === kl;
+    let keep = Array.from({ length: k }, (_, i2) => same2 ? Math.abs(k > 1 ? -1 + 2 * i2 / (k - 1) : -1) <= TEETH_SPAN : true);
+    if (same2 && keep.filter(Boolean).length < 2) keep = keep.map(() => true);
+    const idx = keep.flatMap((kept, i2) => kept ? [i2] : []);
+    const opening = idx.map((i2) => {
+      const o = same2 ? (lower[2 * i2] - upper[2 * i2]) * downX + (lower[2 * i2 + 1] - upper[2 * i2 + 1]) * downY : width;
+      return o * Math.min(Math.max(o / (TEETH_FROM * width) - 1, 0), 1);
+    });
+    const rows = [
+      [upper, UPPER_TEETH, UPPER_SHARE, Math.max(uncovered, UPPER_MIN), 1],
+      [lower, LOWER_TEETH, LOWER_SHARE, uncovered, -1]
+    ];
+    for (const [curve, height, share, shown2, sign] of rows) {
+      const reach = opening.map((o) => shown2 * Math.min(height * width, share * o));
+      if (Math.max(...reach) < 0.5) continue;
+      const edge = idx.flatMap((i2) => [curve[2 * i2], curve[2 * i2 + 1]]);
+      const tips = idx.flatMap((_, j) => [edge[2 * j] + sign * reach[j] * downX, edge[2 * j + 1] + sign * reach[j] * downY]);
+      const outline = [...edge];
+      for (let j = idx.length - 1; j >= 0; j--) outline.push(tips[2 * j], tips[2 * j + 1]);
+      ctx.fillStyle = css(TEETH);
+      path(outline);
+      ctx.fill();
+      ctx.strokeStyle = css(GAPS);
+      ctx.lineWidth = 1;
+      for (let j = 1; j < idx.length - 1; j++) {
+        const a = fix(edge[2 * j], edge[2 * j + 1]), b = fix(tips[2 * j], tips[2 * j + 1]);
+        ctx.beginPath();
+        ctx.moveTo(a[0], a[1]);
+        ctx.lineTo(b[0], b[1]);
+        ctx.stroke();
+      }
+    }
+    const paint = ctx.getImageData(0, 0, w, h).data;
+    const centre = (upper[0] + upper[2 * (k - 1)]) / 2, half = Math.max(width / 2, 1);
+    const rgba = new Uint8Array(w * h * 4);
+    for (let x2 = 0; x2 < w; x2++) {
+      const cx = (x0 + x2 - centre) / half;
+      const shade = Math.min(Math.max(1.15 - 0.6 * cx * cx, 0.35), 1);
+      for (let y = 0; y < h; y++) {
+        const p = 4 * (y * w + x2);
+        for (let c = 0; c < 3; c++) rgba[p + c] = Math.round(paint[p + c] * shade);
+        rgba[p + 3] = mask[p + 3];
+      }
+    }
+    return { x0, y0, width: w, height: h, rgba };
+  }
+
+  // node_modules/robust-predicates/esm/util.js
+  var epsilon = 11102230246251565e-32;
+  var splitter = 134217729;
+  var resulterrbound = (3 + 8 * epsilon) * epsilon;
+  function sum(elen, e, flen, f, h) {
+    let Q, Qnew, hh, bvirt;
+    let enow = e[0];
+    let fnow = f[0];
+    let eindex = 0;
+    let findex = 0;
+    if (fnow > enow === fnow > -enow) {
+      Q = enow;
+      enow = e[++eindex];
+    } else {
+      Q = fnow;
+      fnow = f[++findex];
+    }
+    let hindex = 0;
+    if (eindex < elen && findex < flen) {
+      if (fnow > enow === fnow > -enow) {
+        Qnew = enow + Q;
+        hh = Q - (Qnew - enow);
+        enow = e[++eindex];
+      } else {
+        Qnew = fnow + Q;
+        hh = Q - (Qnew - fnow);
+        fnow = f[++findex];
+      }
+      Q = Qnew;
+      if (hh !== 0) {
+        h[hindex++] = hh;
+      }
+      while (eindex < elen && findex < flen) {
+        if (fnow > enow === fnow > -enow) {
+          Qnew = Q + enow;
+          bvirt = Qnew - Q;
+          hh = Q - (Qnew - bvirt) + (enow - bvirt);
+          enow = e[++eindex];
+        } else {
+          Qnew = Q + fnow;
+          bvirt = Qnew - Q;
+          hh = Q - (Qnew - bvirt) + (fnow - bvirt);
+          fnow = f[++findex];
+        }
+        Q = Qnew;
+        if (hh !== 0) {
+          h[hindex++] = hh;
+        }
+      }
+    }
+    while (eindex < elen) {
+      Qnew = Q + enow;
+      bvirt = Qnew - Q;
+      hh = Q - (Qnew - bvirt) + (enow - bvirt);
+      enow = e[++eindex];
+      Q = Qnew;
+      if (hh !== 0) {
+        h[hindex++] = hh;
+      }
+    }
+    while (findex < flen) {
+      Qnew = Q + fnow;
+      bvirt = Qnew - Q;
+      hh = Q - (Qnew - bvirt) + (fnow - bvirt);
+      fnow = f[++findex];
+      Q = Qnew;
+      if (hh !== 0) {
+        h[hindex++] = hh;
+      }
+    }
+    if (Q !== 0 || hindex === 0) {
+      h[hindex++] = Q;
+    }
+    return hindex;
+  }
+  function estimate(elen, e) {
+    let Q = e[0];
+    for (let i2 = 1; i2 < elen; i2++) Q += e[i2];
+    return Q;
+  }
+  function vec(n) {
+    return new Float64Array(n);
+  }
+
+  // node_modules/robust-predicates/esm/orient2d.js
+  var ccwerrboundA = (3 + 16 * epsilon) * epsilon;
+  var ccwerrboundB = (2 + 12 * epsilon) * epsilon;
+  var ccwerrboundC = (9 + 64 * epsilon) * epsilon * epsilon;
+  var B = vec(4);
+  var C1 = vec(8);
+  var C2 = vec(12);
+  var D = vec(16);
+  var u = vec(4);
+  function orient2dadapt(ax, ay, bx, by, cx, cy, detsum) {
+    let acxtail, acytail, bcxtail, bcytail;
+    let bvirt, c, ahi, alo, bhi, blo, _i, _j, _0, s1, s0, t1, t0, u32;
+    const acx = ax - cx;
+    const bcx = bx - cx;
+    const acy = ay - cy;
+    const bcy = by - cy;
+    s1 = acx * bcy;
+    c = splitter * acx;
+    ahi = c - (c - acx);
+    alo = acx - ahi;
+    c = splitter * bcy;
+    bhi = c - (c - bcy);
+    blo = bcy - bhi;
+    s0 = alo * blo - (s1 - ahi * bhi - alo * bhi - ahi * blo);
+    t1 = acy * bcx;
+    c = splitter * acy;
+    ahi = c - (c - acy);
+    alo = acy - ahi;
+    c = splitter * bcx;
+    bhi = c - (c - bcx);
+    blo = bcx - bhi;
+    t0 = alo * blo - (t1 - ahi * bhi - alo * bhi - ahi * blo);
+    _i = s0 - t0;
+    bvirt = s0 - _i;
+    B[0] = s0 - (_i + bvirt) + (bvirt - t0);
+    _j = s1 + _i;
+    bvirt = _j - s1;
+    _0 = s1 - (_j - bvirt) + (_i - bvirt);
+    _i = _0 - t1;
+    bvirt = _0 - _i;
+    B[1] = _0 - (_i + bvirt) + (bvirt - t1);
+    u32 = _j + _i;
+    bvirt = u32 - _j;
+    B[2] = _j - (u32 - bvirt) + (_i - bvirt);
+    B[3] = u32;
+    let det = estimate(4, B);
+    let errbound = ccwerrboundB * detsum;
+    if (det >= errbound || -det >= errbound) {
+      return det;
+    }
+    bvirt = ax - acx;
+    acxtail = ax - (acx + bvirt) + (bvirt - cx);
+    bvirt = bx - bcx;
+    bcxtail = bx - (bcx + bvirt) + (bvirt - cx);
+    bvirt = ay - acy;
+    acytail = ay - (acy + bvirt) + (bvirt - cy);
+    bvirt = by - bcy;
+    bcytail = by - (bcy + bvirt) + (bvirt - cy);
+    if (acxtail === 0 && acytail === 0 && bcxtail === 0 && bcytail === 0) {
+      return det;
+    }
+    errbound = ccwerrboundC * detsum + resulterrbound * Math.abs(det);
+    det += acx * bcytail + bcy * acxtail - (acy * bcxtail + bcx * acytail);
+    if (det >= errbound || -det >= errbound) return det;
+    s1 = acxtail * bcy;
+    c = splitter * acxtail;
+    ahi = c - (c - acxtail);
+    alo = acxtail - ahi;
+    c = splitter * bcy;
+    bhi = c - (c - bcy);
+    blo = bcy - bhi;
+    s0 = alo * blo - (s1 - ahi * bhi - alo * bhi - ahi * blo);
+    t1 = acytail * bcx;
+    c = splitter * acytail;
+    ahi = c - (c - acytail);
+    alo = acytail - ahi;
+    c = splitter * bcx;
+    bhi = c - (c - bcx);
+    blo = bcx - bhi;
+    t0 = alo * blo - (t1 - ahi * bhi - alo * bhi - ahi * blo);
+    _i = s0 - t0;
+    bvirt = s0 - _i;
+    u[0] = s0 - (_i + bvirt) + (bvirt - t0);
+    _j = s1 + _i;
+    bvirt = _j - s1;
+    _0 = s1 - (_j - bvirt) + (_i - bvirt);
+    _i = _0 - t1;
+    bvirt = _0 - _i;
+    u[1] = _0 - (_i + bvirt) + (bvirt - t1);
+    u32 = _j + _i;
+    bvirt = u32 - _j;
+    u[2] = _j - (u32 - bvirt) + (_i - bvirt);
+    u[3] = u32;
+    const C1len = sum(4, B, 4, u, C1);
+    s1 = acx * bcytail;
+    c = splitter * acx;
+    ahi = c - (c - acx);
+    alo = acx - ahi;
+    c = splitter * bcytail;
+    bhi = c - (c - bcytail);
+    blo = bcytail - bhi;
+    s0 = alo * blo - (s1 - ahi * bhi - alo * bhi - ahi * blo);
+    t1 = acy * bcxtail;
+    c = splitter * acy;
+    ahi = c - (c - acy);
+    alo = acy - ahi;
+    c = splitter * bcxtail;
+    bhi = c - (c - bcxtail);
+    blo = bcxtail - bhi;
+    t0 = alo * blo - (t1 - ahi * bhi - alo * bhi - ahi * blo);
+    _i = s0 - t0;
+    bvirt = s0 - _i;
+    u[0] = s0 - (_i + bvirt) + (bvirt - t0);
+    _j = s1 + _i;
+    bvirt = _j - s1;
+    _0 = s1 - (_j - bvirt) + (_i - bvirt);
+    _i = _0 - t1;
+    bvirt = _0 - _i;
+    u[1] = _0 - (_i + bvirt) + (bvirt - t1);
+    u32 = _j + _i;
+    bvirt = u32 - _j;
+    u[2] = _j - (u32 - bvirt) + (_i - bvirt);
+    u[3] = u32;
+    const C2len = sum(C1len, C1, 4, u, C2);
+    s1 = acxtail * bcytail;
+    c = splitter * acxtail;
+    ahi = c - (c - acxtail);
+    alo = acxtail - ahi;
+    c = splitter * bcytail;
+    bhi = c - (c - bcytail);
+    blo = bcytail - bhi;
+    s0 = alo * blo - (s1 - ahi * bhi - alo * bhi - ahi * blo);
+    t1 = acytail * bcxtail;
+    c = splitter * acytail;
+    ahi = c - (c - acytail);
+    alo = acytail - ahi;
+    c = splitter * bcxtail;
+    bhi = c - (c - bcxtail);
+    blo = bcxtail - bhi;
+    t0 = alo * blo - (t1 - ahi * bhi - alo * bhi - ahi * blo);
+    _i = s0 - t0;
+    bvirt = s0 - _i;
+    u[0] = s0 - (_i + bvirt) + (bvirt - t0);
+    _j = s1 + _i;
+    bvirt = _j - s1;
+    _0 = s1 - (_j - bvirt) + (_i - bvirt);
+    _i = _0 - t1;
+    bvirt = _0 - _i;
+    u[1] = _0 - (_i + bvirt) + (bvirt - t1);
+    u32 = _j + _i;
+    bvirt = u32 - _j;
+    u[2] = _j - (u32 - bvirt) + (_i - bvirt);
+    u[3] = u32;
+    const Dlen = sum(C2len, C2, 4, u, D);
+    return D[Dlen - 1];
+  }
+  function orient2d(ax, ay, bx, by, cx, cy) {
+    const detleft = (ay - cy) * (bx - cx);
+    const detright = (ax - cx) * (by - cy);
+    const det = detleft - detright;
+    const detsum = Math.abs(detleft + detright);
+    if (Math.abs(det) >= ccwerrboundA * detsum) return det;
+    return -orient2dadapt(ax, ay, bx, by, cx, cy, detsum);
+  }
+
+  // node_modules/robust-predicates/esm/orient3d.js
+  var o3derrboundA = (7 + 56 * epsilon) * epsilon;
+  var o3derrboundB = (3 + 28 * epsilon) * epsilon;
+  var o3derrboundC = (26 + 288 * epsilon) * epsilon * epsilon;
+  var bc = vec(4);
+  var ca = vec(4);
+  var ab = vec(4);
+  var at_b = vec(4);
+  var at_c = vec(4);
+  var bt_c = vec(4);
+  var bt_a = vec(4);
+  var ct_a = vec(4);
+  var ct_b = vec(4);
+  var bct = vec(8);
+  var cat = vec(8);
+  var abt = vec(8);
+  var u2 = vec(4);
+  var _8 = vec(8);
+  var _8b = vec(8);
+  var _16 = vec(16);
+  var _12 = vec(12);
+  var fin = vec(192);
+  var fin2 = vec(192);
+
+  // node_modules/robust-predicates/esm/incircle.js
+  var iccerrboundA = (10 + 96 * epsilon) * epsilon;
+  var iccerrboundB = (4 + 48 * epsilon) * epsilon;
+  var iccerrboundC = (44 + 576 * epsilon) * epsilon * epsilon;
+  var bc2 = vec(4);
+  var ca2 = vec(4);
+  var ab2 = vec(4);
+  var aa = vec(4);
+  var bb = vec(4);
+  var cc = vec(4);
+  var u3 = vec(4);
+  var v = vec(4);
+  var axtbc = vec(8);
+  var aytbc = vec(8);
+  var bxtca = vec(8);
+  var bytca = vec(8);
+  var cxtab = vec(8);
+  var cytab = vec(8);
+  var abt2 = vec(8);
+  var bct2 = vec(8);
+  var cat2 = vec(8);
+  var abtt = vec(4);
+  var bctt = vec(4);
+  var catt = vec(4);
+  var _82 = vec(8);
+  var _162 = vec(16);
+  var _16b = vec(16);
+  var _16c = vec(16);
+  var _32 = vec(32);
+  var _32b = vec(32);
+  var _48 = vec(48);
+  var _64 = vec(64);
+  var fin3 = vec(1152);
+  var fin22 = vec(1152);
+
+  // node_modules/robust-predicates/esm/insphere.js
+  var isperrboundA = (16 + 224 * epsilon) * epsilon;
+  var isperrboundB = (5 + 72 * epsilon) * epsilon;
+  var isperrboundC = (71 + 1408 * epsilon) * epsilon * epsilon;
+  var ab3 = vec(4);
+  var bc3 = vec(4);
+  var cd = vec(4);
+  var de = vec(4);
+  var ea = vec(4);
+  var ac = vec(4);
+  var bd = vec(4);
+  var ce = vec(4);
+  var da = vec(4);
+  var eb = vec(4);
+  var abc = vec(24);
+  var bcd = vec(24);
+  var cde = vec(24);
+  var dea = vec(24);
+  var eab = vec(24);
+  var abd = vec(24);
+  var bce = vec(24);
+  var cda = vec(24);
+  var deb = vec(24);
+  var eac = vec(24);
+  var adet = vec(1152);
+  var bdet = vec(1152);
+  var cdet = vec(1152);
+  var ddet = vec(1152);
+  var edet = vec(1152);
+  var abdet = vec(2304);
+  var cddet = vec(2304);
+  var cdedet = vec(3456);
+  var deter = vec(5760);
+  var _83 = vec(8);
+  var _8b2 = vec(8);
+  var _8c = vec(8);
+  var _163 = vec(16);
+  var _24 = vec(24);
+  var _482 = vec(48);
+  var _48b = vec(48);
+  var _96 = vec(96);
+  var _192 = vec(192);
+  var _384x = vec(384);
+  var _384y = vec(384);
+  var _384z = vec(384);
+  var _768 = vec(768);
+  var xdet = vec(96);
+  var ydet = vec(96);
+  var zdet = vec(96);
+  var fin4 = vec(1152);
+
+  // node_modules/delaunator/index.js
+  var EPSILON = Math.pow(2, -52);
+  var EDGE_STACK = new Uint32Array(512);
+  var Delaunator = class _Delaunator {
+    /**
+     * Constructs a delaunay triangulation object given an array of points (`[x, y]` by default).
+     * `getX` and `getY` are optional functions of the form `(point) => value` for custom point formats.
+     *
+     * @template P
+     * @param {P[]} points
+     * @param {(p: P) => number} [getX]
+     * @param {(p: P) => number} [getY]
+     */
+    // @ts-expect-error TS2322
+    static from(points, getX = defaultGetX, getY = defaultGetY) {
+      const n = points.length;
+      const coords = new Float64Array(n * 2);
+      for (let i2 = 0; i2 < n; i2++) {
+        const p = points[i2];
+        coords[2 * i2] = getX(p);
+        coords[2 * i2 + 1] = getY(p);
+      }
+      return new _Delaunator(coords);
+    }
+    /**
+     * Constructs a delaunay triangulation object given an array of point coordinates of the form:
+     * `[x0, y0, x1, y1, ...]` (use a typed array for best performance). Duplicate points are skipped.
+     *
+     * @param {T} coords
+     */
+    constructor(coords) {
+      const n = coords.length >> 1;
+      if (n > 0 && typeof coords[0] !== "number") throw new Error("Expected coords to contain numbers.");
+      this.coords = coords;
+      const maxTriangles = Math.max(2 * n - 5, 0);
+      this._triangles = new Uint32Array(maxTriangles * 3);
+      this._halfedges = new Int32Array(maxTriangles * 3);
+      this._hashSize = Math.ceil(Math.sqrt(n));
+      this._hullPrev = new Uint32Array(n);
+      this._hullNext = new Uint32Array(n);
+      this._hullTri = new Uint32Array(n);
+      this._hullHash = new Int32Array(this._hashSize);
+      this._ids = new Uint32Array(n);
+      this._dists = new Float64Array(n);
+      this.trianglesLen = 0;
+      this._cx = 0;
+      this._cy = 0;
+      this._hullStart = 0;
+      this.hull = this._triangles;
+      this.triangles = this._triangles;
+      this.halfedges = this._halfedges;
+      this.update();
+    }
+    /**
+     * Updates the triangulation if you modified `delaunay.coords` values in place, avoiding expensive memory allocations.
+     * Useful for iterative relaxation algorithms such as Lloyd's.
+     */
+    update() {
+      const { coords, _hullPrev: hullPrev, _hullNext: hullNext, _hullTri: hullTri, _hullHash: hullHash } = this;
+      const n = coords.length >> 1;
+      let minX = Infinity;
+      let minY = Infinity;
+      let maxX = -Infinity;
+      let maxY = -Infinity;
+      for (let i3 = 0; i3 < n; i3++) {
+        const x2 = coords[2 * i3];
+        const y = coords[2 * i3 + 1];
+        if (x2 < minX) minX = x2;
+        if (y < minY) minY = y;
+        if (x2 > maxX) maxX = x2;
+        if (y > maxY) maxY = y;
+        this._ids[i3] = i3;
+      }
+      const cx = (minX + maxX) / 2;
+      const cy = (minY + maxY) / 2;
+      let i0 = 0, i1 = 0, i2 = 0;
+      for (let i3 = 0, minDist = Infinity; i3 < n; i3++) {
+        const d = dist(cx, cy, coords[2 * i3], coords[2 * i3 + 1]);
+        if (d < minDist) {
+          i0 = i3;
+          minDist = d;
+        }
+      }
+      const i0x = coords[2 * i0];
+      const i0y = coords[2 * i0 + 1];
+      for (let i3 = 0, minDist = Infinity; i3 < n; i3++) {
+        if (i3 === i0) continue;
+        const d = dist(i0x, i0y, coords[2 * i3], coords[2 * i3 + 1]);
+        if (d < minDist && d > 0) {
+          i1 = i3;
+          minDist = d;
+        }
+      }
+      let i1x = coords[2 * i1];
+      let i1y = coords[2 * i1 + 1];
+      let minRadius = Infinity;
+      for (let i3 = 0; i3 < n; i3++) {
+        if (i3 === i0 || i3 === i1) continue;
+        const r = circumradius(i0x, i0y, i1x, i1y, coords[2 * i3], coords[2 * i3 + 1]);
+        if (r < minRadius) {
+          i2 = i3;
+          minRadius = r;
+        }
+      }
+      let i2x = coords[2 * i2];
+      let i2y = coords[2 * i2 + 1];
+      if (minRadius === Infinity) {
+        for (let i3 = 0; i3 < n; i3++) {
+          this._dists[i3] = coords[2 * i3] - coords[0] || coords[2 * i3 + 1] - coords[1];
+        }
+        quicksort(this._ids, this._dists, 0, n - 1);
+        const hull = new Uint32Array(n);
+        let j = 0;
+        for (let i3 = 0, d0 = -Infinity; i3 < n; i3++) {
+          const id = this._ids[i3];
+          const d = this._dists[id];
+          if (d > d0) {
+            hull[j++] = id;
+            d0 = d;
+          }
+        }
+        this.hull = hull.subarray(0, j);
+        this.triangles = new Uint32Array(0);
+        this.halfedges = new Int32Array(0);
+        return;
+      }
+      if (orient2d(i0x, i0y, i1x, i1y, i2x, i2y) < 0) {
+        const i3 = i1;
+        const x2 = i1x;
+        const y = i1y;
+        i1 = i2;
+        i1x = i2x;
+        i1y = i2y;
+        i2 = i3;
+        i2x = x2;
+        i2y = y;
+      }
+      const center = circumcenter(i0x, i0y, i1x, i1y, i2x, i2y);
+      this._cx = center.x;
+      this._cy = center.y;
+      for (let i3 = 0; i3 < n; i3++) {
+        this._dists[i3] = dist(coords[2 * i3], coords[2 * i3 + 1], center.x, center.y);
+      }
+      quicksort(this._ids, this._dists, 0, n - 1);
+      this._hullStart = i0;
+      let hullSize = 3;
+      hullNext[i0] = hullPrev[i2] = i1;
+      hullNext[i1] = hullPrev[i0] = i2;
+      hullNext[i2] = hullPrev[i1] = i0;
+      hullTri[i0] = 0;
+      hullTri[i1] = 1;
+      hullTri[i2] = 2;
+      hullHash.fill(-1);
+      hullHash[this._hashKey(i0x, i0y)] = i0;
+      hullHash[this._hashKey(i1x, i1y)] = i1;
+      hullHash[this._hashKey(i2x, i2y)] = i2;
+      this.trianglesLen = 0;
+      this._addTriangle(i0, i1, i2, -1, -1, -1);
+      for (let k = 0, xp = 0, yp = 0; k < this._ids.length; k++) {
+        const i3 = this._ids[k];
+        const x2 = coords[2 * i3];
+        const y = coords[2 * i3 + 1];
+        if (k > 0 && Math.abs(x2 - xp) <= EPSILON && Math.abs(y - yp) <= EPSILON) continue;
+        xp = x2;
+        yp = y;
+        if (i3 === i0 || i3 === i1 || i3 === i2) continue;
+        let start = 0;
+        for (let j = 0, key = this._hashKey(x2, y); j < this._hashSize; j++) {
+          start = hullHash[(key + j) % this._hashSize];
+          if (start !== -1 && start !== hullNext[start]) break;
+        }
+        start = hullPrev[start];
+        let e = start, q;
+        while (q = hullNext[e], orient2d(x2, y, coords[2 * e], coords[2 * e + 1], coords[2 * q], coords[2 * q + 1]) >= 0) {
+          e = q;
+          if (e === start) {
+            e = -1;
+            break;
+          }
+        }
+        if (e === -1) continue;
+        let t = this._addTriangle(e, i3, hullNext[e], -1, -1, hullTri[e]);
+        hullTri[i3] = this._legalize(t + 2);
+        hullTri[e] = t;
+        hullSize++;
+        let n2 = hullNext[e];
+        while (q = hullNext[n2], orient2d(x2, y, coords[2 * n2], coords[2 * n2 + 1], coords[2 * q], coords[2 * q + 1]) < 0) {
+          t = this._addTriangle(n2, i3, q, hullTri[i3], -1, hullTri[n2]);
+          hullTri[i3] = this._legalize(t + 2);
+          hullNext[n2] = n2;
+          hullSize--;
+          n2 = q;
+        }
+        if (e === start) {
+          while (q = hullPrev[e], orient2d(x2, y, coords[2 * q], coords[2 * q + 1], coords[2 * e], coords[2 * e + 1]) < 0) {
+            t = this._addTriangle(q, i3, e, -1, hullTri[e], hullTri[q]);
+            this._legalize(t + 2);
+            hullTri[q] = t;
+            hullNext[e] = e;
+            hullSize--;
+            e = q;
+          }
+        }
+        this._hullStart = hullPrev[i3] = e;
+        hullNext[e] = hullPrev[n2] = i3;
+        hullNext[i3] = n2;
+        hullHash[this._hashKey(x2, y)] = i3;
+        hullHash[this._hashKey(coords[2 * e], coords[2 * e + 1])] = e;
+      }
+      this.hull = new Uint32Array(hullSize);
+      for (let i3 = 0, e = this._hullStart; i3 < hullSize; i3++) {
+        this.hull[i3] = e;
+        e = hullNext[e];
+      }
+      this.triangles = this._triangles.subarray(0, this.trianglesLen);
+      this.halfedges = this._halfedges.subarray(0, this.trianglesLen);
+    }
+    /**
+     * Calculate an angle-based key for the edge hash used for advancing convex hull.
+     *
+     * @param {number} x
+     * @param {number} y
+     * @private
+     */
+    _hashKey(x2, y) {
+      return Math.floor(pseudoAngle(x2 - this._cx, y - this._cy) * this._hashSize) % this._hashSize;
+    }
+    /**
+     * Flip an edge in a pair of triangles if it doesn't satisfy the Delaunay condition.
+     *
+     * @param {number} a
+     * @private
+     */
+    _legalize(a) {
+      const { _triangles: triangles, _halfedges: halfedges, coords } = this;
+      let i2 = 0;
+      let ar = 0;
+      while (true) {
+        const b = halfedges[a];
+        const a0 = a - a % 3;
+        ar = a0 + (a + 2) % 3;
+        if (b === -1) {
+          if (i2 === 0) break;
+          a = EDGE_STACK[--i2];
+          continue;
+        }
+        const b0 = b - b % 3;
+        const al = a0 + (a + 1) % 3;
+        const bl = b0 + (b + 2) % 3;
+        const p0 = triangles[ar];
+        const pr = triangles[a];
+        const pl = triangles[al];
+        const p1 = triangles[bl];
+        const illegal = inCircle(
+          coords[2 * p0],
+          coords[2 * p0 + 1],
+          coords[2 * pr],
+          coords[2 * pr + 1],
+          coords[2 * pl],
+          coords[2 * pl + 1],
+          coords[2 * p1],
+          coords[2 * p1 + 1]
+        );
+        if (illegal) {
+          triangles[a] = p1;
+          triangles[b] = p0;
+          const hbl = halfedges[bl];
+          if (hbl === -1) {
+            let e = this._hullStart;
+            do {
+              if (this._hullTri[e] === bl) {
+                this._hullTri[e] = a;
+                break;
+              }
+              e = this._hullPrev[e];
+            } while (e !== this._hullStart);
+          }
+          this._link(a, hbl);
+          this._link(b, halfedges[ar]);
+          this._link(ar, bl);
+          const br = b0 + (b + 1) % 3;
+          if (i2 < EDGE_STACK.length) {
+            EDGE_STACK[i2++] = br;
+          }
+        } else {
+          if (i2 === 0) break;
+          a = EDGE_STACK[--i2];
+        }
+      }
+      return ar;
+    }
+    /**
+     * Link two half-edges to each other.
+     * @param {number} a
+     * @param {number} b
+     * @private
+     */
+    _link(a, b) {
+      this._halfedges[a] = b;
+      if (b !== -1) this._halfedges[b] = a;
+    }
+    /**
+     * Add a new triangle given vertex indices and adjacent half-edge ids.
+     *
+     * @param {number} i0
+     * @param {number} i1
+     * @param {number} i2
+     * @param {number} a
+     * @param {number} b
+     * @param {number} c
+     * @private
+     */
+    _addTriangle(i0, i1, i2, a, b, c) {
+      const t = this.trianglesLen;
+      this._triangles[t] = i0;
+      this._triangles[t + 1] = i1;
+      this._triangles[t + 2] = i2;
+      this._link(t, a);
+      this._link(t + 1, b);
+      this._link(t + 2, c);
+      this.trianglesLen += 3;
+      return t;
+    }
+  };
+  function pseudoAngle(dx, dy) {
+    const p = dx / (Math.abs(dx) + Math.abs(dy));
+    return (dy > 0 ? 3 - p : 1 + p) / 4;
+  }
+  function dist(ax, ay, bx, by) {
+    const dx = ax - bx;
+    const dy = ay - by;
+    return dx * dx + dy * dy;
+  }
+  function inCircle(ax, ay, bx, by, cx, cy, px, py) {
+    const dx = ax - px;
+    const dy = ay - py;
+    const ex = bx - px;
+    const ey = by - py;
+    const fx = cx - px;
+    const fy = cy - py;
+    const ap = dx * dx + dy * dy;
+    const bp = ex * ex + ey * ey;
+    const cp = fx * fx + fy * fy;
+    return dx * (ey * cp - bp * fy) - dy * (ex * cp - bp * fx) + ap * (ex * fy - ey * fx) < 0;
+  }
+  function circumradius(ax, ay, bx, by, cx, cy) {
+    const dx = bx - ax;
+    const dy = by - ay;
+    const ex = cx - ax;
+    const ey = cy - ay;
+    const bl = dx * dx + dy * dy;
+    const cl = ex * ex + ey * ey;
+    const d = 0.5 / (dx * ey - dy * ex);
+    const x2 = (ey * bl - dy * cl) * d;
+    const y = (dx * cl - ex * bl) * d;
+    return x2 * x2 + y * y;
+  }
+  function circumcenter(ax, ay, bx, by, cx, cy) {
+    const dx = bx - ax;
+    const dy = by - ay;
+    const ex = cx - ax;
+    const ey = cy - ay;
+    const bl = dx * dx + dy * dy;
+    const cl = ex * ex + ey * ey;
+    const d = 0.5 / (dx * ey - dy * ex);
+    const x2 = ax + (ey * bl - dy * cl) * d;
+    const y = ay + (dx * cl - ex * bl) * d;
+    return { x: x2, y };
+  }
+  function quicksort(ids, dists, left, right) {
+    if (right - left <= 20) {
+      for (let i2 = left + 1; i2 <= right; i2++) {
+        const temp = ids[i2];
+        const tempDist = dists[temp];
+        let j = i2 - 1;
+        while (j >= left && dists[ids[j]] > tempDist) ids[j + 1] = ids[j--];
+        ids[j + 1] = temp;
+      }
+    } else {
+      const median2 = left + right >> 1;
+      let i2 = left + 1;
+      let j = right;
+      swap(ids, median2, i2);
+      if (dists[ids[left]] > dists[ids[right]]) swap(ids, left, right);
+      if (dists[ids[i2]] > dists[ids[right]]) swap(ids, i2, right);
+      if (dists[ids[left]] > dists[ids[i2]]) swap(ids, left, i2);
+      const temp = ids[i2];
+      const tempDist = dists[temp];
+      while (true) {
+        do
+          i2++;
+        while (dists[ids[i2]] < tempDist);
+        do
+          j--;
+        while (dists[ids[j]] > tempDist);
+        if (j < i2) break;
+        swap(ids, i2, j);
+      }
+      ids[left + 1] = ids[j];
+      ids[j] = temp;
+      if (right - i2 + 1 >= j - left) {
+        quicksort(ids, dists, i2, right);
+        quicksort(ids, dists, left, j - 1);
+      } else {
+        quicksort(ids, dists, left, j - 1);
+        quicksort(ids, dists, i2, right);
+      }
+    }
+  }
+  function swap(arr, i2, j) {
+    const tmp = arr[i2];
+    arr[i2] = arr[j];
+    arr[j] = tmp;
+  }
+  function defaultGetX(p) {
+    return p[0];
+  }
+  function defaultGetY(p) {
+    return p[1];
+  }
+
+  // src/render/scene.ts
+  var RINGS = [[1.2, 1], [1.7, 0]];
+  var EDGE_MARGIN = 0.04;
+  var BORDER_STEPS = 9;
+  var SLOW = 1;
+  var SceneMesh = class {
+    constructor(width, height, anchors, outline) {
+      this.width = width;
+      this.height = height;
+      this.anchors = anchors;
+      const a = outline.length / 2;
+      let cx = 0, cy = 0;
+      for (let i2 = 0; i2 < a; i2++) {
+        cx += outline[2 * i2];
+        cy += outline[2 * i2 + 1];
+      }
+      cx /= a;
+      cy /= a;
+      const margin = EDGE_MARGIN * Math.min(width, height);
+      const pts = Array.from(outline);
+      const follow = new Array(a).fill(1);
+      for (const [reach, share] of RINGS) {
+        for (let i2 = 0; i2 < a; i2++) {
+          const x2 = cx + reach * (outline[2 * i2] - cx), y = cy + reach * (outline[2 * i2 + 1] - cy);
+          if (x2 > -0.5 + margin && x2 < width - 0.5 - margin && y > -0.5 + margin && y < height - 0.5 - margin) {
+            pts.push(x2, y);
+            follow.push(share);
+          }
+        }
+      }
+      const lo = [-0.5, -0.5], hi = [width - 0.5, height - 0.5];
+      const corners = [lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]];
+      for (let c = 0; c < 4; c++) {
+        const p = corners[c], q = corners[(c + 1) % 4];
+        for (let s = 0; s < BORDER_STEPS - 1; s++) {
+          const t = s / (BORDER_STEPS - 1);
+          pts.push(p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1]));
+          follow.push(0);
+        }
+      }
+      this.rest = Float64Array.from(pts);
+      this.follow = Float64Array.from(follow);
+      this.triangles = Uint32Array.from(new Delaunator(this.rest).triangles);
+    }
+    /** Every vertex now (N*2 px) for the face outline now at ``outline`` (A*2 px). */
+    points(outline) {
+      const a = this.anchors.length, n = this.rest.length / 2;
+      const m = similarity(this.rest.subarray(0, 2 * a), outline);
+      const out = new Float64Array(2 * n);
+      for (let i2 = 0; i2 < n; i2++) {
+        const x2 = this.rest[2 * i2], y = this.rest[2 * i2 + 1], f = this.follow[i2];
+        const mx = m[0] * x2 + m[1] * y + m[2], my = m[3] * x2 + m[4] * y + m[5];
+        out[2 * i2] = i2 < a ? outline[2 * i2] : Math.min(Math.max(x2 + f * (mx - x2), -0.5), this.width - 0.5);
+        out[2 * i2 + 1] = i2 < a ? outline[2 * i2 + 1] : Math.min(Math.max(y + f * (my - y), -0.5), this.height - 0.5);
+      }
+      return out;
+    }
+  };
+  function similarity(src, dst) {
+    const n = src.length / 2;
+    let sx = 0, sy = 0, dx = 0, dy = 0;
+    for (let i2 = 0; i2 < n; i2++) {
+      sx += src[2 * i2];
+      sy += src[2 * i2 + 1];
+      dx += dst[2 * i2];
+      dy += dst[2 * i2 + 1];
+    }
+    sx /= n;
+    sy /= n;
+    dx /= n;
+    dy /= n;
+    let dot = 0, cross = 0, norm = 0;
+    for (let i2 = 0; i2 < n; i2++) {
+      const px = src[2 * i2] - sx, py = src[2 * i2 + 1] - sy, qx = dst[2 * i2] - dx, qy = dst[2 * i2 + 1] - dy;
+      dot += px * qx + py * qy;
+      cross += px * qy - py * qx;
+      norm += px * px + py * py;
+    }
+    const a = norm > 0 ? dot / norm : 1, b = norm > 0 ? cross / norm : 0;
+    return [a, -b, dx - a * sx + b * sy, b, a, dy - b * sx - a * sy];
+  }
+
+  // src/render/synth.ts
+  var BACKGROUND = [38, 40, 46];
+  var NO_FACE_DIM = 0.45;
+  var Synthesizer = class {
+    constructor(renderer2, actor, header) {
+      this.renderer = renderer2;
+      this.actor = actor;
+      this.header = header;
+      this.mouthCanvas = document.createElement("canvas");
+      /** Seconds spent in the last :meth:`draw`, split by stage. */
+      this.timings = { geometry: 0, mouth: 0, gl: 0 };
+      const m = actor.model;
+      this.deformer = new Deformer(m);
+      if (header.basisLength !== 2 * this.deformer.knots.length) {
+        throw new Error(`the stream's basis does not fit the ${this.deformer.knots.length} knots of its actor`);
+      }
+      this.basis = Float64Array.from(header.basis, (x2) => x2 / 32767);
+      this.key = poseFromValues(header.references.slice(0, 6).map((r, i2) => r * header.steps[i2]));
+      this.restWidth = mouthWidth(m, m.vertices);
+      this.textureLayer = renderer2.upload(actor.texture);
+      if (actor.scene) {
+        const { width, height } = actor.source;
+        const outline = m.groups.face_outline;
+        const projected = project(m.vertices, actor.pose).points;
+        this.scene = new SceneMesh(width, height, outline, Float64Array.from(outline.flatMap((i2) => [projected[2 * i2], projected[2 * i2 + 1]])));
+        this.sceneLayer = renderer2.upload(actor.scene);
+        this.sceneUv = Float32Array.from(this.scene.rest, (p, i2) => (p + 0.5) / (i2 % 2 ? height : width));
+      } else {
+        this.scene = this.sceneLayer = this.sceneUv = null;
+      }
+    }
+    /** The picture's size, px: the scene's, or the stream's when the actor has none. */
+    get size() {
+      return this.scene ? [this.scene.width, this.scene.height] : [this.header.width, this.header.height];
+    }
+    /** Replaces the actor's texture (after an appearance update); same size. */
+    retexture(texture) {
+      this.textureLayer = this.renderer.upload(texture, this.textureLayer);
+    }
+    /** Draws ``motion`` into the renderer's canvas, letterboxed into ``view`` ([x, y, w, h]). */
+    draw(motion, view) {
+      const t0 = performance.now();
+      const v2 = motion.values, m = this.actor.model, knots = this.deformer.knots.length;
+      const coefficients = this.basis.length / (2 * knots);
+      const offsets = new Float64Array(2 * knots);
+      for (let c = 0; c < coefficients; c++) {
+        const q = v2[6 + c];
+        for (let r2 = 0; r2 < 2 * knots; r2++) offsets[r2] += this.basis[c * 2 * knots + r2] * q;
+      }
+      const look = this.look(v2, 6 + coefficients);
+      let vertices = this.deformer.sealed(this.deformer.vertices(offsets), SEAL);
+      vertices = closeLids(m, vertices, look.closure);
+      const pose = shownPose(poseFromValues(v2), this.actor.pose, this.key, this.scene !== null);
+      const { points, depth } = project(vertices, pose);
+      const [w, h] = this.size;
+      const t1 = performance.now();
+      const pick = (name) => Float64Array.from(m.groups[name].flatMap((i2) => [points[2 * i2], points[2 * i2 + 1]]));
+      const spread = mouthWidth(m, vertices) / Math.max(this.restWidth, 1e-9);
+      const patch = mouthPatch(pick("mouth_inner_upper"), pick("mouth_inner_lower"), teethUncovered(spread), [w, h], this.mouthCanvas);
+      const t2 = performance.now();
+      const r = this.renderer;
+      r.begin(w, h, BACKGROUND, view);
+      if (this.scene && this.sceneLayer && this.sceneUv) {
+        const at = this.scene.points(pick("face_outline"));
+        const rest = this.scene.rest, tris = this.scene.triangles;
+        const slow = [], fast = [];
+        for (let t = 0; t < tris.length; t += 3) {
+          let moved = 0;
+          for (let c = 0; c < 3; c++) {
+            const i2 = tris[t + c];
+            moved = Math.max(moved, Math.abs(at[2 * i2] - rest[2 * i2]), Math.abs(at[2 * i2 + 1] - rest[2 * i2 + 1]));
+          }
+          (moved < SLOW ? slow : fast).push(tris[t], tris[t + 1], tris[t + 2]);
+        }
+        r.mesh(this.sceneLayer, at, this.sceneUv, Uint32Array.from(slow), false, false);
+        r.mesh(this.sceneLayer, at, this.sceneUv, Uint32Array.from(fast), true, false);
+      }
+      if (patch) r.mouthPatch(patch);
+      r.mesh(this.textureLayer, points, m.uv, paintersOrder(points, depth, m.triangles), true, false);
+      if (!motion.face) r.dim(NO_FACE_DIM, w, h);
+      const t3 = performance.now();
+      Object.assign(this.timings, { geometry: t1 - t0, mouth: t2 - t1, gl: t3 - t2 });
+    }
+    look(v2, first) {
+      const at = (kind) => {
+        const j = this.header.extras.indexOf(kind);
+        return j < 0 ? 0 : v2[first + j];
+      };
+      return { closure: [at(1), at(2)] };
+    }
+  };
+  function paintersOrder(points, depth, triangles) {
+    const order = [];
+    for (let f = 0; f < triangles.length / 3; f++) {
+      const a = triangles[3 * f], b = triangles[3 * f + 1], c = triangles[3 * f + 2];
+      const area2 = (points[2 * b] - points[2 * a]) * (points[2 * c + 1] - points[2 * a + 1]) - (points[2 * b + 1] - points[2 * a + 1]) * (points[2 * c] - points[2 * a]);
+      if (area2 < 0) order.push([(depth[a] + depth[b] + depth[c]) / 3, f]);
+    }
+    order.sort((x2, y) => x2[0] - y[0]);
+    const out = new Uint32Array(order.length * 3);
+    order.forEach(([, f], i2) => out.set(triangles.subarray(3 * f, 3 * f + 3), 3 * i2));
+    return out;
+  }
+
+  // src/stream/crc32.ts
+  var TABLE = (() => {
+    const t = new Uint32Array(256);
+    for (let n = 0; n < 256; n++) {
+      let c = n;
+      for (let k = 0; k < 8; k++) c = c & 1 ? 3988292384 ^ c >>> 1 : c >>> 1;
+      t[n] = c >>> 0;
+    }
+    return t;
+  })();
+  function crc32(bytes, start = 0, end = bytes.length) {
+    let c = 4294967295;
+    for (let i2 = start; i2 < end; i2++) c = TABLE[(c ^ bytes[i2]) & 255] ^ c >>> 8;
+    return (c ^ 4294967295) >>> 0;
+  }
+
+  // src/stream/chunks.ts
+  var KIND_HEADER = 1;
+  var KIND_ACTOR = 2;
+  var KIND_INTRA = 3;
+  var KIND_INTER = 4;
+  var KIND_APPEARANCE = 5;
+  var APPEARANCE_PREFIX = 8;
+  var MAX_PAYLOAD = [0, 1 << 20, 1 << 26, 1 << 16, 1 << 16, 1 << 20];
+  function maxPayload(kind) {
+    return MAX_PAYLOAD[kind] ?? 0;
+  }
+  function readLength(buf, at, end = buf.length) {
+    let value = 0;
+    for (let i2 = 0; i2 < 4; i2++) {
+      if (at + i2 >= end) return "short";
+      const b = buf[at + i2];
+      value += (b & 127) * 2 ** (7 * i2);
+      if ((b & 128) === 0) return { value, used: i2 + 1 };
+    }
+    return "bad";
+  }
+  function readChunk(buf, start = 0, end = buf.length) {
+    if (start >= end) return "short";
+    const tag = buf[start];
+    const kind = tag >> 5;
+    const limit = maxPayload(kind);
+    if (limit === 0) return "bad";
+    const packet = kind === KIND_INTRA || kind === KIND_INTER;
+    if (!packet && (tag & 31) !== 0) return "bad";
+    if (end - start < 3) return "short";
+    const seq = buf[start + 1] | buf[start + 2] << 8;
+    const length = readLength(buf, start + 3, end);
+    if (length === "short" || length === "bad") return length;
+    if (length.value > limit) return "bad";
+    const from = start + 3 + length.used;
+    const to = from + length.value;
+    if (end < to + 4) return "short";
+    const crc = (buf[to] | buf[to + 1] << 8 | buf[to + 2] << 16 | buf[to + 3] << 24) >>> 0;
+    if (crc32(buf, start, to) !== crc) return "bad";
+    return {
+      chunk: { kind, frames: packet ? (tag & 31) + 1 : 0, seq, payload: buf.slice(from, to) },
+      used: to + 4 - start
+    };
+  }
+  var ByteQueue = class {
+    constructor() {
+      this.buf = new Uint8Array(256);
+      this.start = 0;
+      this.end = 0;
+    }
+    /** Bytes held. */
+    get length() {
+      return this.end - this.start;
+    }
+    /** The backing array and the held bytes' bounds in it (valid until the next append). */
+    view() {
+      return { buf: this.buf, start: this.start, end: this.end };
+    }
+    append(bytes) {
+      if (this.end + bytes.length > this.buf.length) {
+        const held = this.end - this.start;
+        if (held + bytes.length <= this.buf.length) {
+          this.buf.copyWithin(0, this.start, this.end);
+        } else {
+          let size = this.buf.length;
+          while (size < held + bytes.length) size *= 2;
+          const next = new Uint8Array(size);
+          next.set(this.buf.subarray(this.start, this.end));
+          this.buf = next;
+        }
+        this.start = 0;
+        this.end = held;
+      }
+      this.buf.set(bytes, this.end);
+      this.end += bytes.length;
+    }
+    /** Drops the first `n` held bytes. */
+    consume(n) {
+      this.start += n;
+      if (this.start === this.end) this.start = this.end = 0;
+    }
+  };
+
+  // src/stream/header.ts
+  var POSE_PARAMETERS = 6;
+  var MAX_VALUE = 2 ** 30;
+  var MAX_SIDE = 16384;
+  var InvalidHeader = class extends Error {
+  };
+  var Bytes = class {
+    constructor(buf) {
+      this.buf = buf;
+      this.at = 0;
+      this.view = new DataView(buf.buffer, buf.byteOffset, buf.byteLength);
+    }
+    take(n) {
+      const at = this.skip(n);
+      return this.buf.slice(at, at + n);
+    }
+    skip(n) {
+      if (this.at + n > this.buf.length) throw new InvalidHeader("the stream header is cut short");
+      const at = this.at;
+      this.at += n;
+      return at;
+    }
+    u8() {
+      return this.buf[this.skip(1)];
+    }
+    u16() {
+      return this.view.getUint16(this.skip(2), true);
+    }
+    u32() {
+      return this.view.getUint32(this.skip(4), true);
+    }
+    i32() {
+      return this.view.getInt32(this.skip(4), true);
+    }
+    f32() {
+      return this.view.getFloat32(this.skip(4), true);
+    }
+  };
+  function checkExtras(n, kinds) {
+    const room = Math.max(n - POSE_PARAMETERS, 0);
+    if (kinds.length > room) {
+      throw new InvalidHeader(
+        `${kinds.length} extra parameters do not fit in ${n} parameters per frame (at most ${room} after the pose)`
+      );
+    }
+    for (let i2 = 0; i2 < kinds.length; i2++) {
+      if (kinds[i2] === 0) throw new InvalidHeader(`extra parameter ${i2} has kind 0; kinds are 1-255`);
+      for (let j = 0; j < i2; j++) {
+        if (kinds[j] === kinds[i2]) throw new InvalidHeader(`extra parameter kind ${kinds[i2]} appears twice`);
+      }
+    }
+  }
+  function parseHeader(buf) {
+    const b = new Bytes(buf);
+    const magic = b.take(4);
+    if (String.fromCharCode(...magic) !== "FMST") throw new InvalidHeader("not a facemime stream (no FMST header)");
+    const version = b.u8();
+    if (version !== 1 && version !== 2) {
+      throw new InvalidHeader(`stream format version ${version}; this decoder reads versions 1 and 2`);
+    }
+    const fpsNum = b.u32();
+    const fpsDen = b.u32();
+    const width = b.u16();
+    const height = b.u16();
+    const topology = b.take(8);
+    const packetFrames = b.u8();
+    const keyframePackets = b.u16();
+    const n = b.u8();
+    if (n < POSE_PARAMETERS) {
+      throw new InvalidHeader(`${n} parameters per frame is not within ${POSE_PARAMETERS}..255`);
+    }
+    const steps = [];
+    const references = [];
+    const classes = [];
+    for (let i2 = 0; i2 < n; i2++) {
+      steps.push(b.f32());
+      references.push(b.i32());
+      classes.push(b.u8());
+    }
+    let extras = [];
+    if (version === 2) {
+      const x2 = b.u8();
+      extras = Array.from(b.take(x2));
+      checkExtras(n, extras);
+    }
+    const basisLength = b.u16();
+    const entries = (n - POSE_PARAMETERS - extras.length) * basisLength;
+    const raw = b.take(2 * entries);
+    const basis = new Int16Array(entries);
+    for (let i2 = 0; i2 < entries; i2++) basis[i2] = (raw[2 * i2] | raw[2 * i2 + 1] << 8) << 16 >> 16;
+    const actorId = b.take(32);
+    const flag = b.u8();
+    if (flag > 1) throw new InvalidHeader(`the header's actor flag is ${flag}, not 0 or 1`);
+    if (b.at !== buf.length) throw new InvalidHeader(`the stream header has ${buf.length - b.at} bytes too many`);
+    if (fpsNum === 0 || fpsDen === 0 || fpsNum / fpsDen > 1e3) {
+      throw new InvalidHeader(`frame rate ${fpsNum}/${fpsDen} is not in (0, 1000] frames/s`);
+    }
+    if (width === 0 || height === 0 || width > MAX_SIDE || height > MAX_SIDE) {
+      throw new InvalidHeader(`picture size ${width}x${height} is not within 1..${MAX_SIDE}`);
+    }
+    if (packetFrames === 0 || packetFrames > 32) {
+      throw new InvalidHeader(`${packetFrames} frames per packet is not within 1..32`);
+    }
+    if (keyframePackets === 0) throw new InvalidHeader("the keyframe interval must be at least one packet");
+    for (let i2 = 0; i2 < n; i2++) {
+      if (!(Number.isFinite(steps[i2]) && steps[i2] > 0) || classes[i2] >= 16 || Math.abs(references[i2]) > MAX_VALUE) {
+        throw new InvalidHeader(`parameter ${i2} has a bad quantiser (step ${steps[i2]}, class ${classes[i2]})`);
+      }
+    }
+    return {
+      version,
+      fps: [fpsNum, fpsDen],
+      width,
+      height,
+      topology,
+      packetFrames,
+      keyframePackets,
+      steps,
+      references,
+      classes,
+      extras,
+      basisLength,
+      basis,
+      actorId,
+      actorInStream: flag === 1
+    };
+  }
+  function sameArray(a, b) {
+    if (a.length !== b.length) return false;
+    for (let i2 = 0; i2 < a.length; i2++) if (a[i2] !== b[i2]) return false;
+    return true;
+  }
+  function sameHeader(a, b) {
+    return a.fps[0] === b.fps[0] && a.fps[1] === b.fps[1] && a.width === b.width && a.height === b.height && sameArray(a.topology, b.topology) && a.packetFrames === b.packetFrames && a.keyframePackets === b.keyframePackets && sameArray(a.steps, b.steps) && sameArray(a.references, b.references) && sameArray(a.classes, b.classes) && sameArray(a.extras, b.extras) && a.basisLength === b.basisLength && sameArray(a.basis, b.basis) && sameArray(a.actorId, b.actorId) && a.actorInStream === b.actorInStream;
+  }
+  function dequantise(header, q) {
+    const out = new Float64Array(q.length);
+    for (let i2 = 0; i2 < q.length; i2++) out[i2] = q[i2] * header.steps[i2];
+    return out;
+  }
+
+  // src/stream/range.ts
+  var PRECISION = 12;
+  var ONE = 1 << PRECISION;
+  var RADIUS = 12;
+  var ALPHABET = 2 * RADIUS + 2;
+  var ESCAPE = ALPHABET - 1;
+  var CLASSES = 16;
+  var DECAY = [
+    3764,
+    6909,
+    11147,
+    16245,
+    21852,
+    27600,
+    33170,
+    38337,
+    42966,
+    47001,
+    50443,
+    53330,
+    55718,
+    57674,
+    59263,
+    60544
+  ];
+  var FLAG_SYMBOLS = 32;
+  var LIMIT = 1 << 24;
+  var InvalidPayload = class extends Error {
+  };
+  function tableFromFrequencies(freq) {
+    const n = freq.length;
+    let total = 0;
+    for (let s = 0; s < n; s++) total += freq[s];
+    const spare = ONE - n;
+    const probs = new Array(n);
+    let used = 0;
+    let top = 0;
+    for (let s = 0; s < n; s++) {
+      probs[s] = 1 + Math.floor(freq[s] * spare / total);
+      used += probs[s];
+      if (freq[s] > freq[top]) top = s;
+    }
+    probs[top] += ONE - used;
+    const cdf = new Uint16Array(n + 1);
+    let acc = 0;
+    for (let s = 0; s < n; s++) {
+      acc += probs[s];
+      cdf[s + 1] = acc;
+    }
+    return cdf;
+  }
+  function uniformTable(bits2) {
+    const share = 1 << PRECISION - bits2;
+    const cdf = new Uint16Array((1 << bits2) + 1);
+    for (let s = 0; s <= 1 << bits2; s++) cdf[s] = s * share;
+    return cdf;
+  }
+  var UNIFORM = Array.from({ length: PRECISION + 1 }, (_, b) => uniformTable(b));
+  function startingFrequencies(c) {
+    const f = new Array(ALPHABET).fill(0);
+    let level = 4096;
+    f[RADIUS] = level;
+    for (let k = 1; k <= RADIUS; k++) {
+      level = Math.max(1, Math.floor(level * DECAY[c] / 65536));
+      f[RADIUS + k] = level;
+      f[RADIUS - k] = level;
+    }
+    f[ESCAPE] = Math.max(1, level);
+    return f;
+  }
+  var INTRA_TABLE = tableFromFrequencies(startingFrequencies(CLASSES - 1));
+  var Context = class _Context {
+    constructor(freq) {
+      this.freq = Array.from(freq);
+      this.total = this.freq.reduce((a, b) => a + b, 0);
+      this.step = Math.max(1, this.total >> 4);
+      this.table = tableFromFrequencies(this.freq);
+    }
+    /** The value context of spread class `c`. */
+    static values(c) {
+      return new _Context(startingFrequencies(c));
+    }
+    /** The frame-flags context: 16 for every symbol, 496 for symbol 1 (a face, nothing lost). */
+    static flags() {
+      const f = new Array(FLAG_SYMBOLS).fill(16);
+      f[1] = 16 * (FLAG_SYMBOLS - 1);
+      return new _Context(f);
+    }
+    /** Learns that `symbol` was decoded. */
+    update(symbol) {
+      this.freq[symbol] += this.step;
+      this.total += this.step;
+      if (this.total > LIMIT) {
+        this.total = 0;
+        for (let s = 0; s < this.freq.length; s++) {
+          this.freq[s] = this.freq[s] + 1 >> 1;
+          this.total += this.freq[s];
+        }
+      }
+      this.table = tableFromFrequencies(this.freq);
+    }
+  };
+  var RangeDecoder = class {
+    /** Throws InvalidPayload for an odd payload length. */
+    constructor(payload) {
+      this.lower = 0;
+      this.range = 4294967295;
+      if (payload.length % 2 !== 0) throw new InvalidPayload("a packet's payload has an odd length");
+      const n = payload.length / 2;
+      this.words = new Uint16Array(n);
+      for (let i2 = 0; i2 < n; i2++) this.words[i2] = payload[2 * i2] | payload[2 * i2 + 1] << 8;
+      this.point = n >= 2 ? (this.words[0] << 16 | this.words[1]) >>> 0 : n === 1 ? this.words[0] << 16 >>> 0 : 0;
+      this.next = Math.min(n, 2);
+    }
+    /** Decodes one symbol with `cdf`; throws InvalidPayload when the quantile is >= 4096. */
+    symbol(cdf) {
+      const scale2 = this.range >>> PRECISION;
+      const quantile = Math.floor((this.point - this.lower >>> 0) / scale2);
+      if (quantile >= ONE) throw new InvalidPayload("range decoder: invalid data");
+      let lo = 0;
+      let hi = cdf.length - 2;
+      while (lo < hi) {
+        const mid = lo + hi + 1 >> 1;
+        if (cdf[mid] <= quantile) lo = mid;
+        else hi = mid - 1;
+      }
+      const s = lo;
+      this.lower = this.lower + scale2 * cdf[s] >>> 0;
+      this.range = scale2 * (cdf[s + 1] - cdf[s]);
+      if (this.range < 65536) {
+        this.lower = this.lower << 16 >>> 0;
+        this.range = this.range << 16 >>> 0;
+        const w = this.next < this.words.length ? this.words[this.next] : 0;
+        this.next++;
+        this.point = (this.point << 16 | w) >>> 0;
+      }
+      return s;
+    }
+    /** Decodes an integer with value table `cdf`: the value and the table's symbol (the escape's
+     * extra symbols are uniform: sign, bit length n of m = |v| - 13, then m's n - 1 low bits in
+     * chunks of at most 12, most significant first). */
+    value(cdf) {
+      const symbol = this.symbol(cdf);
+      if (symbol !== ESCAPE) return { value: symbol - RADIUS, symbol };
+      const negative = this.symbol(UNIFORM[1]) === 1;
+      const n = this.symbol(UNIFORM[5]);
+      let m = n === 0 ? 0 : 1;
+      let left = Math.max(n - 1, 0);
+      while (left > 0) {
+        const b = Math.min(left, PRECISION);
+        m = m * 2 ** b + this.symbol(UNIFORM[b]);
+        left -= b;
+      }
+      const magnitude = m + RADIUS + 1;
+      return { value: negative ? -magnitude : magnitude, symbol };
+    }
+  };
+
+  // src/stream/packet.ts
+  var FACE = 1;
+  var CodingState = class {
+    /** The state at the start of an intra packet. */
+    constructor(header) {
+      this.flags = Context.flags();
+      /** The last frame with a face since the intra packet: what the next one is predicted from. */
+      this.pred = null;
+      this.values = header.classes.map((c) => Context.values(c));
+      this.references = header.references;
+    }
+  };
+  function decodePacket(state, payload, frames) {
+    const dec = new RangeDecoder(payload);
+    const n = state.references.length;
+    const out = [];
+    for (let j = 0; j < frames; j++) {
+      const flags = dec.symbol(state.flags.table);
+      state.flags.update(flags);
+      if ((flags & FACE) === 0) {
+        out.push({ flags, q: null });
+        continue;
+      }
+      const q = new Int32Array(n);
+      const pred = state.pred;
+      for (let i2 = 0; i2 < n; i2++) {
+        let v2;
+        if (pred) {
+          const r = dec.value(state.values[i2].table);
+          state.values[i2].update(r.symbol);
+          v2 = pred[i2] + r.value;
+        } else {
+          v2 = state.references[i2] + dec.value(INTRA_TABLE).value;
+        }
+        if (Math.abs(v2) > MAX_VALUE) throw new InvalidPayload(`parameter ${i2} decodes to ${v2}, beyond the format's range`);
+        q[i2] = v2;
+      }
+      state.pred = q;
+      out.push({ flags, q });
+    }
+    return out;
+  }
+
+  // src/stream/decoder.ts
+  var MAX_GAP_PACKETS = 256;
+  var StreamDecoder = class {
+    /** `fromStart`: the bytes start at the stream's start (a file: missing leading packets are
+     * concealed); false for a receiver joining a live stream at the first packet it gets. */
+    constructor(fromStart = true) {
+      this.fromStart = fromStart;
+      /** What the decoder met so far. */
+      this.stats = {
+        packets: 0,
+        lost_packets: 0,
+        late_packets: 0,
+        undecodable: 0,
+        appearance: 0,
+        damaged_runs: 0,
+        damaged_bytes: 0,
+        frames: 0,
+        concealed: 0
+      };
+      this.queue = new ByteQueue();
+      this.inDamage = false;
+      this.current = null;
+      this.refused = null;
+      this.actorData = null;
+      this.state = null;
+      /** The next expected packet number (unwrapped), once a packet was read. */
+      this.next = null;
+      /** The quantised parameters of the last face (the header's references before any). */
+      this.shown = new Int32Array(0);
+      /** The last good decoded frame, which concealed frames repeat. */
+      this.last = null;
+      this.raw = [];
+    }
+    /** The header in force, once one was read. */
+    get header() {
+      return this.current;
+    }
+    /** Why the last well-framed header was refused, if one was. */
+    get headerError() {
+      return this.refused;
+    }
+    /** The last actor chunk's payload, once one was read. */
+    get actor() {
+      return this.actorData;
+    }
+    /** Reads `bytes` (after what is buffered); returns the events they completed. */
+    push(bytes) {
+      this.queue.append(bytes);
+      this.drain(false);
+      return this.output();
+    }
+    /** Reads what is buffered as the stream's end (a chunk cut short there is damage). */
+    finish() {
+      this.drain(true);
+      return this.output();
+    }
+    drain(end) {
+      const { buf, start, end: stop } = this.queue.view();
+      let at = start;
+      while (at < stop) {
+        const r = readChunk(buf, at, stop);
+        if (r === "short" && !end) break;
+        if (r === "short" || r === "bad") {
+          if (!this.inDamage) {
+            this.stats.damaged_runs++;
+            this.inDamage = true;
+          }
+          this.stats.damaged_bytes++;
+          at++;
+          continue;
+        }
+        this.inDamage = false;
+        at += r.used;
+        this.chunk(r.chunk);
+      }
+      this.queue.consume(at - start);
+    }
+    chunk(c) {
+      switch (c.kind) {
+        case KIND_HEADER: {
+          let h;
+          try {
+            h = parseHeader(c.payload);
+          } catch (e) {
+            if (!(e instanceof InvalidHeader)) throw e;
+            this.refused = e.message;
+            return;
+          }
+          if (this.current && sameHeader(this.current, h)) return;
+          this.shown = Int32Array.from(h.references);
+          this.current = h;
+          this.state = null;
+          this.next = null;
+          this.raw.push({ t: "event", event: { kind: "header", header: h } });
+          return;
+        }
+        case KIND_ACTOR:
+          this.actorData = c.payload;
+          this.raw.push({ t: "event", event: { kind: "actor", data: c.payload } });
+          return;
+        case KIND_APPEARANCE:
+          if (!this.current || c.payload.length < APPEARANCE_PREFIX) {
+            this.stats.undecodable++;
+            return;
+          }
+          this.stats.appearance++;
+          this.raw.push({ t: "event", event: { kind: "appearance", payload: c.payload } });
+          return;
+        default:
+          this.packet(c);
+      }
+    }
+    packet(c) {
+      const header = this.current;
+      if (!header) {
+        this.stats.undecodable++;
+        return;
+      }
+      const per = header.packetFrames;
+      const expected = this.next ?? (this.fromStart ? 0 : c.seq);
+      const delta = (c.seq - expected % 65536 + 65536) % 65536;
+      if (delta >= 1 << 15) {
+        this.stats.late_packets++;
+        return;
+      }
+      const seq = expected + delta;
+      if (delta > 0) {
+        this.stats.lost_packets += delta;
+        this.state = null;
+        if (delta <= MAX_GAP_PACKETS) this.conceal(expected * per, delta * per);
+      }
+      this.next = seq + 1;
+      const first = seq * per;
+      if (c.frames > per) {
+        this.stats.undecodable++;
+        this.state = null;
+        this.conceal(first, c.frames);
+        return;
+      }
+      if (c.kind === KIND_INTRA) this.state = new CodingState(header);
+      if (!this.state) {
+        this.conceal(first, c.frames);
+        return;
+      }
+      let frames;
+      try {
+        frames = decodePacket(this.state, c.payload, c.frames);
+      } catch (e) {
+        if (!(e instanceof InvalidPayload)) throw e;
+        this.stats.undecodable++;
+        this.state = null;
+        this.conceal(first, c.frames);
+        return;
+      }
+      this.stats.packets++;
+      this.stats.frames += frames.length;
+      frames.forEach((f, j) => {
+        const face = (f.flags & FACE) !== 0;
+        if (f.q) this.shown = f.q;
+        const frame = {
+          index: first + j,
+          face,
+          lost: f.flags >> 1 & 15,
+          q: this.shown.slice(),
+          values: dequantise(header, this.shown),
+          concealed: false
+        };
+        this.raw.push({ t: "frame", frame });
+      });
+    }
+    conceal(first, count) {
+      if (count > 0) {
+        this.stats.concealed += count;
+        this.raw.push({ t: "concealed", first, count });
+      }
+    }
+    /** This call's events: its frames in index order (a stable sort, decoded frames before
+     * concealed runs on a tie, as MotionDecoder does), concealed runs filled in, each other event
+     * after as many frames as the decoder had output before reading it. */
+    output() {
+      const raw = this.raw;
+      this.raw = [];
+      const runs = [];
+      const others = [];
+      let seen = 0;
+      for (const r of raw) {
+        if (r.t === "frame") {
+          runs.push({ first: r.frame.index, frame: r.frame, count: 1 });
+          seen++;
+        } else if (r.t === "concealed") {
+          seen += r.count;
+        } else {
+          others.push({ before: seen, event: r.event });
+        }
+      }
+      for (const r of raw) if (r.t === "concealed") runs.push({ first: r.first, frame: null, count: r.count });
+      runs.sort((a, b) => a.first - b.first);
+      const out = [];
+      let k = 0;
+      let emitted = 0;
+      const flush = () => {
+        while (k < others.length && others[k].before <= emitted) out.push(others[k++].event);
+      };
+      flush();
+      for (const run of runs) {
+        if (run.frame) {
+          this.last = run.frame;
+          out.push({ kind: "frame", frame: run.frame });
+          emitted++;
+          flush();
+          continue;
+        }
+        for (let j = 0; j < run.count; j++) {
+          out.push({ kind: "frame", frame: this.concealedFrame(run.first + j) });
+          emitted++;
+          flush();
+        }
+      }
+      while (k < others.length) out.push(others[k++].event);
+      return out;
+    }
+    concealedFrame(index) {
+      const last = this.last;
+      if (last) {
+        return { index, face: last.face, lost: last.lost, q: last.q.slice(), values: last.values.slice(), concealed: true };
+      }
+      const header = this.current;
+      const q = new Int32Array(header.references.length);
+      for (let i2 = 0; i2 < POSE_PARAMETERS; i2++) q[i2] = header.references[i2];
+      return { index, face: false, lost: 15, q, values: dequantise(header, q), concealed: true };
+    }
+  };
+
+  // src/main.ts
+  var WINDOW_S = 5;
+  var INTRA_EVERY_MS = 250;
+  var canvas = document.getElementById("picture");
+  var hud = document.getElementById("hud");
+  var message = document.getElementById("message");
+  var params = new URLSearchParams(location.search);
+  var dropShare = Number(params.get("drop") ?? 0);
+  var seed = Number(params.get("seed") ?? 1) >>> 0 || 1;
+  var random = () => {
+    seed ^= seed << 13;
+    seed >>>= 0;
+    seed ^= seed >>> 17;
+    seed ^= seed << 5;
+    seed >>>= 0;
+    return seed / 2 ** 32;
+  };
+  var renderer = new Renderer(canvas);
+  var now = () => performance.timeOrigin + performance.now();
+  var Session = class {
+    constructor(live) {
+      this.header = null;
+      this.actor = null;
+      this.texture = null;
+      this.synth = null;
+      this.frames = [];
+      /** Appearance updates with the number of frames output before each was read. */
+      this.updates = [];
+      this.applied = 0;
+      this.pending = Promise.resolve();
+      this.decoder = new StreamDecoder(!live);
+    }
+    /** Takes the decoder's events in order (actor and images decode asynchronously, in turn). */
+    take(events, onFrame) {
+      for (const e of events) {
+        this.pending = this.pending.then(async () => {
+          if (e.kind === "header") {
+            if (this.header && this.actor && !same(this.header.actorId, e.header.actorId)) this.actor = null;
+            this.header = e.header;
+            this.synth = null;
+            this.updates = [];
+            this.applied = 0;
+            this.frames = [];
+            this.build();
+          } else if (e.kind === "actor") {
+            if (!this.actor) {
+              this.actor = await readActor(e.data);
+              this.build();
+            }
+          } else if (e.kind === "appearance") {
+            const update = await readUpdate(e.payload);
+            if (update) this.updates.push({ update, after: this.frames.length });
+            else api.counts.refused += 1;
+          } else {
+            this.frames.push(e.frame);
+            onFrame(e.frame);
+          }
+        });
+      }
+      return this.pending;
+    }
+    build() {
+      if (!this.header || !this.actor || this.synth) return;
+      this.texture = { ...this.actor.texture, rgba: this.actor.texture.rgba.slice() };
+      this.applied = 0;
+      this.synth = new Synthesizer(renderer, this.actor, this.header);
+      const [w, h] = [this.header.width, this.header.height];
+      if (canvas.width !== w || canvas.height !== h) {
+        canvas.width = w;
+        canvas.height = h;
+      }
+    }
+    /** Draws ``frame`` (its updates applied first); false when the actor is not here yet. */
+    draw(frame, position) {
+      if (!this.synth || !this.texture || !this.header) return false;
+      let changed = false;
+      while (this.applied < this.updates.length) {
+        const { update, after } = this.updates[this.applied];
+        if (after > position || update.frame > frame.index) break;
+        if (applyUpdate(this.texture, update)) changed = true;
+        else api.counts.refused += 1;
+        this.applied += 1;
+      }
+      if (changed) this.synth.retexture(this.texture);
+      const [w, h] = this.synth.size;
+      this.synth.draw(frame, letterbox(w, h, canvas.width, canvas.height));
+      return true;
+    }
+  };
+  function same(a, b) {
+    return a.length === b.length && a.every((x2, i2) => x2 === b[i2]);
+  }
+  function letterbox(w, h, cw, ch) {
+    const f = Math.min(cw / w, ch / h);
+    const sw = Math.max(1, Math.round(w * f)), sh = Math.max(1, Math.round(h * f));
+    return [Math.floor((cw - sw) / 2), Math.floor((ch - sh) / 2), sw, sh];
+  }
+  var counts = { drawn: 0, intraRequests: 0, dropped: 0, refused: 0, received: 0 };
+  var latencies = [];
+  var drawTimes = [];
+  var drawnAt = [];
+  var bytesAt = [];
+  var arrived = /* @__PURE__ */ new Map();
+  var session = null;
+  var lastRequest = -Infinity;
+  var socket = null;
+  function present(frame, position) {
+    if (!session) return;
+    const t0 = performance.now();
+    if (!session.draw(frame, position)) return;
+    renderer.gl.finish();
+    const t1 = performance.now();
+    drawTimes.push(t1 - t0);
+    counts.drawn += 1;
+    drawnAt.push(t1);
+    const sent = arrived.get(frame.index);
+    if (sent !== void 0 && !frame.concealed) latencies.push(now() - sent);
+    arrived.delete(frame.index);
+  }
+  function updateHud() {
+    const t = performance.now();
+    while (drawnAt.length && drawnAt[0] < t - WINDOW_S * 1e3) drawnAt.shift();
+    while (bytesAt.length && bytesAt[0][0] < t - WINDOW_S * 1e3) bytesAt.shift();
+    const fps = drawnAt.length / WINDOW_S;
+    const kbps = bytesAt.reduce((s2, [, b]) => s2 + b, 0) * 8 / 1e3 / WINDOW_S;
+    const s = session?.decoder.stats;
+    const lat = latencies.length ? `, latency ${median(latencies.slice(-50)).toFixed(0)} ms` : "";
+    hud.textContent = `${fps.toFixed(1)} frames/s drawn · ${kbps.toFixed(2)} kbit/s received · ${s?.concealed ?? 0} frames concealed (${s?.lost_packets ?? 0} packets lost)${lat}`;
+  }
+  function median(xs) {
+    const s = [...xs].sort((a, b) => a - b);
+    return s.length ? s[Math.floor(s.length / 2)] : NaN;
+  }
+  function fail(text) {
+    api.error = text;
+    message.textContent = text;
+    message.hidden = false;
+  }
+  function requestIntra() {
+    const t = performance.now();
+    if (!socket || socket.readyState !== WebSocket.OPEN || t - lastRequest < INTRA_EVERY_MS) return;
+    lastRequest = t;
+    counts.intraRequests += 1;
+    socket.send(JSON.stringify({ type: "intra" }));
+  }
+  function connect() {
+    const live = new Session(true);
+    session = live;
+    const ws = new WebSocket(`${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/stream`);
+    ws.binaryType = "arraybuffer";
+    socket = ws;
+    ws.onopen = () => {
+      message.hidden = true;
+      requestIntra();
+    };
+    ws.onmessage = (m) => {
+      if (typeof m.data === "string") {
+        const note = JSON.parse(m.data);
+        if (note.type === "frames") note.arrived.forEach((t, j) => arrived.set(note.first + j, t));
+        if (note.type === "end") message.textContent = "the call has ended";
+        if (note.type === "end") message.hidden = false;
+        return;
+      }
+      const bytes = new Uint8Array(m.data);
+      const kind = bytes[0] >> 5;
+      if (kind === KIND_INTRA || kind === KIND_INTER) {
+        if (dropShare > 0 && random() < dropShare) {
+          counts.dropped += 1;
+          return;
+        }
+        counts.received += bytes.length;
+        bytesAt.push([performance.now(), bytes.length]);
+      }
+      const events = live.decoder.push(bytes);
+      live.take(events, (f) => {
+        if (f.concealed) requestIntra();
+        api.frames.push(shown(f));
+        present(f, live.frames.length - 1);
+      }).catch((e) => fail(`cannot play the call: ${e.message}`));
+    };
+    ws.onclose = (e) => {
+      socket = null;
+      if (session === live && e.code !== 1e3) {
+        message.textContent = "the sender is gone: reconnecting…";
+        message.hidden = false;
+        setTimeout(connect, 1e3);
+      }
+    };
+  }
+  function shown(f) {
+    return { index: f.index, face: f.face, concealed: f.concealed, lost: f.lost, values: Array.from(f.values) };
+  }
+  var playing = 0;
+  async function loadStream(data, autoplay = true) {
+    const bytes = typeof data === "string" ? Uint8Array.from(atob(data), (c) => c.charCodeAt(0)) : data;
+    socket?.close(1e3);
+    const file = new Session(false);
+    session = file;
+    api.frames = [];
+    const collect = (f) => {
+      api.frames.push(shown(f));
+    };
+    await file.take(file.decoder.push(bytes), collect);
+    await file.take(file.decoder.finish(), collect);
+    if (!file.header) throw new Error("this is not a facemime stream (no header found)");
+    if (!file.synth) throw new Error("the stream does not carry its actor");
+    message.hidden = true;
+    const run = ++playing;
+    if (!autoplay) return;
+    const fps = file.header.fps[0] / file.header.fps[1];
+    const start = performance.now();
+    const tick = () => {
+      if (run !== playing || session !== file) return;
+      const i2 = Math.floor((performance.now() - start) / 1e3 * fps) % file.frames.length;
+      present(file.frames[i2], i2);
+      updateHud();
+      requestAnimationFrame(tick);
+    };
+    requestAnimationFrame(tick);
+  }
+  var api = {
+    frames: [],
+    counts,
+    error: null,
+    stats: () => ({
+      ...session?.decoder.stats ?? {},
+      ...counts,
+      latencies: [...latencies],
+      drawTimes: [...drawTimes],
+      header: session?.header ? { width: session.header.width, height: session.header.height, fps: session.header.fps } : null
+    }),
+    loadStream: (data, autoplay = true) => loadStream(data, autoplay),
+    show: (index) => {
+      if (!session) throw new Error("no stream loaded");
+      playing += 1;
+      const position = session.frames.findIndex((f) => f.index === index);
+      if (position < 0) throw new Error(`no frame ${index}`);
+      session.texture = session.actor ? { ...session.actor.texture, rgba: session.actor.texture.rgba.slice() } : null;
+      session.applied = 0;
+      if (session.texture) session.synth?.retexture(session.texture);
+      present(session.frames[position], position);
+    },
+    pixels: () => {
+      const p = renderer.pixels();
+      let s = "";
+      for (let i2 = 0; i2 < p.length; i2 += 32768) s += String.fromCharCode(...p.subarray(i2, i2 + 32768));
+      return btoa(s);
+    },
+    benchmark: (count) => {
+      if (!session?.synth) throw new Error("no stream loaded");
+      playing += 1;
+      const t0 = performance.now();
+      for (let i2 = 0; i2 < count; i2++) {
+        const f = session.frames[i2 % session.frames.length];
+        session.synth.draw(f, [0, 0, canvas.width, canvas.height]);
+        renderer.gl.finish();
+      }
+      return (performance.now() - t0) / count;
+    }
+  };
+  window.facemime = api;
+  var chooser = document.getElementById("file");
+  var play = (f) => f.arrayBuffer().then((b) => loadStream(new Uint8Array(b))).catch((e) => fail(`cannot play ${f.name}: ${e.message}`));
+  chooser.onchange = () => {
+    if (chooser.files?.[0]) void play(chooser.files[0]);
+  };
+  document.body.ondragover = (e) => e.preventDefault();
+  document.body.ondrop = (e) => {
+    e.preventDefault();
+    const f = e.dataTransfer?.files[0];
+    if (f) void play(f);
+  };
+  setInterval(updateHud, 500);
+  if (location.protocol.startsWith("http") && params.get("live") !== "0") connect();
+  else {
+    message.textContent = "drop a .fmstream file here, or choose one";
+    message.hidden = false;
+  }
+})();
