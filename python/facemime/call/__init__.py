@@ -11,13 +11,13 @@ import threading
 from pathlib import Path
 from typing import BinaryIO
 
-from facemime.call.sender import KEYFRAME, PACKET_FRAMES, QUALITY, WARMUP, CameraSource, Sender, open_source
+from facemime.call.sender import KEYFRAME, PACKET_FRAMES, RATE, WARMUP, CameraSource, Sender, open_source
 from facemime.call.server import GOING_AWAY, PORT, Hub, make_server
 from facemime.errors import InvalidInputError
 from facemime.fit.actor import Actor
 from facemime.io.outputs import OutputFileError, check_outputs, temporary_sibling
 
-__all__ = ["Call", "KEYFRAME", "PACKET_FRAMES", "PORT", "QUALITY", "WARMUP"]
+__all__ = ["Call", "KEYFRAME", "PACKET_FRAMES", "PORT", "RATE", "WARMUP"]
 
 #: The suffix of a recording (``--record``).
 SUFFIX = ".fmstream"
@@ -60,10 +60,10 @@ class Call:
     :meth:`start` serves and streams, :meth:`wait` returns when the source has ended, :meth:`close`
     (or leaving a ``with`` block) stops everything within a second or two."""
 
-    def __init__(self, source: str | Path, actor: Actor | None = None, port: int = PORT, quality: int = QUALITY,
+    def __init__(self, source: str | Path, actor: Actor | None = None, port: int = PORT, quality: int | None = None,
                  packet_frames: int = PACKET_FRAMES, record: str | Path | None = None, force: bool = False,
                  loop: bool = False, web: Path | None = None, keyframe: float = KEYFRAME, warmup: float = WARMUP,
-                 actor_path: str | Path | None = None):
+                 actor_path: str | Path | None = None, rate: float = RATE):
         self.record_path = None if record is None else Path(record)
         if self.record_path is not None:
             if self.record_path.suffix.lower() != SUFFIX:
@@ -74,7 +74,7 @@ class Call:
         self._serving: threading.Thread | None = None
         self.server = None
         try:
-            self.sender = Sender(self.source, self, actor, quality, packet_frames, keyframe, warmup)
+            self.sender = Sender(self.source, self, actor, quality, packet_frames, keyframe, warmup, rate)
             self.hub = Hub({"source": self.source.name, "fps": self.source.fps, "width": self.source.size[0],
                             "height": self.source.size[1]}, self.sender.request_intra)
             self.server = make_server(self.hub, port, web)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Protocol
 
@@ -23,20 +23,23 @@ import numpy as np
 from facemime import _core
 from facemime.animate.analysis import Analysis, FrameMotion
 from facemime.codec.params import Basis, pose_vector
-from facemime.codec.stream import MotionEncoder, Settings
+from facemime.codec.files import Clip, encode_clip
+from facemime.codec.stream import DEFAULT_QUALITY, LADDER, MotionEncoder, Settings
 from facemime.errors import InputFileError, InvalidInputError, NoFaceError
 from facemime.fit.actor import Actor
+from facemime.io.actor_file import actor_bytes
 from facemime.io.video import VideoReader
 
 #: Seconds of analysed frames the basis is learned from before the stream starts (not streamed).
 WARMUP = 2.0
-# The defaults below were measured on the ten shared videos with the basis from the first 2 s,
-# motion rate at P = 2 frames a packet: quality 3 mean 1.80, max 2.49 kbit/s; quality 4 mean 1.95,
-# max 2.76; quality 5 mean 2.19, max 3.15 (a keyframe of 2 s instead of 5 s changes them by ~0.03).
-# A packet of 2 frames waits one frame for its second frame: more frames a packet cost latency,
-# fewer cost framing (8 bytes a packet).
-#: The stream's quality (0-10, ``facemime.codec.stream.LADDER``).
-QUALITY = 4
+# Measured on the ten shared videos with the basis from the first 2 s, at 2 frames a packet: the
+# motion's rate at quality 3 was 1.80 kbit/s on average (2.49 at most), at 4 1.95 (2.76), at 5 2.19
+# (3.15); a keyframe of 2 s instead of 5 s changes them by ~0.03. No one quality keeps every face
+# under 2 kbit/s, hence the choice from the warm-up (RATE). A packet of 2 frames waits one frame for
+# its second: more frames a packet cost latency, fewer cost framing (8 bytes a packet).
+#: The motion's rate a call aims at, kbit/s: the stream takes the finest quality whose warm-up
+#: frames code within it (``--quality`` sets one instead).
+RATE = 2.0
 #: Frames per packet.
 PACKET_FRAMES = 2
 #: Seconds between scheduled intra packets (a receiver can also ask for one).
@@ -171,14 +174,18 @@ class Sender(threading.Thread):
     what stopped the thread otherwise (None: the source ended, or it was stopped)."""
 
     def __init__(self, source: FileSource | CameraSource, sink: Sink, actor: Actor | None = None,
-                 quality: int = QUALITY, packet_frames: int = PACKET_FRAMES, keyframe: float = KEYFRAME,
-                 warmup: float = WARMUP):
+                 quality: int | None = None, packet_frames: int = PACKET_FRAMES, keyframe: float = KEYFRAME,
+                 warmup: float = WARMUP, rate: float = RATE):
         super().__init__(name="call sender", daemon=True)
         if not 1 <= packet_frames <= 32:
             raise InvalidInputError(f"frames per packet must be 1-32, got {packet_frames}")
         self.source, self.sink, self.fps = source, sink, source.fps
         packet = packet_frames / self.fps
-        self.settings = Settings(quality=quality, packet=packet, keyframe=max(keyframe, packet))
+        if not (np.isfinite(rate) and rate > 0):
+            raise InvalidInputError(f"the target rate must be a positive number of kbit/s, got {rate}")
+        self.quality, self.rate = quality, float(rate)
+        self.settings = Settings(quality=DEFAULT_QUALITY if quality is None else quality, packet=packet,
+                                 keyframe=max(keyframe, packet))
         self.packet_frames, self.keyframe_packets = self.settings.framing(self.fps)
         self.warmup_frames = max(1, round(warmup * self.fps))
         self.stats = SenderStats()
@@ -197,6 +204,9 @@ class Sender(threading.Thread):
         except NoFaceError as e:
             raise NoFaceError(f"{e}; the video must start with a frontal face") from None
         self.actor = actor or self.analysis.actor
+        # made now, not when the stream starts: encoding the texture and scene takes ~0.3 s, which
+        # delayed the first packets that much
+        self._actor_data = actor_bytes(self.actor, "webp", self.settings.texture)
         self._warm: list[tuple[FrameMotion, float]] = [(self.analysis.last, arrived)]
         self.encoder: MotionEncoder | None = None
 
@@ -244,8 +254,21 @@ class Sender(threading.Thread):
         if not self._stopping.is_set():
             self._send(self.encoder.finish())
 
+    def _choose_quality(self) -> None:
+        """Without a quality given: the finest whose warm-up frames, coded as the stream will be
+        (their own basis and tables), fit :attr:`rate` (the coarsest when none does)."""
+        clip = Clip(self.actor, self.fps, self.source.size, [m for m, _ in self._warm], [], 0.0)
+        for quality in reversed(range(len(LADDER))):
+            self.settings = replace(self.settings, quality=quality)
+            packets = encode_clip(clip, self.settings, carry_actor=False)[2]
+            if sum(map(len, packets)) * 8 / 1000 / (len(clip.motion) / self.fps) <= self.rate:
+                return
+
     def _start(self) -> None:
-        """The warm-up is over: learn the basis and the tables' classes, start the stream."""
+        """The warm-up is over: choose the quality, learn the basis and the tables' classes, start
+        the stream."""
+        if self.quality is None:
+            self._choose_quality()
         faces = [m for m, _ in self._warm if m.face]
         m = self.settings.basis_size
         basis = Basis.learn(np.array([f.offsets for f in faces]).reshape(len(faces), -1, 2), m)
@@ -254,7 +277,7 @@ class Sender(threading.Thread):
                            for f in faces])
         classes = _core.choose_classes(steps, self.settings.hysteresis, values.reshape(len(faces), len(steps)))
         encoder = MotionEncoder(self.actor, self.fps, self.source.size, basis, self.settings, True, classes,
-                                reference=self._warm[0][0].pose, look=True)
+                                reference=self._warm[0][0].pose, look=True, actor_data=self._actor_data)
         start = encoder.start()
         header = encoder.header
         self.stats.warmup_frames, self.stats.header_bytes = len(self._warm), len(header)

@@ -269,16 +269,18 @@ def view(source: Path, actor_file: Path | None, port: int, no_browser: bool, mas
               help="NAME.actor of this person to send (default: fit one on the first frame); the stream carries it.")
 @click.option("--port", default=8766, show_default=True, type=click.IntRange(0, 65535),
               help="Local port of the page and the stream (0: any free port).")
-@click.option("--quality", default=4, show_default=True, type=click.IntRange(0, 10),
-              help="0 (coarsest) to 10 (finest); 4 is about 2 kbit/s.")
+@click.option("--quality", type=click.IntRange(0, 10),
+              help="0 (coarsest) to 10 (finest) (default: the finest whose first 2 s fit --rate).")
+@click.option("--rate", default=2.0, show_default=True, type=float,
+              help="Target rate of the motion, kbit/s, when no --quality is given.")
 @click.option("--packet", "packet_frames", default=2, show_default=True, type=click.IntRange(1, 32),
               help="Frames per packet (more: more delay, fewer bytes).")
 @click.option("--record", type=click.Path(path_type=Path), help="X.fmstream to write the stream to, as sent.")
 @click.option("--force", is_flag=True, help="Overwrite an existing recording.")
 @click.option("--no-browser", is_flag=True, help="Do not open a browser; print the address only.")
 @click.option("--loop", is_flag=True, help="Play a video file again and again, as one continuing stream.")
-def call(source: str, actor_file: Path | None, port: int, quality: int, packet_frames: int, record: Path | None,
-         force: bool, no_browser: bool, loop: bool) -> None:
+def call(source: str, actor_file: Path | None, port: int, quality: int | None, rate: float, packet_frames: int,
+         record: Path | None, force: bool, no_browser: bool, loop: bool) -> None:
     """Send the face in VIDEO_OR_CAMERA (a video file played at its own pace, or a camera's number
     such as 0) live, as a facemime stream, to receivers in a web browser on this machine. The
     first 2 s are analysed only (to learn the motion's basis); then the stream starts. Stops at
@@ -289,7 +291,7 @@ def call(source: str, actor_file: Path | None, port: int, quality: int, packet_f
     from facemime.io.actor_file import load_actor
 
     actor = load_actor(actor_file) if actor_file is not None else None
-    c = Call(source, actor, port, quality, packet_frames, record, force, loop, actor_path=actor_file)
+    c = Call(source, actor, port, quality, packet_frames, record, force, loop, actor_path=actor_file, rate=rate)
     try:
         click.echo(c.url)
         sys.stdout.flush()
@@ -306,7 +308,8 @@ def call(source: str, actor_file: Path | None, port: int, quality: int, packet_f
         delays = (f"; arrival to sending {1000 * sum(d[1] for d in s.delays) / len(s.delays):.1f} ms a packet "
                   f"from its last frame, {1000 * max(d[0] for d in s.delays):.0f} ms at most from its first"
                   if s.delays else "")
-        click.echo(f"sent {s.frames} frames ({s.warmup_frames} of warm-up not sent): motion "
+        click.echo(f"sent {s.frames} frames ({s.warmup_frames} of warm-up not sent) at quality "
+                   f"{c.sender.settings.quality}: motion "
                    f"{s.motion_kbit_s(c.sender.fps):.2f} kbit/s ({s.packet_bytes} bytes in {s.packets} packets), "
                    f"header {s.header_bytes} bytes, actor {s.actor_bytes} bytes; {s.intra_honoured} of "
                    f"{s.intra_asked} intra requests honoured; {c.hub.served} clients served{delays}", err=True)

@@ -126,12 +126,15 @@ class MotionEncoder:
     of its starting table (``facemime._core.choose_classes``; default: a middle class);
     ``reference``: the pose intra frames are coded from (default: the actor's); ``look``: the
     stream carries each frame's :class:`~facemime.animate.look.Look` (format version 2; without
-    it the stream is version 1 and the receiver decodes a neutral look).
+    it the stream is version 1 and the receiver decodes a neutral look); ``actor_data``: the
+    carried actor's file bytes when already made (:func:`~facemime.io.actor_file.actor_bytes`
+    with a WebP texture: a live sender makes them before its stream starts, as they take a few
+    hundred milliseconds).
     """
 
     def __init__(self, actor: Actor, fps: float, size: tuple[int, int], basis: Basis, settings: Settings = Settings(),
                  carry_actor: bool = True, classes: Sequence[int] | None = None, reference: Pose | None = None,
-                 look: bool = False):
+                 look: bool = False, actor_data: bytes | None = None):
         self.settings, self.basis, self.look = settings, basis, bool(look)
         m = len(basis.raw)
         steps = settings.steps(m, self.look)
@@ -145,7 +148,11 @@ class MotionEncoder:
             _fps_fraction(fps), (int(size[0]), int(size[1])), topology_id(actor.model), frames, keyframes, steps,
             references, list(classes) if classes is not None else [6] * len(steps), basis.raw,
             actor_id(actor), carry_actor, settings.hysteresis, extras)
-        self.actor_data = actor_bytes(actor, "webp", settings.texture) if carry_actor else b""
+        if not carry_actor:
+            actor_data = b""
+        elif actor_data is None:
+            actor_data = actor_bytes(actor, "webp", settings.texture)
+        self.actor_data = actor_data
 
     def start(self) -> bytes:
         """The stream's first bytes: the header, and the actor when carried."""
