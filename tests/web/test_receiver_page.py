@@ -84,6 +84,7 @@ def test_the_pages_picture_matches_the_python_decoders(page, stream):
     opening = [np.ptp(f.offsets[:, 1]) for f in frames]
     chosen = int(np.argmax(opening[20:])) + 20
     got, expected = picture(page, chosen, size), python_picture(decoder, frames, chosen)
-    # measured: 36.5 dB at frame 40 (irises not moved by the page), 75 dB on the key frame
-    assert psnr(got, expected) >= 35.0
-    assert psnr(picture(page, 0, size), python_picture(decoder, frames, 0)) >= 50.0
+    # measured: 57.4 dB on that frame (67; the issue asks for 35), 75.4 dB on the key frame; the
+    # irises not moved gave 36.5 dB on frame 40
+    assert psnr(got, expected) >= 50.0
+    assert psnr(picture(page, 0, size), python_picture(decoder, frames, 0)) >= 65.0

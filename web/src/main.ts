@@ -26,8 +26,9 @@ interface Api {
   /** Every frame the decoder output, in order (decoded and concealed). */
   frames: Shown[];
   /** Counts and figures: the decoder's stats, frames drawn, frame rate, received kbit/s,
-   * intra requests, packets dropped on purpose, latencies (ms, frame's arrival at the sender to
-   * its picture drawn), draw times (ms). */
+   * intra requests, packets dropped on purpose, the actor's set-up (ms, from its chunk to the
+   * first frame it can draw), latencies ([frame index, ms] from a frame's arrival at the sender
+   * to its picture drawn), draw times (ms). */
   stats(): Record<string, unknown>;
   /** Plays a saved stream's bytes (replacing what plays now); resolves once decoded. */
   loadStream(data: Uint8Array | string, autoplay?: boolean): Promise<void>;
@@ -85,8 +86,10 @@ class Session {
           this.build();
         } else if (e.kind === 'actor') {
           if (!this.actor) {
+            const t0 = performance.now();
             this.actor = await readActor(e.data);
             this.build();
+            counts.setupMs = performance.now() - t0;
           }
         } else if (e.kind === 'appearance') {
           const update = await readUpdate(e.payload);
@@ -140,8 +143,8 @@ function letterbox(w: number, h: number, cw: number, ch: number): number[] {
 }
 
 // --- the figures shown and exposed --------------------------------------------------------------
-const counts = { drawn: 0, intraRequests: 0, dropped: 0, refused: 0, received: 0 };
-const latencies: number[] = [];
+const counts = { drawn: 0, intraRequests: 0, dropped: 0, refused: 0, received: 0, setupMs: 0 };
+const latencies: [number, number][] = []; // (frame index, ms)
 const drawTimes: number[] = [];
 const drawnAt: number[] = [];
 const bytesAt: [number, number][] = [];
@@ -160,7 +163,7 @@ function present(frame: Frame, position: number): void {
   counts.drawn += 1;
   drawnAt.push(t1);
   const sent = arrived.get(frame.index);
-  if (sent !== undefined && !frame.concealed) latencies.push(now() - sent);
+  if (sent !== undefined && !frame.concealed) latencies.push([frame.index, now() - sent]);
   arrived.delete(frame.index);
 }
 
@@ -171,7 +174,7 @@ function updateHud(): void {
   const fps = drawnAt.length / WINDOW_S;
   const kbps = (bytesAt.reduce((s, [, b]) => s + b, 0) * 8) / 1000 / WINDOW_S;
   const s = session?.decoder.stats;
-  const lat = latencies.length ? `, latency ${median(latencies.slice(-50)).toFixed(0)} ms` : '';
+  const lat = latencies.length ? `, latency ${median(latencies.slice(-50).map((l) => l[1])).toFixed(0)} ms` : '';
   hud.textContent = `${fps.toFixed(1)} frames/s drawn · ${kbps.toFixed(2)} kbit/s received · `
     + `${s?.concealed ?? 0} frames concealed (${s?.lost_packets ?? 0} packets lost)${lat}`;
 }

@@ -901,6 +901,976 @@ void main() {
     return { yaw: v2[0], pitch: v2[1], roll: v2[2], scale: Math.exp(v2[3]), tx: v2[4], ty: v2[5] };
   }
 
+  // src/imaging/filters.ts
+  function rint(x2) {
+    const f = Math.floor(x2), d = x2 - f;
+    if (d > 0.5) return f + 1;
+    if (d < 0.5) return f;
+    return f % 2 === 0 ? f : f + 1;
+  }
+  function reflect101(p, len) {
+    if (len === 1) return 0;
+    while (p < 0 || p >= len) p = p < 0 ? -p : 2 * len - 2 - p;
+    return p;
+  }
+  var clampIndex = (p, len) => p < 0 ? 0 : p >= len ? len - 1 : p;
+  function erodeEllipse(src, w, h, k) {
+    const r = k >> 1, c = k >> 1;
+    const half = [];
+    for (let i2 = 0; i2 < k; i2++) {
+      const dy = i2 - r;
+      const dx = rint(c * Math.sqrt((r * r - dy * dy) / (r * r)));
+      const j1 = Math.max(c - dx, 0), j2 = Math.min(c + dx + 1, k);
+      half.push(j2 > j1 ? Math.min(c - j1, j2 - 1 - c) : -1);
+    }
+    const runs = [src];
+    const most = Math.max(...half);
+    for (let m = 1; m <= most; m++) {
+      const prev = runs[m - 1], next = new Float32Array(w * h);
+      for (let y = 0; y < h; y++) {
+        const o = y * w;
+        for (let x2 = 0; x2 < w; x2++) {
+          let v2 = prev[o + x2];
+          if (x2 - m >= 0 && src[o + x2 - m] < v2) v2 = src[o + x2 - m];
+          if (x2 + m < w && src[o + x2 + m] < v2) v2 = src[o + x2 + m];
+          next[o + x2] = v2;
+        }
+      }
+      runs.push(next);
+    }
+    const out = new Float32Array(w * h).fill(Infinity);
+    for (let i2 = 0; i2 < k; i2++) {
+      if (half[i2] < 0) continue;
+      const run = runs[half[i2]], dy = i2 - r;
+      for (let y = Math.max(0, -dy); y < Math.min(h, h - dy); y++) {
+        const o = y * w, q = (y + dy) * w;
+        for (let x2 = 0; x2 < w; x2++) if (run[q + x2] < out[o + x2]) out[o + x2] = run[q + x2];
+      }
+    }
+    return out;
+  }
+  var gaussianSize = (sigma) => rint(sigma * 4 * 2 + 1) | 1;
+  function gaussianBlur(src, w, h, ch, sigma, [x0, y0, x1, y1]) {
+    const n = gaussianSize(sigma), half = n >> 1;
+    const kernel = new Float64Array(n);
+    let sum2 = 0;
+    for (let i2 = 0; i2 < n; i2++) {
+      const x2 = i2 - (n - 1) * 0.5;
+      kernel[i2] = Math.exp(-0.5 / (sigma * sigma) * x2 * x2);
+      sum2 += kernel[i2];
+    }
+    for (let i2 = 0; i2 < n; i2++) kernel[i2] = Math.fround(kernel[i2] / sum2);
+    const out = new Float32Array(w * h * ch);
+    if (x1 <= x0 || y1 <= y0) return out;
+    const span = (x1 - x0) * ch;
+    const rows = /* @__PURE__ */ new Map();
+    const pad = new Float32Array((x1 - x0 + 2 * half) * ch), acc = new Float64Array(span);
+    const filtered = (y) => {
+      let row = rows.get(y);
+      if (row) return row;
+      for (let x2 = 0; x2 < x1 - x0 + 2 * half; x2++) {
+        const from = (y * w + reflect101(x0 + x2 - half, w)) * ch;
+        for (let c = 0; c < ch; c++) pad[x2 * ch + c] = src[from + c];
+      }
+      const along = new Float64Array(span);
+      for (let i2 = 0; i2 < n; i2++) {
+        const kv = kernel[i2], o = i2 * ch;
+        for (let q = 0; q < span; q++) along[q] += kv * pad[o + q];
+      }
+      row = Float32Array.from(along);
+      rows.set(y, row);
+      return row;
+    };
+    for (let y = y0; y < y1; y++) {
+      acc.fill(0);
+      for (let i2 = 0; i2 < n; i2++) {
+        const kv = kernel[i2], row = filtered(reflect101(y + i2 - half, h));
+        for (let q = 0; q < span; q++) acc[q] += kv * row[q];
+      }
+      out.set(acc, (y * w + x0) * ch);
+    }
+    return out;
+  }
+  function percentile(a, q) {
+    a.sort();
+    const at = q / 100 * (a.length - 1), lo = Math.floor(at), t = at - lo;
+    if (lo + 1 >= a.length) return a[a.length - 1];
+    const d = a[lo + 1] - a[lo];
+    return t >= 0.5 ? a[lo + 1] - d * (1 - t) : a[lo] + d * t;
+  }
+  function median(a) {
+    a.sort();
+    const m = a.length >> 1;
+    return a.length % 2 ? a[m] : (a[m - 1] + a[m]) / 2;
+  }
+
+  // src/imaging/inpaint.ts
+  var KNOWN = 0;
+  var BAND = 1;
+  var INSIDE = 2;
+  var CHANGE = 3;
+  var MarchQueue = class {
+    constructor(capacity) {
+      this.size = 0;
+      this.count = 0;
+      this.t = new Float64Array(capacity);
+      this.seq = new Float64Array(capacity);
+      this.at = new Int32Array(capacity);
+    }
+    less(a, b) {
+      return this.t[a] < this.t[b] || this.t[a] === this.t[b] && this.seq[a] < this.seq[b];
+    }
+    swap(a, b) {
+      const { t, seq, at } = this;
+      const tt = t[a], ts = seq[a], ta = at[a];
+      t[a] = t[b];
+      seq[a] = seq[b];
+      at[a] = at[b];
+      t[b] = tt;
+      seq[b] = ts;
+      at[b] = ta;
+    }
+    push(index, t) {
+      let n = this.size++;
+      this.t[n] = t;
+      this.seq[n] = this.count++;
+      this.at[n] = index;
+      while (n > 0) {
+        const p = n - 1 >> 1;
+        if (!this.less(n, p)) break;
+        this.swap(n, p);
+        n = p;
+      }
+    }
+    /** The index (row * cols + col) of the element popped. */
+    pop() {
+      const top = this.at[0];
+      const last = --this.size;
+      this.t[0] = this.t[last];
+      this.seq[0] = this.seq[last];
+      this.at[0] = this.at[last];
+      let n = 0;
+      for (; ; ) {
+        const l = 2 * n + 1, r = l + 1;
+        let m = n;
+        if (l < last && this.less(l, m)) m = l;
+        if (r < last && this.less(r, m)) m = r;
+        if (m === n) break;
+        this.swap(n, m);
+        n = m;
+      }
+      return top;
+    }
+  };
+  function solve(i1, j1, i2, j2, f, t, ec2) {
+    const a11 = t[i1 * ec2 + j1], a22 = t[i2 * ec2 + j2], m12 = Math.min(a11, a22);
+    let sol;
+    if (f[i1 * ec2 + j1] !== INSIDE) {
+      if (f[i2 * ec2 + j2] !== INSIDE) {
+        sol = Math.abs(a11 - a22) >= 1 ? 1 + m12 : (a11 + a22 + Math.sqrt(2 - (a11 - a22) * (a11 - a22))) * 0.5;
+      } else sol = 1 + a11;
+    } else if (f[i2 * ec2 + j2] !== INSIDE) sol = 1 + a22;
+    else sol = 1 + m12;
+    return Math.fround(sol);
+  }
+  function solve4(i2, j, f, t, ec2) {
+    return Math.min(
+      solve(i2 - 1, j, i2, j - 1, f, t, ec2),
+      solve(i2 + 1, j, i2, j - 1, f, t, ec2),
+      solve(i2 - 1, j, i2, j + 1, f, t, ec2),
+      solve(i2 + 1, j, i2, j + 1, f, t, ec2)
+    );
+  }
+  function dilate(src, er, ec2, r, cross = false) {
+    const at = (i2, j) => i2 >= 0 && i2 < er && j >= 0 && j < ec2 ? src[i2 * ec2 + j] : 0;
+    const out = new Uint8Array(er * ec2);
+    if (cross) {
+      for (let i2 = 0; i2 < er; i2++) {
+        for (let j = 0; j < ec2; j++) out[i2 * ec2 + j] = Math.max(at(i2, j), at(i2 - 1, j), at(i2 + 1, j), at(i2, j - 1), at(i2, j + 1));
+      }
+      return out;
+    }
+    const rows = new Uint8Array(er * ec2);
+    for (let i2 = 0; i2 < er; i2++) {
+      for (let j = 0; j < ec2; j++) {
+        let m = 0;
+        for (let d = Math.max(0, j - r); d <= Math.min(ec2 - 1, j + r); d++) if (src[i2 * ec2 + d] > m) m = src[i2 * ec2 + d];
+        rows[i2 * ec2 + j] = m;
+      }
+    }
+    for (let i2 = 0; i2 < er; i2++) {
+      for (let j = 0; j < ec2; j++) {
+        let m = 0;
+        for (let d = Math.max(0, i2 - r); d <= Math.min(er - 1, i2 + r); d++) if (rows[d * ec2 + j] > m) m = rows[d * ec2 + j];
+        out[i2 * ec2 + j] = m;
+      }
+    }
+    return out;
+  }
+  function zeroBorder(a, er, ec2) {
+    a.fill(0, 0, ec2);
+    a.fill(0, (er - 1) * ec2, er * ec2);
+    for (let i2 = 1; i2 < er - 1; i2++) a[i2 * ec2] = a[i2 * ec2 + ec2 - 1] = 0;
+  }
+  function inpaintTelea(img, mask, w, h, inpaintRange) {
+    const range = Math.min(Math.max(rint(inpaintRange), 1), 100);
+    const ec2 = w + 2, er = h + 2;
+    const f = new Uint8Array(er * ec2);
+    for (let y = 0; y < h; y++) for (let x2 = 0; x2 < w; x2++) if (mask[y * w + x2]) f[(y + 1) * ec2 + x2 + 1] = INSIDE;
+    zeroBorder(f, er, ec2);
+    const t = new Float32Array(er * ec2).fill(1e6);
+    const band = dilate(f, er, ec2, 1, true);
+    for (let k = 0; k < band.length; k++) band[k] = Math.max(band[k] - f[k], 0);
+    zeroBorder(band, er, ec2);
+    const heap = new MarchQueue(er * ec2);
+    for (let k = 0; k < band.length; k++) if (band[k]) {
+      heap.push(k, 0);
+      t[k] = 0;
+    }
+    if (heap.size === 0) return;
+    const out = dilate(f, er, ec2, range);
+    for (let k = 0; k < out.length; k++) out[k] = Math.max(out[k] - f[k], 0);
+    const outer = new MarchQueue(er * ec2);
+    for (let k = 0; k < band.length; k++) if (band[k]) outer.push(k, 0);
+    for (let k = 0; k < out.length; k++) out[k] = Math.max(out[k] - band[k], 0);
+    zeroBorder(out, er, ec2);
+    while (outer.size) {
+      const at = outer.pop(), ii = Math.floor(at / ec2), jj = at - ii * ec2;
+      out[at] = CHANGE;
+      for (let q = 0; q < 4; q++) {
+        const i2 = q === 0 ? ii - 1 : q === 2 ? ii + 1 : ii, j = q === 1 ? jj - 1 : q === 3 ? jj + 1 : jj;
+        if (i2 <= 0 || j <= 0 || i2 >= er || j >= ec2) continue;
+        if (out[i2 * ec2 + j] === INSIDE) {
+          const dist2 = solve4(i2, j, out, t, ec2);
+          t[i2 * ec2 + j] = dist2;
+          out[i2 * ec2 + j] = BAND;
+          outer.push(i2 * ec2 + j, dist2);
+        }
+      }
+    }
+    for (let k = 0; k < out.length; k++) if (out[k] === CHANGE) t[k] = -t[k];
+    const fr = Math.fround;
+    const side = 2 * range + 1;
+    const reach = new Int32Array(side), dst = new Float32Array(side * side);
+    for (let dk = -range; dk <= range; dk++) {
+      while ((reach[dk + range] + 1) ** 2 + dk * dk <= range * range) reach[dk + range]++;
+      for (let dl = -range; dl <= range; dl++) {
+        const len = dk * dk + dl * dl;
+        dst[(dk + range) * side + dl + range] = fr(1 / (len * Math.sqrt(len)));
+      }
+    }
+    const ia = new Float64Array(3), jx = new Float64Array(3), jy = new Float64Array(3);
+    const rowStep = w * 3;
+    while (heap.size) {
+      const at = heap.pop(), ii = Math.floor(at / ec2), jj = at - ii * ec2;
+      f[at] = KNOWN;
+      for (let q = 0; q < 4; q++) {
+        const i2 = q === 0 ? ii - 1 : q === 2 ? ii + 1 : ii, j = q === 1 ? jj - 1 : q === 3 ? jj + 1 : jj;
+        if (i2 <= 1 || j <= 1 || i2 > er - 1 || j > ec2 - 1) continue;
+        const ij = i2 * ec2 + j;
+        if (f[ij] !== INSIDE) continue;
+        const dist2 = solve4(i2, j, f, t, ec2);
+        t[ij] = dist2;
+        let gtx, gty;
+        if (f[ij + 1] !== INSIDE) gtx = f[ij - 1] !== INSIDE ? fr(fr(t[ij + 1] - t[ij - 1]) * 0.5) : fr(t[ij + 1] - t[ij]);
+        else gtx = f[ij - 1] !== INSIDE ? fr(t[ij] - t[ij - 1]) : 0;
+        if (f[ij + ec2] !== INSIDE) gty = f[ij - ec2] !== INSIDE ? fr(fr(t[ij + ec2] - t[ij - ec2]) * 0.5) : fr(t[ij + ec2] - t[ij]);
+        else gty = f[ij - ec2] !== INSIDE ? fr(t[ij] - t[ij - ec2]) : 0;
+        ia.fill(0);
+        jx.fill(0);
+        jy.fill(0);
+        let s = fr(1e-20);
+        const tij = t[ij];
+        for (let k = Math.max(i2 - range, 1); k <= Math.min(i2 + range, er - 2); k++) {
+          const ry = i2 - k, half = reach[k - i2 + range], drow = (k - i2 + range) * side + range - j;
+          const km = k - 1 + +(k === 1), kp = k - 1 - +(k === er - 2), rowM = km * rowStep;
+          const fry = fr(ry * gty);
+          for (let l = Math.max(j - half, 1); l <= Math.min(j + half, ec2 - 2); l++) {
+            const kl = k * ec2 + l;
+            if (f[kl] === INSIDE) continue;
+            const rx = j - l;
+            const lev = fr(1 / fr(1 + Math.abs(fr(t[kl] - tij))));
+            let dir = fr(fr(rx * gtx) + fry);
+            if (Math.abs(dir) <= 0.01) dir = fr(1e-6);
+            const wt = Math.abs(fr(fr(dst[drow + l] * lev) * dir));
+            const lm = l - 1 + +(l === 1), lp = l - 1 - +(l === ec2 - 2);
+            const right = f[kl + 1] !== INSIDE, left = f[kl - 1] !== INSIDE;
+            const below = f[kl + ec2] !== INSIDE, above = f[kl - ec2] !== INSIDE;
+            const here = (km * w + lm) * 3;
+            for (let c = 0; c < 3; c++) {
+              let gx, gy;
+              if (right) {
+                gx = left ? (img[rowM + (lp + 1) * 3 + c] - img[here - 3 + c]) * 2 : img[rowM + (lp + 1) * 3 + c] - img[here + c];
+              } else gx = left ? img[rowM + lp * 3 + c] - img[here - 3 + c] : 0;
+              if (below) {
+                gy = above ? (img[(kp + 1) * rowStep + lm * 3 + c] - img[here - rowStep + c]) * 2 : img[(kp + 1) * rowStep + lm * 3 + c] - img[here + c];
+              } else gy = above ? img[kp * rowStep + lm * 3 + c] - img[here - rowStep + c] : 0;
+              ia[c] = fr(ia[c] + fr(wt * img[here + c]));
+              jx[c] = fr(jx[c] - fr(wt * fr(gx * rx)));
+              jy[c] = fr(jy[c] - fr(wt * fr(gy * ry)));
+            }
+            s = fr(s + wt);
+          }
+        }
+        for (let c = 0; c < 3; c++) {
+          const norm = fr(fr(Math.sqrt(fr(fr(jx[c] * jx[c]) + fr(jy[c] * jy[c])))) + fr(1e-20));
+          const sat = fr(fr(fr(ia[c] / s) + fr(fr(jx[c] + jy[c]) / norm)) + 0.5);
+          img[((i2 - 1) * w + j - 1) * 3 + c] = Math.min(Math.max(rint(sat), 0), 255);
+        }
+        f[ij] = BAND;
+        heap.push(ij, dist2);
+      }
+    }
+  }
+
+  // src/imaging/polygon.ts
+  var XY_SHIFT = 16;
+  var XY_ONE = 1 << XY_SHIFT;
+  var SLOPE_CORR = [
+    181,
+    181,
+    181,
+    182,
+    182,
+    183,
+    184,
+    185,
+    187,
+    188,
+    190,
+    192,
+    194,
+    196,
+    198,
+    201,
+    203,
+    206,
+    209,
+    211,
+    214,
+    218,
+    221,
+    224,
+    227,
+    231,
+    235,
+    238,
+    242,
+    246,
+    250,
+    254
+  ];
+  var FILTER = [
+    168,
+    177,
+    185,
+    194,
+    202,
+    210,
+    218,
+    224,
+    231,
+    236,
+    241,
+    246,
+    249,
+    252,
+    254,
+    254,
+    254,
+    254,
+    252,
+    249,
+    246,
+    241,
+    236,
+    231,
+    224,
+    218,
+    210,
+    202,
+    194,
+    185,
+    177,
+    168,
+    158,
+    149,
+    140,
+    131,
+    122,
+    114,
+    105,
+    97,
+    89,
+    82,
+    75,
+    68,
+    62,
+    56,
+    50,
+    45,
+    40,
+    36,
+    32,
+    28,
+    25,
+    22,
+    19,
+    16,
+    14,
+    12,
+    11,
+    9,
+    8,
+    7,
+    5,
+    5
+  ];
+  var sar = (v2, s) => Math.floor(v2 / 2 ** s);
+  function clipLine(width, height, p) {
+    const right = width - 1, bottom = height - 1;
+    if (width <= 0 || height <= 0) return false;
+    let [x1, y1, x2, y2] = p;
+    let c1 = +(x1 < 0) + +(x1 > right) * 2 + +(y1 < 0) * 4 + +(y1 > bottom) * 8;
+    let c2 = +(x2 < 0) + +(x2 > right) * 2 + +(y2 < 0) * 4 + +(y2 > bottom) * 8;
+    if ((c1 & c2) === 0 && (c1 | c2) !== 0) {
+      if (c1 & 12) {
+        const a = c1 < 8 ? 0 : bottom;
+        x1 += Math.trunc((a - y1) * (x2 - x1) / (y2 - y1));
+        y1 = a;
+        c1 = +(x1 < 0) + +(x1 > right) * 2;
+      }
+      if (c2 & 12) {
+        const a = c2 < 8 ? 0 : bottom;
+        x2 += Math.trunc((a - y2) * (x2 - x1) / (y2 - y1));
+        y2 = a;
+        c2 = +(x2 < 0) + +(x2 > right) * 2;
+      }
+      if ((c1 & c2) === 0 && (c1 | c2) !== 0) {
+        if (c1) {
+          const a = c1 === 1 ? 0 : right;
+          y1 += Math.trunc((a - x1) * (y2 - y1) / (x2 - x1));
+          x1 = a;
+          c1 = 0;
+        }
+        if (c2) {
+          const a = c2 === 1 ? 0 : right;
+          y2 += Math.trunc((a - x2) * (y2 - y1) / (x2 - x1));
+          x2 = a;
+          c2 = 0;
+        }
+      }
+    }
+    p[0] = x1;
+    p[1] = y1;
+    p[2] = x2;
+    p[3] = y2;
+    return (c1 | c2) === 0;
+  }
+  function lineAA(img, w, h, ax0, ay0, ax1, ay1) {
+    const p = [ax0 - 2 * XY_ONE, ay0 - 2 * XY_ONE, ax1 - 2 * XY_ONE, ay1 - 2 * XY_ONE];
+    if (!clipLine((w - 5) * XY_ONE + 1, (h - 5) * XY_ONE + 1, p)) return;
+    let [x1, y1, x2, y2] = p;
+    let dx = x2 - x1, dy = y2 - y1;
+    const ax = Math.abs(dx), ay = Math.abs(dy);
+    let xStep, yStep, ecount, slope, i2, j;
+    const horizontal = ax > ay;
+    if (horizontal) {
+      if (dx < 0) {
+        dy = -dy;
+        [x1, x2] = [x2, x1];
+        [y1, y2] = [y2, y1];
+      }
+      xStep = XY_ONE;
+      yStep = Math.trunc(dy * XY_ONE / (ax | 1));
+      x2 += XY_ONE;
+      ecount = sar(x2, XY_SHIFT) - sar(x1, XY_SHIFT);
+      j = -(x1 - sar(x1, XY_SHIFT) * XY_ONE);
+      y1 += sar(yStep * j, XY_SHIFT) + (XY_ONE >> 1);
+      slope = sar(yStep, XY_SHIFT - 5) & 63;
+      slope ^= yStep < 0 ? 63 : 0;
+      i2 = sar(x1, XY_SHIFT - 7) & 120;
+      j = sar(x2, XY_SHIFT - 7) & 120;
+    } else {
+      if (dy < 0) {
+        dx = -dx;
+        [x1, x2] = [x2, x1];
+        [y1, y2] = [y2, y1];
+      }
+      xStep = Math.trunc(dx * XY_ONE / (ay | 1));
+      yStep = XY_ONE;
+      y2 += XY_ONE;
+      ecount = sar(y2, XY_SHIFT) - sar(y1, XY_SHIFT);
+      j = -(y1 - sar(y1, XY_SHIFT) * XY_ONE);
+      x1 += sar(xStep * j, XY_SHIFT) + (XY_ONE >> 1);
+      slope = sar(xStep, XY_SHIFT - 5) & 63;
+      slope ^= xStep < 0 ? 63 : 0;
+      i2 = sar(y1, XY_SHIFT - 7) & 120;
+      j = sar(y2, XY_SHIFT - 7) & 120;
+    }
+    slope = slope & 32 ? 256 : SLOPE_CORR[slope];
+    const ep = new Array(9);
+    {
+      const t0 = slope << 7, t1 = (120 - i2 | 4) * slope, t2 = (j | 4) * slope;
+      ep[0] = 0;
+      ep[8] = slope;
+      ep[1] = ep[3] = (j - i2 & 120 | 4) * slope >> 8 & 511;
+      ep[2] = t1 >> 8 & 511;
+      ep[4] = (j - i2 + 128 | 4) * slope >> 8 & 511;
+      ep[5] = t1 + t0 >> 8 & 511;
+      ep[6] = t2 >> 8 & 511;
+      ep[7] = t2 + t0 >> 8 & 511;
+    }
+    const put = (at, a) => {
+      for (let n = 0; n < 2; n++) img[at] += (255 - img[at]) * a + 127 >> 8;
+    };
+    const index = (n) => n >= 2 ? 2 : n;
+    let scount = 0;
+    if (horizontal) {
+      let col = sar(x1, XY_SHIFT) + 2;
+      while (ecount >= 0) {
+        const row = sar(y1, XY_SHIFT) - 1 + 2;
+        const corr = ep[index(scount) * 3 + index(ecount)];
+        const dist2 = sar(y1, XY_SHIFT - 5) & 31;
+        put(row * w + col, corr * FILTER[dist2 + 32] >> 8 & 255);
+        put((row + 1) * w + col, corr * FILTER[dist2] >> 8 & 255);
+        put((row + 2) * w + col, corr * FILTER[63 - dist2] >> 8 & 255);
+        y1 += yStep;
+        col++;
+        scount++;
+        ecount--;
+      }
+    } else {
+      let row = sar(y1, XY_SHIFT) + 2;
+      while (ecount >= 0) {
+        const col = sar(x1, XY_SHIFT) - 1 + 2;
+        const corr = ep[index(scount) * 3 + index(ecount)];
+        const dist2 = sar(x1, XY_SHIFT - 5) & 31;
+        put(row * w + col, corr * FILTER[dist2 + 32] >> 8 & 255);
+        put(row * w + col + 1, corr * FILTER[dist2] >> 8 & 255);
+        put(row * w + col + 2, corr * FILTER[63 - dist2] >> 8 & 255);
+        x1 += xStep;
+        row++;
+        scount++;
+        ecount--;
+      }
+    }
+  }
+  function fillPolyAA(img, w, h, pts, shift) {
+    const count = pts.length / 2;
+    const delta = 1 << shift >> 1;
+    const edges = [];
+    let p0x = pts[2 * count - 2] * 2 ** (XY_SHIFT - shift), p0y = sar(pts[2 * count - 1] + delta, shift);
+    for (let i3 = 0; i3 < count; i3++) {
+      const p1x = pts[2 * i3] * 2 ** (XY_SHIFT - shift), p1y = sar(pts[2 * i3 + 1] + delta, shift);
+      lineAA(img, w, h, p0x, p0y * XY_ONE, p1x, p1y * XY_ONE);
+      if (p0y !== p1y) {
+        const up = p0y < p1y;
+        edges.push({
+          y0: up ? p0y : p1y,
+          y1: up ? p1y : p0y,
+          x: up ? p0x : p1x,
+          dx: Math.trunc((p1x - p0x) / (p1y - p0y)),
+          next: null
+        });
+      }
+      p0x = p1x;
+      p0y = p1y;
+    }
+    const total = edges.length;
+    if (total < 2) return;
+    let yMax = -Infinity, yMin = Infinity, xMax = -Infinity, xMin = Infinity;
+    for (const e1 of edges) {
+      const xEnd = e1.x + (e1.y1 - e1.y0) * e1.dx;
+      yMin = Math.min(yMin, e1.y0);
+      yMax = Math.max(yMax, e1.y1);
+      xMin = Math.min(xMin, e1.x, xEnd);
+      xMax = Math.max(xMax, e1.x, xEnd);
+    }
+    if (yMax < 0 || yMin >= h || xMax < 0 || xMin >= w * XY_ONE) return;
+    edges.sort((a, b) => a.y0 !== b.y0 ? a.y0 - b.y0 : a.x !== b.x ? a.x - b.x : a.dx - b.dx);
+    edges.push({ y0: 2 ** 31 - 1, y1: 0, x: 0, dx: 0, next: null });
+    const tmp = { y0: 2 ** 31 - 1, y1: 0, x: 0, dx: 0, next: null };
+    let i2 = 0;
+    let e = edges[0];
+    yMax = Math.min(yMax, h);
+    for (let y = e.y0; y < yMax; y++) {
+      let prelast = tmp, last = tmp.next, keep;
+      let sortFlag = false, draw = false;
+      const clip = y < 0;
+      while (last || e.y0 === y) {
+        if (last && last.y1 === y) {
+          prelast.next = last.next;
+          last = last.next;
+          continue;
+        }
+        keep = prelast;
+        if (last && (e.y0 > y || last.x < e.x)) {
+          prelast = last;
+          last = last.next;
+        } else if (i2 < total) {
+          prelast.next = e;
+          e.next = last;
+          prelast = e;
+          e = edges[++i2];
+        } else break;
+        if (draw) {
+          if (!clip) {
+            let x1, x2;
+            if (keep.x > prelast.x) {
+              x1 = sar(prelast.x + XY_ONE - 1, XY_SHIFT);
+              x2 = sar(keep.x, XY_SHIFT);
+            } else {
+              x1 = sar(keep.x + XY_ONE - 1, XY_SHIFT);
+              x2 = sar(prelast.x, XY_SHIFT);
+            }
+            if (x1 < w && x2 >= 0) {
+              x1 = Math.max(x1, 0);
+              x2 = Math.min(x2, w - 1);
+              if (x2 >= x1) img.fill(255, y * w + x1, y * w + x2 + 1);
+            }
+          }
+          keep.x += keep.dx;
+          prelast.x += prelast.dx;
+        }
+        draw = !draw;
+      }
+      keep = null;
+      do {
+        prelast = tmp;
+        last = tmp.next;
+        while (last !== keep && last !== null && last.next !== null) {
+          const te = last.next;
+          if (last.x > te.x) {
+            prelast.next = te;
+            last.next = te.next;
+            te.next = last;
+            prelast = te;
+            sortFlag = true;
+          } else {
+            prelast = last;
+            last = te;
+          }
+        }
+        keep = prelast;
+      } while (sortFlag && keep !== tmp.next && keep !== tmp);
+    }
+  }
+
+  // src/render/eyes.ts
+  var EYES = ["eye_right", "eye_left"];
+  var DENSITY = 20;
+  var SPAN_U = [-0.7, 0.7];
+  var SPAN_V = [-0.55, 0.55];
+  var IRIS_RADIUS = 0.21;
+  var LID_EDGE = 0.04;
+  var IRIS_U = 0.32;
+  var IRIS_V = [-0.2, 0.2];
+  var STILL = 0.25;
+  var IRIS_REACH = 1.15;
+  var EyeFrame = class _EyeFrame {
+    constructor(origin, axes) {
+      this.origin = origin;
+      this.axes = axes;
+    }
+    /** The frame of an eye ring of 8 points (corner, 3 upper, corner, 3 lower), px (x, y) pairs. */
+    static of(ring) {
+      const [a, b] = ring[0] <= ring[8] ? [0, 8] : [8, 0];
+      const ex = ring[b] - ring[a], ey = ring[b + 1] - ring[a + 1];
+      return new _EyeFrame([(ring[a] + ring[b]) / 2, (ring[a + 1] + ring[b + 1]) / 2], [ex, ey, -ey, ex]);
+    }
+    /** The eye's width, px. */
+    get width() {
+      return Math.hypot(this.axes[0], this.axes[1]);
+    }
+    /** Texture (x, y) px of eye coordinates (u, v). */
+    toImage(u4, v2) {
+      const a = this.axes;
+      return [this.origin[0] + (u4 * a[0] + v2 * a[2]), this.origin[1] + (u4 * a[1] + v2 * a[3])];
+    }
+  };
+  var PATCH_ROWS = rint((SPAN_V[1] - SPAN_V[0]) * DENSITY) + 1;
+  var PATCH_COLS = rint((SPAN_U[1] - SPAN_U[0]) * DENSITY) + 1;
+  var uOf = (col) => SPAN_U[0] + col / DENSITY;
+  var vOf = (row) => SPAN_V[0] + row / DENSITY;
+  var colOf = (u4) => rint((u4 - SPAN_U[0]) * DENSITY);
+  var rowOf = (v2) => rint((v2 - SPAN_V[0]) * DENSITY);
+  function eyePatch(tex, frame) {
+    const a = frame.axes;
+    const start = frame.toImage(SPAN_U[0], SPAN_V[0]);
+    const m = [a[0] / DENSITY, a[2] / DENSITY, start[0], a[1] / DENSITY, a[3] / DENSITY, start[1]];
+    const { width: w, height: h, rgba } = tex;
+    const out = new Float64Array(PATCH_ROWS * PATCH_COLS);
+    const rgb = [0, 0, 0];
+    for (let r = 0; r < PATCH_ROWS; r++) {
+      const x0 = rint((m[1] * r + m[2]) * 1024) + 16, y0 = rint((m[4] * r + m[5]) * 1024) + 16;
+      for (let c = 0; c < PATCH_COLS; c++) {
+        const X = x0 + rint(m[0] * c * 1024) >> 5, Y = y0 + rint(m[3] * c * 1024) >> 5;
+        const sx = X >> 5, sy = Y >> 5, fx = X & 31, fy = Y & 31;
+        const xa = clampIndex(sx, w), xb = clampIndex(sx + 1, w), ya = clampIndex(sy, h), yb = clampIndex(sy + 1, h);
+        const w00 = (32 - fx) * (32 - fy), w01 = fx * (32 - fy), w10 = (32 - fx) * fy, w11 = fx * fy;
+        for (let k = 0; k < 3; k++) {
+          const s = w00 * rgba[(ya * w + xa) * 4 + k] + w01 * rgba[(ya * w + xb) * 4 + k] + w10 * rgba[(yb * w + xa) * 4 + k] + w11 * rgba[(yb * w + xb) * 4 + k];
+          rgb[k] = s + 512 >> 10;
+        }
+        out[r * PATCH_COLS + c] = rgb[0] * 4899 + rgb[1] * 9617 + rgb[2] * 1868 + 8192 >> 14;
+      }
+    }
+    return out;
+  }
+  function peak(values, i2) {
+    if (i2 > 0 && i2 < values.length - 1) {
+      const a = values[i2 - 1], b = values[i2], c = values[i2 + 1];
+      const d = a - 2 * b + c;
+      if (d !== 0) return i2 + Math.min(Math.max(0.5 * (a - c) / d, -0.5), 0.5);
+    }
+    return i2;
+  }
+  function findIris(patch) {
+    const rows = PATCH_ROWS, cols = PATCH_COLS;
+    const rad = IRIS_RADIUS * DENSITY;
+    const kr = Math.ceil(rad);
+    const taps = [];
+    for (let y = -kr; y <= kr; y++) for (let x2 = -kr; x2 <= kr; x2++) if (x2 * x2 + y * y <= rad * rad) taps.push(y, x2);
+    const n = taps.length / 2;
+    const inside = new Float64Array(rows * cols);
+    for (let r = 0; r < rows; r++) {
+      for (let c = 0; c < cols; c++) {
+        let s = 0;
+        for (let t = 0; t < taps.length; t += 2) {
+          s += patch[clampIndex(r + taps[t], rows) * cols + clampIndex(c + taps[t + 1], cols)];
+        }
+        inside[r * cols + c] = s / n;
+      }
+    }
+    const side = rint(0.6 * rad), tall = rint(1.2 * rad);
+    const ax = side >> 1, ay = tall >> 1;
+    const box = new Float64Array(rows * cols);
+    for (let r = 0; r < rows; r++) {
+      for (let c = 0; c < cols; c++) {
+        let s = 0;
+        for (let y = 0; y < tall; y++) {
+          for (let x2 = 0; x2 < side; x2++) s += patch[clampIndex(r + y - ay, rows) * cols + clampIndex(c + x2 - ax, cols)];
+        }
+        box[r * cols + c] = s / (side * tall);
+      }
+    }
+    const shift = rint(rad + side / 2);
+    const beside = new Float64Array(rows * cols);
+    for (let r = 0; r < rows; r++) {
+      const o = r * cols;
+      for (let c = shift; c < cols - shift; c++) beside[o + c] = 0.5 * (box[o + c - shift] + box[o + c + shift]);
+      for (let c = 0; c < shift; c++) beside[o + c] = beside[o + shift];
+      for (let c = cols - shift; c < cols; c++) beside[o + c] = beside[o + cols - shift - 1];
+    }
+    const r0 = rowOf(IRIS_V[0]), r1 = rowOf(IRIS_V[1]), c0 = colOf(-IRIS_U), c1 = colOf(IRIS_U);
+    const score = (r, c) => inside[r * cols + c] - 0.5 * beside[r * cols + c];
+    let best = Infinity, br = r0, bc4 = c0;
+    for (let r = r0; r <= r1; r++) {
+      for (let c = c0; c <= c1; c++) {
+        const s = score(r, c);
+        if (s < best) {
+          best = s;
+          br = r;
+          bc4 = c;
+        }
+      }
+    }
+    const across = [], down = [];
+    for (let c = c0; c <= c1; c++) across.push(score(br, c));
+    for (let r = r0; r <= r1; r++) down.push(score(r, bc4));
+    return [uOf(c0 + peak(across, bc4 - c0)), vOf(r0 + peak(down, br - r0))];
+  }
+  var Eye = class {
+    /** The eye of `tex` whose ring (8 points, (x, y) px pairs) is `ring`. */
+    constructor(tex, ring) {
+      const frame = EyeFrame.of(ring);
+      this.frame = frame;
+      const ew = frame.width;
+      let lx = Infinity, ly = Infinity, hx = -Infinity, hy = -Infinity;
+      for (const u4 of SPAN_U) {
+        for (const v2 of SPAN_V) {
+          const [x2, y] = frame.toImage(u4, v2);
+          lx = Math.min(lx, x2);
+          ly = Math.min(ly, y);
+          hx = Math.max(hx, x2);
+          hy = Math.max(hy, y);
+        }
+      }
+      const x0 = Math.max(Math.floor(lx), 0), y0 = Math.max(Math.floor(ly), 0);
+      const x1 = Math.min(Math.ceil(hx) + 1, tex.width), y1 = Math.min(Math.ceil(hy) + 1, tex.height);
+      this.x0 = x0;
+      this.y0 = y0;
+      this.x1 = x1;
+      this.y1 = y1;
+      const w = Math.max(x1 - x0, 0), h = Math.max(y1 - y0, 0), n = w * h;
+      const region = new Uint8Array(n * 3);
+      this.key = new Uint8Array(n * 4);
+      for (let y = 0; y < h; y++) {
+        const row = tex.rgba.subarray(((y0 + y) * tex.width + x0) * 4, ((y0 + y) * tex.width + x1) * 4);
+        this.key.set(row, y * w * 4);
+        for (let x2 = 0; x2 < w; x2++) for (let c = 0; c < 3; c++) region[(y * w + x2) * 3 + c] = row[x2 * 4 + c];
+      }
+      this.irisUv = findIris(eyePatch(tex, frame));
+      const centre = frame.toImage(this.irisUv[0], this.irisUv[1]);
+      const cx = centre[0] - x0, cy = centre[1] - y0;
+      this.radius = 0.21 * ew * IRIS_REACH;
+      this.disc = new Float64Array(n);
+      for (let y = 0; y < h; y++) {
+        for (let x2 = 0; x2 < w; x2++) {
+          const dx = x2 - cx, dy = y - cy;
+          this.disc[y * w + x2] = Math.min(Math.max(this.radius + 0.5 - Math.sqrt(dx * dx + dy * dy), 0), 1);
+        }
+      }
+      const mask = new Uint8Array(n);
+      const pts = [];
+      for (let k = 0; k < 8; k++) pts.push(rint((ring[2 * k] - x0) * 16), rint((ring[2 * k + 1] - y0) * 16));
+      if (n) fillPolyAA(mask, w, h, pts, 4);
+      this.opening = new Float32Array(n);
+      for (let k = 0; k < n; k++) this.opening[k] = Math.fround(mask[k] / 255);
+      const inner = erodeEllipse(this.opening, w, h, 2 * Math.max(1, rint(LID_EDGE * ew)) + 1);
+      const hole = new Uint8Array(n), inside = new Uint8Array(n);
+      let nBeside = 0, nInside = 0;
+      for (let k = 0; k < n; k++) {
+        this.disc[k] *= inner[k];
+        hole[k] = +(this.disc[k] > 0);
+        inside[k] = +(inner[k] > 0.5);
+        nInside += inside[k];
+        nBeside += +(inside[k] && !hole[k]);
+      }
+      const pick = (k) => nBeside ? inside[k] && !hole[k] : nInside ? inside[k] : 1;
+      const grey = [];
+      const chosen = [];
+      for (let k = 0; k < n; k++) {
+        if (!pick(k)) continue;
+        chosen.push(k);
+        grey.push(region[3 * k] * 0.299 + region[3 * k + 1] * 0.587 + region[3 * k + 2] * 0.114);
+      }
+      const sclera = [0, 0, 0];
+      if (chosen.length) {
+        const p75 = percentile(Float64Array.from(grey), 75);
+        const bright = chosen.filter((_, m) => grey[m] >= p75);
+        for (let c = 0; c < 3; c++) sclera[c] = rint(median(Float64Array.from(bright, (k) => region[3 * k + c])));
+      }
+      const source = region.slice();
+      for (let k = 0; k < n; k++) if (!inside[k]) for (let c = 0; c < 3; c++) source[3 * k + c] = sclera[c];
+      const grown = new Uint8Array(n);
+      for (let y = 0; y < h; y++) {
+        for (let x2 = 0; x2 < w; x2++) {
+          let on = 0;
+          for (let dy = -1; dy <= 1 && !on; dy++) {
+            for (let dx = -1; dx <= 1; dx++) {
+              const yy = y + dy, xx = x2 + dx;
+              if (yy >= 0 && yy < h && xx >= 0 && xx < w && hole[yy * w + xx]) {
+                on = 1;
+                break;
+              }
+            }
+          }
+          grown[y * w + x2] = on;
+        }
+      }
+      if (n) inpaintTelea(source, grown, w, h, Math.max(2, this.radius / 3));
+      const blendSigma = Math.max(1, this.radius / 8), reach = gaussianSize(blendSigma) >> 1;
+      let hx0 = w, hy0 = h, hx1 = 0, hy1 = 0;
+      for (let k = 0; k < n; k++) {
+        if (!hole[k]) continue;
+        const x2 = k % w, y = (k - x2) / w;
+        hx0 = Math.min(hx0, x2);
+        hx1 = Math.max(hx1, x2 + 1);
+        hy0 = Math.min(hy0, y);
+        hy1 = Math.max(hy1, y + 1);
+      }
+      const win = [Math.max(hx0 - reach, 0), Math.max(hy0 - reach, 0), Math.min(hx1 + reach, w), Math.min(hy1 + reach, h)];
+      const fill = gaussianBlur(Float32Array.from(source), w, h, 3, Math.max(1, this.radius / 4), win);
+      const blend = gaussianBlur(Float32Array.from(hole), w, h, 1, blendSigma, win);
+      this.iris = Float32Array.from(region);
+      this.clean = new Float32Array(n * 3);
+      const fr = Math.fround;
+      for (let k = 0; k < n; k++) {
+        const b = Math.max(fr(blend[k] * this.opening[k]), hole[k]);
+        for (let c = 0; c < 3; c++) {
+          const i2 = this.iris[3 * k + c];
+          this.clean[3 * k + c] = fr(i2 + fr(b * fr(fill[3 * k + c] - i2)));
+        }
+      }
+    }
+    /** The warp's offset for an iris shift (u, v) eye widths: texture px (dx, dy) moved, quantised
+     * as cv2.warpAffine does (1/32 px): each pixel samples the key frame at (x + ox / 32, y + oy / 32);
+     * null when the shift is below STILL. */
+    offset(shift) {
+      const a = this.frame.axes;
+      const dx = shift[0] * a[0] + shift[1] * a[2], dy = shift[0] * a[1] + shift[1] * a[3];
+      if (Math.max(Math.abs(dx), Math.abs(dy)) < STILL) return null;
+      return [rint(-Math.fround(dx) * 1024) + 16 >> 5, rint(-Math.fround(dy) * 1024) + 16 >> 5];
+    }
+    /** Paints the eye into `out` (the texture's RGBA working copy, `width` px wide) with the warp
+     * offset `off` (offset()), or as on the key frame when null. */
+    paint(out, width, off) {
+      const { x0, y0, x1, y1 } = this;
+      const w = x1 - x0, h = y1 - y0;
+      if (w <= 0 || h <= 0) return;
+      if (!off) {
+        for (let y = 0; y < h; y++) out.set(this.key.subarray(y * w * 4, (y + 1) * w * 4), ((y0 + y) * width + x0) * 4);
+        return;
+      }
+      const sx = off[0] >> 5, sy = off[1] >> 5, fx = (off[0] & 31) / 32, fy = (off[1] & 31) / 32;
+      const fr = Math.fround;
+      const w00 = fr((1 - fx) * (1 - fy)), w01 = fr(fx * (1 - fy)), w10 = fr((1 - fx) * fy), w11 = fr(fx * fy);
+      const { iris, clean, disc, opening } = this;
+      for (let y = 0; y < h; y++) {
+        const ya = y + sy, yb = ya + 1;
+        const ra = clampIndex(ya, h) * w, rb = clampIndex(yb, h) * w;
+        const inA = ya >= 0 && ya < h, inB = yb >= 0 && yb < h;
+        for (let x2 = 0; x2 < w; x2++) {
+          const xa = x2 + sx, xb = xa + 1;
+          const ca3 = clampIndex(xa, w), cb = clampIndex(xb, w);
+          const inXa = xa >= 0 && xa < w, inXb = xb >= 0 && xb < w;
+          const alpha = (w00 * (inA && inXa ? disc[ra + ca3] : 0) + w01 * (inA && inXb ? disc[ra + cb] : 0) + w10 * (inB && inXa ? disc[rb + ca3] : 0) + w11 * (inB && inXb ? disc[rb + cb] : 0)) * opening[y * w + x2];
+          const o = ((y0 + y) * width + x0 + x2) * 4, k = (y * w + x2) * 3;
+          for (let c = 0; c < 3; c++) {
+            const moved = fr(w00 * iris[(ra + ca3) * 3 + c] + w01 * iris[(ra + cb) * 3 + c] + w10 * iris[(rb + ca3) * 3 + c] + w11 * iris[(rb + cb) * 3 + c]);
+            const v2 = clean[k + c] + alpha * fr(moved - clean[k + c]) + 0.5;
+            out[o + c] = v2 <= 0 ? 0 : v2 >= 255 ? 255 : Math.floor(v2);
+          }
+        }
+      }
+    }
+  };
+  var LookPainter = class {
+    /** Finds each eye's iris on `texture` (RGBA) at `model`'s eye rings (groups eye_right and
+     * eye_left, 8 vertices each) and prepares the eye with the iris painted out. An eye whose group
+     * is missing or malformed is left as on the texture. */
+    constructor(texture, model) {
+      /** The eyes' warp offsets last painted (Eye.offset, 'still' as on the key frame); null before
+       * the first call. */
+      this.last = null;
+      this.eyes = EYES.map((name) => {
+        const ring = model.groups[name];
+        if (!ring || ring.length !== 8) return null;
+        const px = new Float64Array(16);
+        ring.forEach((v2, k) => {
+          px[2 * k] = model.uv[2 * v2] * texture.width - 0.5;
+          px[2 * k + 1] = model.uv[2 * v2 + 1] * texture.height - 0.5;
+        });
+        return new Eye(texture, px);
+      });
+      this.work = { width: texture.width, height: texture.height, rgba: texture.rgba.slice() };
+    }
+    /** The texture with the irises shifted by `iris` ([[u, v] of the subject's right eye (group
+     * eye_right), [u, v] of the left eye (eye_left)], eye widths), or null when it is the same as
+     * the last returned one (so the caller need not re-upload; the first call always returns it).
+     * The returned Picture is a working copy reused between calls. */
+    texture(iris) {
+      const offsets = this.eyes.map((eye, k) => eye?.offset(iris[k] ?? [0, 0]) ?? null);
+      const key = offsets.map((o) => o ? `${o[0]},${o[1]}` : "still").join(";");
+      if (key === this.last) return null;
+      this.eyes.forEach((eye, k) => eye?.paint(this.work.rgba, this.work.width, offsets[k]));
+      this.last = key;
+      return this.work;
+    }
+  };
+
   // src/render/mouth.ts
   var CAVITY = [52, 18, 22];
   var TEETH = [185, 165, 150];
@@ -1747,10 +2717,10 @@ void main() {
         ids[j + 1] = temp;
       }
     } else {
-      const median2 = left + right >> 1;
+      const median3 = left + right >> 1;
       let i2 = left + 1;
       let j = right;
-      swap(ids, median2, i2);
+      swap(ids, median3, i2);
       if (dists[ids[left]] > dists[ids[right]]) swap(ids, left, right);
       if (dists[ids[i2]] > dists[ids[right]]) swap(ids, i2, right);
       if (dists[ids[left]] > dists[ids[i2]]) swap(ids, left, i2);
@@ -1891,6 +2861,7 @@ void main() {
       this.key = poseFromValues(header.references.slice(0, 6).map((r, i2) => r * header.steps[i2]));
       this.restWidth = mouthWidth(m, m.vertices);
       this.textureLayer = renderer2.upload(actor.texture);
+      this.painter = new LookPainter(actor.texture, m);
       if (actor.scene) {
         const { width, height } = actor.source;
         const outline = m.groups.face_outline;
@@ -1906,9 +2877,10 @@ void main() {
     get size() {
       return this.scene ? [this.scene.width, this.scene.height] : [this.header.width, this.header.height];
     }
-    /** Replaces the actor's texture (after an appearance update); same size. */
+    /** Replaces the actor's texture (after an appearance update); same size. Its irises are found
+     * again, as the Python synthesis does (a few hundred ms for a large texture). */
     retexture(texture) {
-      this.textureLayer = this.renderer.upload(texture, this.textureLayer);
+      this.painter = new LookPainter(texture, this.actor.model);
     }
     /** Draws ``motion`` into the renderer's canvas, letterboxed into ``view`` ([x, y, w, h]). */
     draw(motion, view) {
@@ -1930,6 +2902,8 @@ void main() {
       const pick = (name) => Float64Array.from(m.groups[name].flatMap((i2) => [points[2 * i2], points[2 * i2 + 1]]));
       const spread = mouthWidth(m, vertices) / Math.max(this.restWidth, 1e-9);
       const patch = mouthPatch(pick("mouth_inner_upper"), pick("mouth_inner_lower"), teethUncovered(spread), [w, h], this.mouthCanvas);
+      const texture = this.painter.texture(look.iris);
+      if (texture) this.textureLayer = this.renderer.upload(texture, this.textureLayer);
       const t2 = performance.now();
       const r = this.renderer;
       r.begin(w, h, BACKGROUND, view);
@@ -1959,7 +2933,7 @@ void main() {
         const j = this.header.extras.indexOf(kind);
         return j < 0 ? 0 : v2[first + j];
       };
-      return { closure: [at(1), at(2)] };
+      return { closure: [at(1), at(2)], iris: [[at(3), at(4)], [at(5), at(6)]] };
     }
   };
   function paintersOrder(points, depth, triangles) {
@@ -2695,8 +3669,10 @@ void main() {
             this.build();
           } else if (e.kind === "actor") {
             if (!this.actor) {
+              const t0 = performance.now();
               this.actor = await readActor(e.data);
               this.build();
+              counts.setupMs = performance.now() - t0;
             }
           } else if (e.kind === "appearance") {
             const update = await readUpdate(e.payload);
@@ -2746,7 +3722,7 @@ void main() {
     const sw = Math.max(1, Math.round(w * f)), sh = Math.max(1, Math.round(h * f));
     return [Math.floor((cw - sw) / 2), Math.floor((ch - sh) / 2), sw, sh];
   }
-  var counts = { drawn: 0, intraRequests: 0, dropped: 0, refused: 0, received: 0 };
+  var counts = { drawn: 0, intraRequests: 0, dropped: 0, refused: 0, received: 0, setupMs: 0 };
   var latencies = [];
   var drawTimes = [];
   var drawnAt = [];
@@ -2765,7 +3741,7 @@ void main() {
     counts.drawn += 1;
     drawnAt.push(t1);
     const sent = arrived.get(frame.index);
-    if (sent !== void 0 && !frame.concealed) latencies.push(now() - sent);
+    if (sent !== void 0 && !frame.concealed) latencies.push([frame.index, now() - sent]);
     arrived.delete(frame.index);
   }
   function updateHud() {
@@ -2775,10 +3751,10 @@ void main() {
     const fps = drawnAt.length / WINDOW_S;
     const kbps = bytesAt.reduce((s2, [, b]) => s2 + b, 0) * 8 / 1e3 / WINDOW_S;
     const s = session?.decoder.stats;
-    const lat = latencies.length ? `, latency ${median(latencies.slice(-50)).toFixed(0)} ms` : "";
+    const lat = latencies.length ? `, latency ${median2(latencies.slice(-50).map((l) => l[1])).toFixed(0)} ms` : "";
     hud.textContent = `${fps.toFixed(1)} frames/s drawn · ${kbps.toFixed(2)} kbit/s received · ${s?.concealed ?? 0} frames concealed (${s?.lost_packets ?? 0} packets lost)${lat}`;
   }
-  function median(xs) {
+  function median2(xs) {
     const s = [...xs].sort((a, b) => a - b);
     return s.length ? s[Math.floor(s.length / 2)] : NaN;
   }

@@ -1,14 +1,14 @@
 /**
  * A stream's frames drawn on its actor, as ``facemime decode`` draws them
  * (facemime.animate.synth.Puppet driven by the actor's own motion): the knot offsets deform the
- * head, the look closes the lids (the irises stay where the key frame has them: moving them,
- * facemime.animate.eyes, is not done here yet), the pose places it, and the picture is the
+ * head, the look closes the lids and moves the irises, the pose places it, and the picture is the
  * actor's scene warped to follow the face (or the face alone on a dark background when the
  * actor has no scene). A frame without a face shows the last face, dimmed.
  */
 import type { Header } from '../stream';
 import type { Actor, Picture } from './actor';
 import { closeLids, Deformer, mouthWidth, poseFromValues, project, SEAL, shownPose, type Pose } from './geometry';
+import { LookPainter } from './eyes';
 import { Renderer, type Layer } from './gl';
 import { mouthPatch, teethUncovered } from './mouth';
 import { SceneMesh, SLOW } from './scene';
@@ -27,6 +27,7 @@ export class Synthesizer {
   private readonly sceneLayer: Layer | null;
   private readonly sceneUv: Float32Array | null;
   private textureLayer: Layer;
+  private painter: LookPainter;
   private readonly key: Pose;
   private readonly basis: Float64Array;
   private readonly restWidth: number;
@@ -44,6 +45,7 @@ export class Synthesizer {
     this.key = poseFromValues(header.references.slice(0, 6).map((r, i) => r * header.steps[i]));
     this.restWidth = mouthWidth(m, m.vertices);
     this.textureLayer = renderer.upload(actor.texture);
+    this.painter = new LookPainter(actor.texture, m);
     if (actor.scene) {
       const { width, height } = actor.source;
       const outline = m.groups.face_outline;
@@ -61,9 +63,10 @@ export class Synthesizer {
     return this.scene ? [this.scene.width, this.scene.height] : [this.header.width, this.header.height];
   }
 
-  /** Replaces the actor's texture (after an appearance update); same size. */
+  /** Replaces the actor's texture (after an appearance update); same size. Its irises are found
+   * again, as the Python synthesis does (a few hundred ms for a large texture). */
   retexture(texture: Picture): void {
-    this.textureLayer = this.renderer.upload(texture, this.textureLayer);
+    this.painter = new LookPainter(texture, this.actor.model);
   }
 
   /** Draws ``motion`` into the renderer's canvas, letterboxed into ``view`` ([x, y, w, h]). */
@@ -86,6 +89,8 @@ export class Synthesizer {
     const pick = (name: string) => Float64Array.from(m.groups[name].flatMap((i) => [points[2 * i], points[2 * i + 1]]));
     const spread = mouthWidth(m, vertices) / Math.max(this.restWidth, 1e-9);
     const patch = mouthPatch(pick('mouth_inner_upper'), pick('mouth_inner_lower'), teethUncovered(spread), [w, h], this.mouthCanvas);
+    const texture = this.painter.texture(look.iris);
+    if (texture) this.textureLayer = this.renderer.upload(texture, this.textureLayer);
     const t2 = performance.now();
     const r = this.renderer;
     r.begin(w, h, BACKGROUND, view);
@@ -112,12 +117,12 @@ export class Synthesizer {
     Object.assign(this.timings, { geometry: t1 - t0, mouth: t2 - t1, gl: t3 - t2 });
   }
 
-  private look(v: ArrayLike<number>, first: number): { closure: [number, number] } {
+  private look(v: ArrayLike<number>, first: number): { closure: [number, number]; iris: [number, number][] } {
     const at = (kind: number) => {
       const j = this.header.extras.indexOf(kind);
       return j < 0 ? 0 : v[first + j];
     };
-    return { closure: [at(1), at(2)] };
+    return { closure: [at(1), at(2)], iris: [[at(3), at(4)], [at(5), at(6)]] };
   }
 }
 
