@@ -87,6 +87,10 @@ def one_call(browser, video: Path, record: Path, drop: float) -> dict:
             "dropped": stats["dropped"], "intra_requests": stats["intraRequests"]}
 
 
+def ms(v: float | None) -> str:
+    return "-" if v is None else f"{v:.1f} ms"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data")
@@ -101,12 +105,12 @@ def main() -> None:
                 t0 = time.perf_counter()
                 r = one_call(browser, args.data / "video" / f"{name}.mp4", Path(tmp) / f"{name}-{drop}.fmstream", drop)
                 figures[f"{name}@{drop}"] = r
-                print(f"{name:10s} drop {drop:.2f}: {r['frames']} frames, latency median {r['latency_median_ms']:.1f} "
-                      f"p95 {r['latency_p95_ms']:.1f} ms (first second: set-up {r['setup_ms']:.0f} ms, worst "
-                      f"{r['start_latency_max_ms']:.0f} ms), draw {r['draw_mean_ms']:.2f} ms (p95 {r['draw_p95_ms']:.2f}; "
-                      f"headroom {r['headroom']:.0f}x), lost {r['lost_packets']} packets, concealed {r['concealed']}, "
-                      f"intra asked {r['intra_requests']}, exact {r['exact']} [{time.perf_counter() - t0:.0f} s]\n"
-                      f"    sender: {r['summary']}", flush=True)
+                print(f"{name:10s} drop {drop:.2f}: {r['frames']} frames, latency median "
+                      f"{ms(r['latency_median_ms'])} p95 {ms(r['latency_p95_ms'])} (first second: set-up "
+                      f"{ms(r['setup_ms'])}, worst {ms(r['start_latency_max_ms'])}), draw {r['draw_mean_ms']:.2f} ms "
+                      f"(p95 {r['draw_p95_ms']:.2f}; headroom {r['headroom']:.0f}x), lost {r['lost_packets']} packets, "
+                      f"concealed {r['concealed']}, intra asked {r['intra_requests']}, exact {r['exact']} "
+                      f"[{time.perf_counter() - t0:.0f} s]\n    sender: {r['summary']}", flush=True)
         browser.close()
     print(json.dumps(figures))
 

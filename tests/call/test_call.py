@@ -10,6 +10,7 @@ import socket
 import struct
 import subprocess
 import sys
+import threading
 import time
 
 import pytest
@@ -17,6 +18,7 @@ from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
 from facemime.call import Call
+from facemime.call.sender import FileSource, Sender
 from facemime.call.server import MAX_MESSAGE
 from facemime.codec.stream import MotionDecoder
 
@@ -281,3 +283,32 @@ def test_bad_input_gives_one_line(video, tmp_path, capsys, monkeypatch, args, me
     code, out, err = run(capsys, "call", "--no-browser", "--port", "0", *[a.format(video=video) for a in args])
     assert code == 1 and out == "" and err.count("\n") == 1 and err.startswith("facemime: error:"), err
     assert message in err
+
+
+class Started:
+    """A sink that notes when the stream starts (or the source ends)."""
+
+    def __init__(self):
+        self.event = threading.Event()
+
+    def start_stream(self, header, actor):
+        self.event.set()
+
+    def packet(self, first, arrived, data):
+        pass
+
+    def end(self, error):
+        self.event.set()
+
+
+@pytest.mark.parametrize(("rate", "quality"), [(0.05, 0), (100.0, 10)])
+def test_without_a_quality_the_warm_up_chooses_the_finest_that_fits_the_rate(video, rate, quality):
+    sink = Started()
+    sender = Sender(FileSource(video), sink, warmup=0.6, rate=rate)
+    sender.start()
+    try:
+        assert sink.event.wait(30)
+    finally:
+        sender.stop()
+        sender.finished.wait(5)
+    assert sender.settings.quality == quality  # none fits 0.05 kbit/s: the coarsest; all fit 100
