@@ -39,6 +39,12 @@ def browser():
         b.close()
 
 
+@pytest.fixture(scope="session")
+def receiver_page() -> Path:
+    """The receiver page as the package ships it."""
+    return PAGE
+
+
 @pytest.fixture
 def page(browser):
     """A fresh page; fails the test on any uncaught error in it."""

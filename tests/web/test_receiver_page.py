@@ -3,6 +3,7 @@ decoded parameters equal the Python decoder's for the whole clip, and its WebGL 
 frame matches ``facemime decode``'s."""
 
 import base64
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,8 +16,6 @@ from facemime.codec.files import encode_video
 from facemime.codec.params import look_from_extras, pose_from_vector
 from facemime.codec.stream import MotionDecoder, Settings
 from facemime.fit.placement import model_iod
-
-from conftest import PAGE
 
 
 @pytest.fixture(scope="module")
@@ -36,8 +35,8 @@ def psnr(a: np.ndarray, b: np.ndarray) -> float:
     return 10 * np.log10(255 ** 2 / mse) if mse > 0 else float("inf")
 
 
-def load(page, data: bytes) -> list[dict]:
-    page.goto(PAGE.as_uri())
+def load(page, receiver: Path, data: bytes) -> list[dict]:
+    page.goto(receiver.as_uri())
     page.evaluate("(d) => window.facemime.loadStream(d, false)", base64.b64encode(data).decode())
     return page.evaluate("() => window.facemime.frames")
 
@@ -63,9 +62,9 @@ def python_picture(decoder: MotionDecoder, frames: list, index: int) -> np.ndarr
     return image if f.face else (image * NO_FACE_DIM).astype(np.uint8)
 
 
-def test_the_page_decodes_every_parameter_of_a_real_stream_exactly(page, stream):
+def test_the_page_decodes_every_parameter_of_a_real_stream_exactly(page, receiver_page, stream):
     data, decoder, frames = stream
-    shown = load(page, data)
+    shown = load(page, receiver_page, data)
     assert len(shown) == len(frames) == 78
     m = len(decoder.info.basis.raw)
     for got, f in zip(shown, frames):
@@ -76,9 +75,9 @@ def test_the_page_decodes_every_parameter_of_a_real_stream_exactly(page, stream)
         assert np.array_equal(look_from_extras(decoder.info.extras, v[6 + m:]).vector(), f.look.vector()), f.index
 
 
-def test_the_pages_picture_matches_the_python_decoders(page, stream):
+def test_the_pages_picture_matches_the_python_decoders(page, receiver_page, stream):
     data, decoder, frames = stream
-    load(page, data)
+    load(page, receiver_page, data)
     size = decoder.info.size
     # the frame with the widest open mouth, after the first appearance updates (the hardest to match)
     opening = [np.ptp(f.offsets[:, 1]) for f in frames]

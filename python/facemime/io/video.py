@@ -186,6 +186,9 @@ class VideoReader:
     #: Frames fewer than the container declares that pass without a warning (counts that
     #: containers round).
     SHORT_OK = 2
+    #: Threads FFmpeg decodes with: 0 lets it choose (one a core, or 2 for large frames); a
+    #: process that should keep to one core (a batch worker, ``facemime.batch.worker``) sets 1.
+    DECODE_THREADS = 0
 
     def __init__(self, path: str | Path):
         self.path = Path(path)
@@ -203,7 +206,9 @@ class VideoReader:
         self._stream = self._container.streams.video[0]
         self._stream.thread_type = "AUTO"
         codec = self._stream.codec_context
-        if codec.width * codec.height > LARGE_DECODE:
+        if self.DECODE_THREADS:
+            codec.thread_count = self.DECODE_THREADS
+        elif codec.width * codec.height > LARGE_DECODE:
             codec.thread_count = 2
         self.damaged = 0
         self._source = self._packets_decoded()

@@ -1,0 +1,168 @@
+"""The task a worker runs for one video: pin the process to one thread of compute, do the work
+(track, run or encode), check its results and return the video's manifest line. Every error of
+the video becomes a ``failed`` line; a task that runs past its time limit is stopped and becomes
+a ``timed out`` line; only a crash of the process itself (native code, out of memory) is left to
+the scheduler, which retries the task on another worker."""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import threading
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from facemime.batch.manifest import result_sizes, source_stamp, summarise
+from facemime.errors import FacemimeError
+from facemime.io.video import VideoReader
+
+#: Environment variables that size the thread pools of BLAS and OpenMP libraries (read when they load).
+THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "VECLIB_MAXIMUM_THREADS",
+                    "NUMEXPR_NUM_THREADS")
+#: Seconds a task may take beyond its per-frame allowance (start-up: loading models, fitting the face).
+START_SECONDS = 30.0
+#: Seconds a task stopped for its time limit has to end before its worker process is ended.
+GRACE_SECONDS = 10.0
+#: Name of the worker event that says a task's worker was ended for its time limit.
+TIMEOUT_EVENT = "facemime-batch-timeout"
+
+#: ``task(video, results, what)`` writes the results of one video (paths from
+#: :func:`facemime.batch.manifest.result_paths`) and returns warnings, one line each.
+Task = Callable[[Path, list[Path], str], list[str]]
+
+
+class TimedOut(BaseException):
+    """Raised in a task's thread when it runs past its time limit (a BaseException, so that no
+    ``except Exception`` in the work keeps it)."""
+
+
+def pin_threads() -> None:
+    """One thread of compute in this process: the BLAS/OpenMP variables (for libraries loaded
+    later), OpenCV's pool, FFmpeg's decoding threads (it would start one a core in every worker)
+    and, if threadpoolctl is there, pools already loaded. Decoding still runs on a thread of its
+    own beside the task (:class:`facemime.io.video.VideoReader`'s decode-ahead): one worker keeps
+    about 1.5 cores busy (2 of its 6 CPU ms a frame are decoding)."""
+    for name in THREAD_VARIABLES:
+        os.environ[name] = "1"
+    import cv2
+
+    cv2.setNumThreads(1)
+    VideoReader.DECODE_THREADS = 1
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:
+        return
+    threadpool_limits(1)
+
+
+def default_task(video: Path, results: list[Path], what: str) -> list[str]:
+    """The work of ``facemime track`` (``what="track"``), ``run`` (``"run"``: the track JSON and
+    the side-by-side video) or ``encode`` (``"encode"``: the stream) on one video, writing over
+    results left incomplete by an earlier batch."""
+    if what == "track":
+        from facemime.track.video import track_video
+
+        return track_video(video, None, results[0], force=True).warnings
+    if what == "run":
+        from facemime.animate.run import run_video
+
+        return run_video(video, results[1], None, results[0], force=True).warnings
+    from facemime.codec.files import encode_video
+
+    return encode_video(video, results[0], force=True).warnings
+
+
+def declared_frames(video: Path) -> int:
+    """The frames the video's container declares (or its duration × rate; 0 when unreadable)."""
+    import av
+
+    try:
+        with av.open(str(video)) as c:
+            s = c.streams.video[0]
+            if s.frames:
+                return int(s.frames)
+            rate = float(s.average_rate or 0)
+            return int(float(s.duration * s.time_base) * rate) if s.duration and rate else 0
+    except Exception:  # noqa: BLE001 (the task itself reports an unreadable file)
+        return 0
+
+
+def process(name: str, video: str, results: list[str], what: str, timeout_per_frame: float | None,
+            task: Task | None = None, start_seconds: float = START_SECONDS) -> dict[str, Any]:
+    """Run ``task`` (default :func:`default_task`) on ``video`` within ``start_seconds`` +
+    ``timeout_per_frame`` s × its declared frames (None: no limit), check the results and return
+    its manifest line (see :mod:`facemime.batch.manifest`)."""
+    pin_threads()
+    t0 = time.perf_counter()
+    path, paths = Path(video), [Path(p) for p in results]
+    record: dict[str, Any] = {"video": name, "path": video, "what": what, "source": source_stamp(path)}
+    frames = declared_frames(path) if timeout_per_frame is not None else 0
+    limit = None if timeout_per_frame is None else start_seconds + timeout_per_frame * frames
+    watchdog = _Watchdog(limit, name) if limit is not None else None
+    try:
+        warnings = (task or default_task)(path, paths, what)
+        if watchdog is not None:
+            watchdog.finish()
+        record.update(status="done", **summarise(paths, what), error=None, results=result_sizes(paths))
+        if warnings:
+            record["warnings"] = [" ".join(str(w).split()) for w in warnings]
+    except TimedOut:
+        record.update(status="timed out", error=f"stopped after {limit:.1f} s, its limit ({start_seconds:g} s + "
+                                                f"{timeout_per_frame:g} s a frame for {frames} frames)")
+    except FacemimeError as e:
+        record.update(status="failed", error=" ".join(str(e).split()))
+    except MemoryError:
+        record.update(status="failed", error="out of memory")
+    except Exception as e:  # noqa: BLE001 (one video's defect must not stop the batch)
+        record.update(status="failed", error=" ".join(f"unexpected {type(e).__name__}: {e}".split()))
+    finally:
+        if watchdog is not None:
+            watchdog.finish()
+    record.setdefault("frames", None)
+    record["seconds"] = round(time.perf_counter() - t0, 3)
+    return record
+
+
+class _Watchdog:
+    """Raises :class:`TimedOut` in the calling thread once ``limit`` seconds pass, unless
+    :meth:`finish` was called; if the thread is still busy ``GRACE_SECONDS`` later (stuck in
+    native code, which a Python exception cannot interrupt), records a worker event and ends the
+    worker process (the batch then records the task as timed out)."""
+
+    def __init__(self, limit: float, name: str):
+        self._target = threading.get_ident()
+        self._lock = threading.Lock()
+        self._done = threading.Event()
+        self._fired = False
+        self._name = name
+        threading.Thread(target=self._watch, args=(limit,), daemon=True, name=f"watchdog {name}").start()
+
+    def _watch(self, limit: float) -> None:
+        if self._done.wait(limit):
+            return
+        with self._lock:
+            if self._done.is_set():
+                return
+            self._fired = True
+            ctypes.pythonapi.PyThreadState_SetAsyncExc(ctypes.c_ulong(self._target), ctypes.py_object(TimedOut))
+        if self._done.wait(GRACE_SECONDS):
+            return
+        try:
+            from distributed import get_worker
+
+            get_worker().log_event(TIMEOUT_EVENT, {"video": self._name, "limit": limit})
+            time.sleep(0.5)  # the event's way to the scheduler
+        except Exception:  # noqa: BLE001 (not in a worker: end the process all the same)
+            pass
+        os._exit(3)
+
+    def finish(self) -> None:
+        """The task ended: no exception is raised after this returns."""
+        with self._lock:
+            if self._done.is_set():
+                return
+            self._done.set()
+            if self._fired:  # raised but maybe not yet delivered: take it back
+                ctypes.pythonapi.PyThreadState_SetAsyncExc(ctypes.c_ulong(self._target), None)
