@@ -288,3 +288,21 @@ def test_the_decoder_collects_appearance_payloads_in_order_and_where_they_fall(c
     assert dec.appearance == payloads and dec.appearance_after == after
     assert dec.stats["appearance"] == len(payloads) and dec.stats["undecodable"] == 0
     assert plain.appearance == [] and plain.appearance_after == []
+
+
+@pytest.mark.parametrize("whole", [True, False])
+def test_two_streams_one_after_the_other_decode_each_with_its_own_header(clip, whole):
+    # a second stream of another quality (other steps, another number of coefficients) follows
+    # the first in the same bytes: its frames restart at 0 and are read with its own basis, and
+    # none of the first's is lost, whether the bytes come in one piece or two
+    first, recon1 = encoded(clip)
+    second, recon2 = encoded(clip, Settings(quality=2))
+    dec = MotionDecoder()
+    if whole:
+        frames = dec.push(b"".join(first + second)) + dec.finish()
+    else:
+        frames = dec.push(b"".join(first)) + dec.push(b"".join(second)) + dec.finish()
+    n = len(clip.motion)
+    assert [f.index for f in frames] == list(range(n)) * 2
+    assert all(same(f, e) for f, e in zip(frames, recon1 + recon2))
+    assert len(dec.info.basis.raw) == Settings(quality=2).basis_size

@@ -308,6 +308,23 @@ fn a_stream_whose_header_changes_from_version_1_to_2_decodes_both() {
 }
 
 #[test]
+fn a_segment_stops_before_a_new_header_so_each_part_has_its_own() {
+    let (a, recon_a) = encode(&header(5, 5), &clip(30, 8));
+    let (b, recon_b) = encode(&header_with_extras(), &clip(30, 9));
+    let mut d = Decoder::new(true);
+    // both streams in one piece: the first call ends where the second stream starts
+    let out = d.segment(&[a.concat(), b.concat()].concat(), false);
+    assert!(d.pending());
+    assert_eq!(check(&out, &recon_a), (30, 0));
+    assert_eq!(d.header().map(|h| h.extras.len()), Some(0));
+    let mut rest = d.segment(&[], false);
+    rest.extend(d.segment(&[], true));
+    assert!(!d.pending());
+    assert_eq!(check(&rest, &recon_b), (30, 0));
+    assert_eq!(d.header().map(|h| h.extras.len()), Some(2));
+}
+
+#[test]
 fn values_beyond_the_formats_range_are_an_error_not_garbage() {
     let mut enc = Encoder::new(header(5, 5), 0.0).unwrap();
     let mut v = clip(1, 5)[0].2.clone();

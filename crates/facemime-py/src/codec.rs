@@ -234,16 +234,23 @@ impl StreamDecoder {
         }
     }
 
-    /// Reads `data`; returns the frames it completed and the appearance payloads it held.
+    /// Reads `data`; returns the frames it completed and the appearance payloads it held, up to
+    /// a header that starts a new stream (then `pending()` is true: call again with no bytes),
+    /// so that everything returned belongs to the header `header()` gives.
     fn push<'py>(&mut self, py: Python<'py>, data: &[u8]) -> Decoded<'py> {
-        let out = py.detach(|| self.dec.push(data));
+        let out = py.detach(|| self.dec.segment(data, false));
         self.arrays(py, out)
     }
 
-    /// Reads what is buffered as the stream's end.
+    /// Reads what is buffered as the stream's end (up to a new header, as `push`).
     fn finish<'py>(&mut self, py: Python<'py>) -> Decoded<'py> {
-        let out = self.dec.finish();
+        let out = self.dec.segment(&[], true);
         self.arrays(py, out)
+    }
+
+    /// Whether the last `push` or `finish` stopped before a new header.
+    fn pending(&self) -> bool {
+        self.dec.pending()
     }
 
     /// The header as a dict (None before one was read): fps (num, den), size (w, h), topology,

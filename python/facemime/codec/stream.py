@@ -344,18 +344,27 @@ class MotionDecoder:
     def _rest(self) -> np.ndarray:
         return np.zeros((self.info.basis.raw.shape[1] // 2, 2))
 
+    def _segments(self, decoded: tuple, again) -> list[DecodedFrame]:
+        """The frames of what the core decoded, and of what it has left after a new header (each
+        part read with its own header)."""
+        frames = []
+        while True:
+            decoded = self._collect(decoded)
+            self._read_header()
+            self._resolve_actor()
+            frames += self._frames(decoded)
+            if not self._core.pending():
+                return frames
+            decoded = again()
+
     def push(self, data: bytes) -> list[DecodedFrame]:
         """Reads ``data``; returns the frames it completed, in order (concealed ones included)."""
         self._magic_seen = self._magic_seen or b"FMST" in data
-        decoded = self._collect(self._core.push(bytes(data)))
-        self._read_header()
-        self._resolve_actor()
-        return self._frames(decoded)
+        return self._segments(self._core.push(bytes(data)), lambda: self._core.push(b""))
 
     def finish(self) -> list[DecodedFrame]:
         """Reads the end of the stream; raises :class:`StreamError` when nothing was decodable."""
-        decoded = self._collect(self._core.finish())
-        self._read_header()
+        frames = self._segments(self._core.finish(), self._core.finish)
         if self.info is None:
             reason = self._core.header_error()
             if reason:
@@ -363,10 +372,9 @@ class MotionDecoder:
             if self._magic_seen:
                 raise StreamError(f"{self.name}: its header is damaged or cut short; nothing can be decoded")
             raise StreamError(f"{self.name} is not a facemime stream (no header found)")
-        self._resolve_actor()
         if self.actor is None:
             raise StreamError(f"{self.name}'s actor is missing or damaged: give the actor file (--actor)")
-        return self._frames(decoded)
+        return frames
 
     @property
     def stats(self) -> dict[str, int]:

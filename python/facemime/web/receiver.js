@@ -3422,6 +3422,8 @@ void main() {
       /** The last good decoded frame, which concealed frames repeat. */
       this.last = null;
       this.raw = [];
+      /** The header the output's current part was read under. */
+      this.partHeader = null;
     }
     /** The header in force, once one was read. */
     get header() {
@@ -3566,12 +3568,30 @@ void main() {
         this.raw.push({ t: "concealed", first, count });
       }
     }
-    /** This call's events: its frames in index order (a stable sort, decoded frames before
-     * concealed runs on a tie, as MotionDecoder does), concealed runs filled in, each other event
-     * after as many frames as the decoder had output before reading it. */
+    /** This call's events, in parts split where a header starts a new stream (the header event
+     * between them), as MotionDecoder reads them (the Rust decoder's segments): in each part its
+     * frames in index order (a stable sort, decoded frames before concealed runs on a tie),
+     * concealed runs filled in, each other event after as many frames as the decoder had output
+     * before reading it. */
     output() {
       const raw = this.raw;
       this.raw = [];
+      const out = [];
+      let part = [];
+      for (const r of raw) {
+        if (r.t === "event" && r.event.kind === "header") {
+          out.push(...this.part(part), r.event);
+          this.partHeader = r.event.header;
+          part = [];
+        } else {
+          part.push(r);
+        }
+      }
+      out.push(...this.part(part));
+      return out;
+    }
+    /** One part of a call's output, read under the header `partHeader`. */
+    part(raw) {
       const runs = [];
       const others = [];
       let seen = 0;
@@ -3616,7 +3636,7 @@ void main() {
       if (last) {
         return { index, face: last.face, lost: last.lost, q: last.q.slice(), values: last.values.slice(), concealed: true };
       }
-      const header = this.current;
+      const header = this.partHeader;
       const q = new Int32Array(header.references.length);
       for (let i2 = 0; i2 < POSE_PARAMETERS; i2++) q[i2] = header.references[i2];
       return { index, face: false, lost: 15, q, values: dequantise(header, q), concealed: true };

@@ -87,6 +87,8 @@ export class StreamDecoder {
   /** The last good decoded frame, which concealed frames repeat. */
   private last: Frame | null = null;
   private raw: Raw[] = [];
+  /** The header the output's current part was read under. */
+  private partHeader: Header | null = null;
 
   /** `fromStart`: the bytes start at the stream's start (a file: missing leading packets are
    * concealed); false for a receiver joining a live stream at the first packet it gets. */
@@ -244,12 +246,31 @@ export class StreamDecoder {
     }
   }
 
-  /** This call's events: its frames in index order (a stable sort, decoded frames before
-   * concealed runs on a tie, as MotionDecoder does), concealed runs filled in, each other event
-   * after as many frames as the decoder had output before reading it. */
+  /** This call's events, in parts split where a header starts a new stream (the header event
+   * between them), as MotionDecoder reads them (the Rust decoder's segments): in each part its
+   * frames in index order (a stable sort, decoded frames before concealed runs on a tie),
+   * concealed runs filled in, each other event after as many frames as the decoder had output
+   * before reading it. */
   private output(): Event[] {
     const raw = this.raw;
     this.raw = [];
+    const out: Event[] = [];
+    let part: Raw[] = [];
+    for (const r of raw) {
+      if (r.t === 'event' && r.event.kind === 'header') {
+        out.push(...this.part(part), r.event);
+        this.partHeader = r.event.header;
+        part = [];
+      } else {
+        part.push(r);
+      }
+    }
+    out.push(...this.part(part));
+    return out;
+  }
+
+  /** One part of a call's output, read under the header `partHeader`. */
+  private part(raw: Raw[]): Event[] {
     const runs: { first: number; frame: Frame | null; count: number }[] = [];
     const others: { before: number; event: Event }[] = [];
     let seen = 0;
@@ -296,7 +317,7 @@ export class StreamDecoder {
       return { index, face: last.face, lost: last.lost, q: last.q.slice(), values: last.values.slice(), concealed: true };
     }
     // before any decoded frame: the reference pose, zero offsets, the neutral look
-    const header = this.current as Header; // concealment needs a header
+    const header = this.partHeader as Header; // concealment needs a header
     const q = new Int32Array(header.references.length);
     for (let i = 0; i < POSE_PARAMETERS; i++) q[i] = header.references[i];
     return { index, face: false, lost: 15, q, values: dequantise(header, q), concealed: true };

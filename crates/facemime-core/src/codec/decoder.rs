@@ -66,6 +66,8 @@ pub struct Decoder {
     state: Option<State>,
     next: Option<u64>,
     shown: Vec<i32>,
+    /// A segment read stopped before a header that changes the stream ([`Decoder::segment`]).
+    pending: bool,
     pub stats: Stats,
 }
 
@@ -81,6 +83,7 @@ impl Decoder {
             state: None,
             next: None,
             shown: Vec::new(),
+            pending: false,
             stats: Stats::default(),
         }
     }
@@ -104,19 +107,38 @@ impl Decoder {
     /// the appearance updates they held, in stream order.
     pub fn push(&mut self, bytes: &[u8]) -> Vec<Output> {
         self.buf.extend_from_slice(bytes);
-        self.drain(false)
+        self.drain(false, false)
     }
 
     /// Reads what is buffered as the stream's end (a chunk cut short there is damage).
     pub fn finish(&mut self) -> Vec<Output> {
-        self.drain(true)
+        self.drain(true, false)
     }
 
-    fn drain(&mut self, end: bool) -> Vec<Output> {
+    /// Like [`Decoder::push`] (`end`: like [`Decoder::finish`]), but stops before a header that
+    /// starts a new stream when something was output under the one in force, so that every
+    /// output of one call belongs to the header [`Decoder::header`] gives after it. While
+    /// [`Decoder::pending`], call again (with no bytes) for the rest.
+    pub fn segment(&mut self, bytes: &[u8], end: bool) -> Vec<Output> {
+        self.buf.extend_from_slice(bytes);
+        self.drain(end, true)
+    }
+
+    /// Whether the last [`Decoder::segment`] stopped before a new header.
+    pub fn pending(&self) -> bool {
+        self.pending
+    }
+
+    fn drain(&mut self, end: bool, segment: bool) -> Vec<Output> {
         let mut out = Vec::new();
         let mut at = 0;
+        self.pending = false;
         while at < self.buf.len() {
             match chunk::read(&self.buf[at..]) {
+                Read::Chunk(c, _) if segment && !out.is_empty() && self.starts_stream(&c) => {
+                    self.pending = true;
+                    break;
+                }
                 Read::Chunk(c, used) => {
                     self.in_damage = false;
                     at += used;
@@ -135,6 +157,12 @@ impl Decoder {
         }
         self.buf.drain(..at);
         out
+    }
+
+    /// Whether `c` is a valid header other than the one in force.
+    fn starts_stream(&self, c: &Chunk) -> bool {
+        c.kind == Kind::Header
+            && Header::parse(&c.payload).is_ok_and(|h| self.header.as_ref() != Some(&h))
     }
 
     fn chunk(&mut self, c: Chunk, out: &mut Vec<Output>) {
