@@ -1,5 +1,10 @@
-"""Shared fixtures. Tests that need real data use ../shared next to the repository (CI has it)."""
+"""Shared fixtures. Tests that need real data use ../shared next to the repository (CI has it).
+Browser tests use ``browser``, a headless Chromium (Debian's ``chromium``, driven by Playwright's
+Python client; no browser is downloaded): without it they are skipped, or fail when the
+environment variable CI is set (CI installs it: see the README's test command)."""
 
+import os
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -66,3 +71,48 @@ def astronaut(tmp_path_factory) -> Path:
     jpg = np.frombuffer(resources.files("facemime.data").joinpath("astronaut.jpg").read_bytes(), np.uint8)
     cv2.imwrite(str(path), cv2.imdecode(jpg, cv2.IMREAD_COLOR))
     return path
+
+
+#: Chromium's flags for a closed network: no background connections, no sandbox as root.
+CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
+                 "--disable-component-update", "--disable-sync"]
+
+
+def _unavailable(what: str) -> None:
+    if os.environ.get("CI"):
+        pytest.fail(f"the browser tests need {what}")
+    pytest.skip(f"the browser tests need {what}")
+
+
+@pytest.fixture(scope="session")
+def browser():
+    """A headless Chromium, for the session."""
+    executable = shutil.which("chromium") or shutil.which("chromium-browser")
+    if executable is None:
+        _unavailable("Debian's chromium package (apt-get install chromium)")
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:
+        _unavailable("the Python package playwright (pip install -e '.[test]')")
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=executable, args=CHROMIUM_ARGS)
+        yield b
+        b.close()
+
+
+#: The browser receiver's sources and npm packages.
+WEB = ROOT / "web"
+
+
+@pytest.fixture(scope="session")
+def node() -> str:
+    """The ``node`` executable, with ``web/node_modules`` installed (``npm ci`` in web/): without
+    them the tests that run Node are skipped, or fail when the environment variable CI is set."""
+    node, npm = shutil.which("node"), shutil.which("npm")
+    missing = ("node and npm" if node is None or npm is None else
+               "web/node_modules (run `npm ci` in web/)" if not (WEB / "node_modules").is_dir() else None)
+    if missing:
+        if os.environ.get("CI"):
+            pytest.fail(f"these tests need {missing}")
+        pytest.skip(f"these tests need {missing}")
+    return node

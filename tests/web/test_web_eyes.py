@@ -61,14 +61,9 @@ def _need(what: str) -> None:
 
 
 @pytest.fixture(scope="module")
-def cli() -> list[str]:
+def cli(node) -> list[str]:
     """The command that runs the Node painter (the tests' bundles built once)."""
-    node, npm = shutil.which("node"), shutil.which("npm")
-    if node is None or npm is None:
-        _need("node and npm")
-    if not (WEB / "node_modules").is_dir():
-        _need("web/node_modules (run `npm install` in web/)")
-    subprocess.run([npm, "run", "--silent", "build-tests"], cwd=WEB, check=True)
+    subprocess.run([shutil.which("npm"), "run", "--silent", "build-tests"], cwd=WEB, check=True)
     return [node, str(CLI)]
 
 
