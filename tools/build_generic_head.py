@@ -7,9 +7,18 @@ aligned by generalised Procrustes, averaged, made left/right symmetric, scaled t
 constrained Delaunay triangulation of the frontal view that keeps every feature contour as a
 chain of edges; the mouth opening is left out (the inner lip curves close it at rest).
 
-Run from the repository root (needs numpy, scipy and the `triangle` package, dev-time only):
+Its deformation units are facemime's expression controls (facemime.animate.expressions: ARKit
+names, each a knot pattern spread by the synthesis's deformation), computed from the model as
+stored.
+
+Run from the repository root (needs numpy, scipy and the `triangle` package, dev-time only, and
+facemime importable):
 
     python tools/build_generic_head.py ../shared/data/video
+
+or, to recompute only the deformation units of the shipped file (after the controls change):
+
+    python tools/build_generic_head.py --units-only
 """
 
 from __future__ import annotations
@@ -19,8 +28,6 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import triangle
-from scipy.spatial import cKDTree
 
 IOD_MM = 90.0  # outer-eye-corner distance of the model, millimetres
 
@@ -91,6 +98,8 @@ def mean_shape(shapes: list[np.ndarray]) -> np.ndarray:
 
 def symmetrise(p: np.ndarray) -> np.ndarray:
     """Average each point with the mirror image of its mirror partner (nearest reflected point)."""
+    from scipy.spatial import cKDTree
+
     mirrored = p * [-1, 1, 1]
     partner = cKDTree(p).query(mirrored)[1]
     sym = (p + mirrored[partner]) / 2
@@ -100,6 +109,8 @@ def symmetrise(p: np.ndarray) -> np.ndarray:
 
 
 def triangulate(xy: np.ndarray, segments: list[tuple[int, int]], holes: list[np.ndarray]) -> np.ndarray:
+    import triangle
+
     tri = triangle.triangulate(
         {"vertices": xy, "segments": np.array(segments), "holes": np.array(holes)}, "p"
     )
@@ -112,76 +123,41 @@ def triangulate(xy: np.ndarray, segments: list[tuple[int, int]], holes: list[np.
     return t
 
 
-def smoothstep(a: float, b: float, x: np.ndarray) -> np.ndarray:
-    t = np.clip((x - a) / (b - a), 0.0, 1.0)
-    return t * t * (3 - 2 * t)
+def deformation_units(v: np.ndarray, triangles: np.ndarray, g: dict[str, list[int]]) -> dict[str, dict]:
+    """The model's expression controls (facemime.animate.expressions, ARKit names) as deformation
+    units: each one's vertex displacements (mm) at weight 1, the synthesis's own deformation of
+    its knot pattern (the blinks: the lids closed), with its description. ``v``: the vertices as
+    the file stores them (rounded), so that the units are those facemime computes from the file."""
+    from facemime.animate.expressions import DESCRIPTIONS, Expressions
+    from facemime.model.head import HeadModel
 
-
-def deformation_units(v: np.ndarray, g: dict[str, list[int]]) -> dict[str, dict]:
-    """Displacements (mm) at activation 1 of each deformation unit."""
-    n = len(v)
-    x, y = v[:, 0], v[:, 1]
-    corner_r, corner_l = g["mouth_outer_upper"][0], g["mouth_outer_upper"][-1]
-    mouth_y = (v[corner_r, 1] + v[corner_l, 1]) / 2
-    half_w = (v[corner_l, 0] - v[corner_r, 0]) / 2
-    chin_y = v[g["face_outline"], 1].min()
-    lower_lip = set(g["mouth_outer_lower"][1:-1] + g["mouth_inner_lower"][1:-1])
-    upper_lip = set(g["mouth_outer_upper"][1:-1] + g["mouth_inner_upper"][1:-1])
-    corners = {corner_r, corner_l, g["mouth_inner_upper"][0], g["mouth_inner_upper"][-1]}
-    lips = lower_lip | upper_lip | corners
-    units: dict[str, tuple[str, np.ndarray]] = {}
-
-    d = np.zeros((n, 3))
-    below = smoothstep(mouth_y, mouth_y - 0.35 * (mouth_y - chin_y), y) * np.exp(-((x / (2.2 * half_w)) ** 2))
-    for i in range(n):
-        w = 1.0 if i in lower_lip else 0.45 if i in corners else below[i]
-        d[i] = w * np.array([0.0, -12.0, -3.0])
-    units["jaw_drop"] = ("the jaw opens: lower lip and chin move down (12 mm) and back", d)
-
-    d = np.zeros((n, 3))
-    for i in lips:
-        d[i, 0] = 6.0 * np.clip(x[i] / half_w, -1, 1)
-    units["lip_stretch"] = ("the mouth corners pull outwards (6 mm each), the lips follow", d)
-
-    d = np.zeros((n, 3))
-    for i in lips:
-        d[i, 1] = 4.0 * np.clip(abs(x[i]) / half_w, 0, 1) ** 2
-    d[:, 1] += 2.0 * np.exp(-(((x - np.sign(x) * half_w * 1.3) / 10) ** 2 + ((y - mouth_y) / 10) ** 2)) * (np.abs(x) > 0)
-    units["lip_corner_raise"] = ("the mouth corners move up 4 mm (a smile); negative values pull them down", d)
-
-    d = np.zeros((n, 3))
-    for i in upper_lip:
-        d[i, 1] = 3.5 * (1 - 0.6 * np.clip(abs(x[i]) / half_w, 0, 1))
-    units["upper_lip_raise"] = ("the upper lip lifts (3.5 mm at the centre)", d)
-
-    d = np.zeros((n, 3))
-    brows = {i for k in g if k.startswith("brow_") for i in g[k]}
-    brow_y = v[sorted(brows), 1].mean()
-    for i in range(n):
-        if i in brows:
-            d[i, 1] = 7.0
-        elif y[i] > brow_y:
-            d[i, 1] = 3.0 * np.exp(-((y[i] - brow_y) / 25) ** 2)
-        elif y[i] > brow_y - 18 and i not in set(g["eye_left"] + g["eye_right"]):
-            d[i, 1] = 2.0 * smoothstep(brow_y - 18, brow_y, y[i])
-    units["brow_raise"] = ("both brows lift 7 mm, the forehead follows; negative values lower them", d)
-
-    d = np.zeros((n, 3))
-    for eye in ("eye_right", "eye_left"):
-        ring = g[eye]
-        upper, lower = ring[1:4], ring[7:4:-1]  # lids, each ordered from the image-left corner
-        for u, lo in zip(upper, lower):
-            d[u] = v[lo] - v[u]
-            d[u, 2] = 0.0
-    units["eyes_closed"] = ("the upper lids come down onto the lower lids", d)
-
+    model = HeadModel(v, np.asarray(triangles, np.int64), None, {k: np.asarray(i, np.int64) for k, i in g.items()})
+    e = Expressions.of(model)
     return {
         name: {
-            "description": text,
-            "displacements": [[i, *np.round(disp[i], 3).tolist()] for i in range(n) if np.abs(disp[i]).max() > 1e-3],
+            "description": DESCRIPTIONS[name],
+            "displacements": [[i, *np.round(d[i], 3).tolist()] for i in range(len(v)) if np.abs(d[i]).max() > 1e-3],
         }
-        for name, (text, disp) in units.items()
+        for name, d in zip(e.names, e.fields)
     }
+
+
+def update_units(path: Path) -> None:
+    """Recompute only the deformation units of the model file at ``path`` (from its vertices,
+    triangles and groups), leaving the rest byte for byte: for when the controls change."""
+    model = json.loads(path.read_text())
+    model["deformation_units"] = deformation_units(np.array(model["vertices"]), np.array(model["triangles"]),
+                                                   model["groups"])
+    write(model, path)
+
+
+def write(model: dict, out: Path) -> None:
+    text = json.dumps(model, indent=None, separators=(",", ":"))
+    # One vertex / triangle / entry per line keeps the file readable and its diffs small.
+    text = text.replace("],[", "],\n[").replace('},"', '},\n"')
+    out.write_text(text + "\n")
+    print(f"{out}: {len(model['vertices'])} vertices, {len(model['triangles'])} triangles, "
+          f"{len(model['deformation_units'])} deformation units")
 
 
 def build(video_dir: Path) -> dict:
@@ -229,20 +205,17 @@ def build(video_dir: Path) -> dict:
         "triangles": tris.tolist(),
         "uv": np.round(uv, 5).tolist(),
         "groups": groups,
-        "deformation_units": deformation_units(v, groups),
+        "deformation_units": deformation_units(np.round(v, 3), tris, groups),
     }
 
 
 def main() -> None:
-    video_dir = Path(sys.argv[1] if len(sys.argv) > 1 else "../shared/data/video")
-    model = build(video_dir)
     out = Path(__file__).resolve().parents[1] / "python/facemime/model/data/generic_head.json"
-    text = json.dumps(model, indent=None, separators=(",", ":"))
-    # One vertex / triangle / entry per line keeps the file readable and its diffs small.
-    text = text.replace("],[", "],\n[").replace('},"', '},\n"')
-    out.write_text(text + "\n")
-    print(f"{out}: {len(model['vertices'])} vertices, {len(model['triangles'])} triangles, "
-          f"{len(model['deformation_units'])} deformation units")
+    if sys.argv[1:] == ["--units-only"]:
+        update_units(out)
+        return
+    video_dir = Path(sys.argv[1] if len(sys.argv) > 1 else "../shared/data/video")
+    write(build(video_dir), out)
 
 
 if __name__ == "__main__":

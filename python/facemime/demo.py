@@ -63,17 +63,23 @@ class DemoResult:
 
 
 def performance(t: float) -> tuple[dict[str, float], dict[str, float]]:
-    """Scripted motion at time ``t`` seconds: (deformation unit weights, pose angles in degrees).
+    """Scripted motion at time ``t`` seconds: (expression weights, pose angles in degrees).
     She talks throughout, opens the mouth wide around 2.5 s, raises the brows twice and frowns
     once, smiles, and turns and tilts the head."""
     talk = max(0.0, np.sin(2 * np.pi * 2.1 * t)) * (0.35 + 0.25 * np.sin(2 * np.pi * 0.37 * t) ** 2)
     wide = np.exp(-((t - 2.6) / 0.35) ** 2)
+    # expression weights (facemime.animate.expressions): the lower lip down up to 12 mm, the
+    # corners out up to 2 mm each and up 3 mm, the brows up 6 mm and down 4 mm on the generic head
+    stretch = 0.08 * np.sin(2 * np.pi * 0.3 * t) ** 2
+    smile = 0.19 * np.exp(-((t - 4.4) / 0.5) ** 2)
+    brows = 0.9 * np.exp(-((t - 1.2) / 0.35) ** 2) + 0.9 * np.exp(-((t - 3.6) / 0.35) ** 2)
+    down = 0.6 * np.exp(-((t - 5.2) / 0.3) ** 2)
     units = {
-        "jaw_drop": min(1.0, 0.7 * talk + 1.0 * wide),
-        "lip_stretch": 0.35 * np.sin(2 * np.pi * 0.3 * t) ** 2,
-        "lip_corner_raise": 0.7 * np.exp(-((t - 4.4) / 0.5) ** 2),
-        "brow_raise": 0.9 * np.exp(-((t - 1.2) / 0.35) ** 2) + 0.9 * np.exp(-((t - 3.6) / 0.35) ** 2)
-        - 0.6 * np.exp(-((t - 5.2) / 0.3) ** 2),
+        "jawOpen": 0.33 * min(1.0, 0.7 * talk + 1.0 * wide),
+        "mouthStretchLeft": stretch, "mouthStretchRight": stretch,
+        "mouthSmileLeft": smile, "mouthSmileRight": smile,
+        "browInnerUp": 0.4 * brows, "browOuterUpLeft": 0.4 * brows, "browOuterUpRight": 0.4 * brows,
+        "browDownLeft": 0.48 * down, "browDownRight": 0.48 * down,
     }
     angles = {"yaw": 16 * np.sin(2 * np.pi * t / 4.0), "pitch": 5 * np.sin(2 * np.pi * t / 3.1),
               "roll": 6 * np.sin(2 * np.pi * t / 5.3)}

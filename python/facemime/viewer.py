@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import json
 import re
-import reprlib
 import sys
 import textwrap
 import threading
@@ -44,12 +43,11 @@ import cv2
 import numpy as np
 
 from facemime.animate.analysis import Analysis
+from facemime.animate.replay import FPS_RANGE, load_replay
 from facemime.animate.synth import BACKGROUND, Puppet, UserMotion
 from facemime.errors import FacemimeError, InputFileError, InvalidInputError, NoFaceError
-from facemime.fit.actor import Actor, generic_actor
+from facemime.fit.actor import Actor
 from facemime.fit.placement import model_iod
-from facemime.io.contours_json import ContourFileError, read_motion
-from facemime.io.limits import limit
 from facemime.io.video import VideoReader
 from facemime.render.projection import Pose
 from facemime.render.texture_map import fill
@@ -62,43 +60,12 @@ KEYS = {
     "x": {"gain": 1.25}, "z": {"gain": 0.8},
 }
 HELP = "arrows: turn and tilt · q/e: roll · +/-: zoom · x/z: more/less motion · r: reset · space: pause"
-#: The largest frame side of a track file's ``video`` block, pixels.
-MAX_SIDE = 16384
-#: The frame rates the viewer plays at (a video's own beyond them is clamped; a track's refused).
-FPS_RANGE = (0.1, 1000.0)
 #: The most bytes of a request's line and headers together.
 MAX_HEAD = 8192
 #: ``Host`` values (any port) and ``Origin`` values the server answers: this machine's own names.
 LOOPBACK = r"(?:127\.0\.0\.1|localhost|\[::1\])(?::\d{1,5})?"
 LOOPBACK_HOST = re.compile(LOOPBACK, re.IGNORECASE)
 LOOPBACK_ORIGIN = re.compile(rf"https?://{LOOPBACK}", re.IGNORECASE)
-
-
-def _track_settings(where: str, video: Any, model: dict) -> tuple[tuple[int, int], float, np.ndarray, float | None]:
-    """(width, height), fps, feature sizes and iod (None: absent) of a track file's ``video``
-    and ``model`` blocks, checked: :class:`ContourFileError` names the first wrong field."""
-    if not isinstance(video, dict):
-        raise ContourFileError(f"{where}: 'video' must be an object (width, height, fps), got {reprlib.repr(video)}")
-
-    def number(block: dict, key: str, default: float | None, ok: Any, expected: str) -> Any:
-        value = block.get(key, default)
-        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float)) or not ok(value)):
-            raise ContourFileError(f"{where}: {key!r} must be {expected}, got {reprlib.repr(value)}")
-        return value
-
-    side = (lambda v: isinstance(v, int) and 0 < v <= MAX_SIDE, f"a whole number from 1 to {MAX_SIDE}")
-    size = (number(video, "width", 512, *side), number(video, "height", 512, *side))
-    if size[0] * size[1] > limit("FACEMIME_MAX_IMAGE_PIXELS"):
-        raise ContourFileError(f"{where}: a {size[0]}x{size[1]} frame is over the limit of "
-                               f"{limit('FACEMIME_MAX_IMAGE_PIXELS')} pixels (FACEMIME_MAX_IMAGE_PIXELS)")
-    fps = float(number(video, "fps", 25.0, lambda v: FPS_RANGE[0] <= v <= FPS_RANGE[1],
-                       f"a number from {FPS_RANGE[0]:g} to {FPS_RANGE[1]:g}"))
-    iod = number(model, "iod", None, lambda v: 0 < v < float("inf"), "a positive number")
-    sizes = model["feature_sizes"]
-    if (len(sizes) != len(model["knots"]) or any(isinstance(s, bool) or not isinstance(s, (int, float)) for s in sizes)
-            or not all(0 < s < float("inf") for s in sizes)):
-        raise ContourFileError(f"{where}: 'feature_sizes' must be {len(model['knots'])} positive numbers, one per knot")
-    return size, fps, np.asarray(sizes, np.float64), None if iod is None else float(iod)
 
 
 class Viewer:
@@ -122,11 +89,9 @@ class Viewer:
         self._actor = actor
         self._is_track = self.source.suffix.lower() == ".json"
         if self._is_track:
-            video, model, self._motions = read_motion(self.source)
-            self.size, self.fps, sizes, iod = _track_settings(str(self.source), video, model)
-            driven = actor or generic_actor()
-            key = Pose(**self._motions[0]["pose"]) if self._motions else None
-            self._puppet = Puppet(driven, sizes, model_iod(driven.model) if iod is None else iod, key, mask_only)
+            replay = load_replay(self.source, actor)
+            self.size, self.fps, self._motions = replay.size, replay.fps, replay.motion
+            self._puppet = replay.puppet(mask_only)
         else:
             with VideoReader(self.source) as r:
                 self.size, self.fps = (r.width, r.height), min(max(r.fps, FPS_RANGE[0]), FPS_RANGE[1])
@@ -138,7 +103,7 @@ class Viewer:
         while True:
             if self._is_track:
                 for m in self._motions:
-                    yield None, Pose(**m["pose"]), m["offsets"], m["look"], self._puppet
+                    yield None, m.pose, m.offsets, m.look, self._puppet
                 continue
             analysis = None
             with VideoReader(self.source) as reader:

@@ -20,7 +20,7 @@ def mouth_polygon_mask(points, actor, shape):
 
 
 def test_an_open_mouth_shows_a_dark_cavity_and_teeth_not_the_background(actor):
-    vertices = actor.model.deform({"jaw_drop": 1.0})
+    vertices = actor.model.deform({"jawOpen": 0.33})
     img = synthesize(actor, vertices, actor.pose, (512, 512), background=GREEN)
     inside = mouth_polygon_mask(project(vertices, actor.pose)[0], actor, img.shape[:2])
     assert inside.sum() > 300
@@ -88,10 +88,11 @@ def test_lips_cover_the_teeth_unless_the_mouth_spreads(actor):
         rows = np.nonzero(bright)[0]
         return (rows < middle).sum(), (rows > middle).sum(), inside.sum()
 
-    o_upper, o_lower, o_area = teeth_rows({"jaw_drop": 1.0, "lip_stretch": -1.0})  # corners at 0.77 of rest
+    o_upper, o_lower, o_area = teeth_rows({"jawOpen": 0.33, "mouthPucker": 0.52})  # corners at 0.77 of rest
     assert o_upper > 0.02 * o_area and o_lower == 0
-    _, open_lower, _ = teeth_rows({"jaw_drop": 1.0})
-    s_upper, s_lower, s_area = teeth_rows({"jaw_drop": 1.0, "lip_stretch": 1.0})  # corners at 1.23 of rest
+    _, open_lower, _ = teeth_rows({"jawOpen": 0.33})
+    stretch = {"mouthStretchLeft": 0.23, "mouthStretchRight": 0.23}
+    s_upper, s_lower, s_area = teeth_rows({"jawOpen": 0.33, **stretch})  # corners at 1.23 of rest
     assert s_upper > 0.05 * s_area and s_lower > 0.02 * s_area and 0 < open_lower < s_lower
     assert teeth_uncovered(0.85) == 0.0 and teeth_uncovered(1.2) == 1.0 and 0.0 < teeth_uncovered(1.0) < 1.0
 

@@ -84,6 +84,8 @@ def test_the_per_frame_work_composes_every_frame_without_encoding(clip):
         assert (canvas[:, 512:] != BACKGROUND).any(axis=2).mean() > 0.1  # the face: a fifth of the frame
     result = work.result([])
     assert result.frames == 6 and result.fps > 0 and result.seconds["track"] > 0
+    # the expression weights, solved frame by frame: named, in [0, 1]
+    assert len(work.weights) == 6 and all(0 <= v <= 1 for r in work.records for v in r["weights"].values())
 
 
 def test_the_per_frame_work_of_no_frames_says_so():

@@ -53,18 +53,22 @@ def test_contour_groups_match_the_snake_contours(head):
 def test_deformation_units_move_the_right_way(head):
     g, v = head.groups, head.vertices
     lip = g["mouth_inner_lower"][5]
-    assert head.deform({"jaw_drop": 1})[lip, 1] < v[lip, 1] - 8
-    assert np.allclose(head.deform({"brow_raise": 1})[g["brow_left_upper"], 1] - v[g["brow_left_upper"], 1], 7)
-    assert (head.deform({"brow_raise": -1})[g["brow_right_lower"], 1] < v[g["brow_right_lower"], 1]).all()
-    corner = g["mouth_outer_upper"][-1]
-    assert head.deform({"lip_stretch": 1})[corner, 0] > v[corner, 0] + 4
-    assert head.deform({"lip_corner_raise": 1})[corner, 1] > v[corner, 1] + 3
+    assert head.deform({"jawOpen": 1})[lip, 1] < v[lip, 1] - 8
+    brows = np.concatenate([g["brow_left_upper"], g["brow_right_upper"]])
+    raised = head.deform({"browInnerUp": 1, "browOuterUpLeft": 1, "browOuterUpRight": 1})
+    assert (raised[brows, 1] > v[brows, 1] + 5).all()
+    assert (head.deform({"browDownRight": 1})[g["brow_right_lower"], 1] < v[g["brow_right_lower"], 1]).all()
+    corner = g["mouth_outer_upper"][-1]  # image-right: the subject's left corner
+    assert head.deform({"mouthStretchLeft": 1})[corner, 0] > v[corner, 0] + 4
+    assert head.deform({"mouthSmileLeft": 1})[corner, 1] > v[corner, 1] + 3
     up = g["mouth_outer_upper"][5]
-    assert head.deform({"upper_lip_raise": 1})[up, 1] > v[up, 1] + 2
-    closed = head.deform({"eyes_closed": 1})
+    assert head.deform({"mouthUpperUpLeft": 1, "mouthUpperUpRight": 1})[up, 1] > v[up, 1] + 2
+    closed = head.deform({"eyeBlinkLeft": 1})
     ring = g["eye_left"]
     assert np.abs(closed[ring[1:4], 1] - closed[ring[7:4:-1], 1]).max() < 0.5
-    assert set(head.units) == {"jaw_drop", "lip_stretch", "lip_corner_raise", "upper_lip_raise", "brow_raise", "eyes_closed"}
+    from facemime.animate.expressions import NAMES
+
+    assert tuple(head.units) == NAMES
 
 
 def test_unknown_unit_is_named(head):
@@ -87,7 +91,7 @@ def model_doc():
         (lambda d: d["triangles"].append([0, 0, 1]), "is degenerate"),
         (lambda d: d["groups"].pop("brow_left_upper"), "missing vertex groups brow_left_upper"),
         (lambda d: d["vertices"][3].__setitem__(0, "x"), "malformed model"),
-        (lambda d: d["deformation_units"]["jaw_drop"]["displacements"].append([500, 0, 0, 0]), "names vertex 500"),
+        (lambda d: d["deformation_units"]["jawOpen"]["displacements"].append([500, 0, 0, 0]), "names vertex 500"),
     ],
 )
 def test_bad_model_files_are_refused_with_a_message(tmp_path, edit, message):

@@ -2,12 +2,14 @@
 
 Writes a side-by-side video (the original with the tracked contours | the synthesised picture:
 the face in the driven actor's scene, or alone with ``mask_only``) that browsers play, and the
-``facemime.track/1`` JSON with contours, head pose, knot offsets and look (the eyes,
-:mod:`facemime.animate.look`) per frame; when the face is
+``facemime.track/1`` JSON with contours, head pose, knot offsets, look (the eyes,
+:mod:`facemime.animate.look`) and expression weights (:mod:`facemime.animate.expressions`)
+per frame, and on request the weights as CSV (``frame,time_s,<names...>``); when the face is
 synthesised in its own scene, also how far each frame departs from that synthesis
 (:mod:`facemime.animate.departure`): per frame ``scene_departure`` (0..1) and
 ``scene_departs`` (bool), and top-level ``scene_departs`` (the [first, last] frame ranges
-reported). Outputs appear only when complete.
+reported). Outputs appear only when complete. Given a track file instead of a video
+(:func:`run_track`), it writes the synthesised picture of the track's motion alone.
 """
 
 from __future__ import annotations
@@ -21,13 +23,14 @@ import numpy as np
 
 from facemime.animate.analysis import Analysis
 from facemime.animate.departure import DEPARTS_AT, departure
+from facemime.animate.expressions import Expressions
 from facemime.animate.synth import BACKGROUND, Puppet, UserMotion
 from facemime.errors import InputFileError, InvalidInputError, NoFaceError
 from facemime.fit.actor import Actor
 from facemime.fit.placement import model_iod
 from facemime.io.actor_file import load_actor
 from facemime.io.contours_json import TrackWriter
-from facemime.io.outputs import Outputs
+from facemime.io.outputs import Outputs, write_text
 from facemime.io.video import CODECS, VideoReader, VideoWriter
 from facemime.progress import track as progress
 from facemime.render.projection import Pose, project
@@ -101,6 +104,8 @@ class SideBySide:
         self.frames = 0
         self.seconds = dict.fromkeys(("decode", "track", "pose", "look", "synth", "compose"), 0.0)
         self.analysis: Analysis | None = None
+        #: Per frame, the expression weights (E,) solved from its offsets and look.
+        self.weights: list[np.ndarray] = []
 
     def __iter__(self) -> Iterator[np.ndarray]:
         seconds, canvas, synth, puppet = self.seconds, None, None, None
@@ -127,6 +132,7 @@ class SideBySide:
                 canvas = np.empty((h, 2 * w, 3), np.uint8)
                 synth = np.empty((h, w, 3), np.uint8)
                 motion = self.analysis.last
+                solver = Expressions.of(actor.model).solver()
             else:
                 motion = self.analysis.update(frame)
             t1 = time.perf_counter()
@@ -136,6 +142,8 @@ class SideBySide:
             record = {"index": self.frames, "contours": motion.contours, "confidence": motion.confidence,
                       "lost": motion.lost, "redetected": motion.redetected, "face": motion.face,
                       "pose": pose_dict(motion.pose), "offsets": motion.offsets, "look": motion.look.as_dict()}
+            self.weights.append(solver.step(motion.offsets, motion.look.closure))
+            record["weights"] = solver.named(self.weights[-1])
             if compare and motion.face:
                 vertices, shown = puppet.shown
                 share = departure(frame, synth, project(vertices[outline], shown)[0])
@@ -169,36 +177,99 @@ class SideBySide:
                          {**self.seconds, "encode": encode_seconds}, [list(r) for r in self.departs])
 
 
-def run_video(video: str | Path, out: str | Path, actor: str | Path | Actor | None = None,
-              track: str | Path | None = None, user: UserMotion = UserMotion(), force: bool = False,
-              params: TrackerParams | None = None, mask_only: bool = False) -> RunResult:
-    """Analyse ``video`` and write ``out`` (.mp4 or .webm, side by side) and ``track`` (default:
-    ``out`` with the suffix ``.json``). ``actor``: an ``.actor`` file or an :class:`Actor` to
-    drive (default: the actor fitted on the first frame), shown in its own scene unless
-    ``mask_only`` (or it has none). Both outputs or neither are written; existing ones are
-    refused unless ``force``, an input always."""
+def weights_csv(weights: list[np.ndarray], fps: float) -> str:
+    """The expression ``weights`` (per frame (E,)) as CSV text: a header ``frame,time_s,<names>``
+    (:data:`facemime.animate.expressions.NAMES`), then a row per frame (time in seconds at
+    ``fps``; weights with 4 decimals)."""
+    from facemime.animate.expressions import NAMES
+
+    lines = [",".join(("frame", "time_s") + NAMES)]
+    for i, w in enumerate(weights):
+        lines.append(f"{i},{i / fps if fps > 0 else 0.0:.4f}," + ",".join(f"{x:.4f}" for x in w))
+    return "\n".join(lines) + "\n"
+
+
+def video_output(out: str | Path) -> Path:
+    """``out`` as a path, refused unless it names a video run writes (.mp4 or .webm)."""
     out = Path(out)
     if out.suffix.lower() not in CODECS:
         raise InvalidInputError(f"the output video must end in .mp4 or .webm, got {out.name!r}")
+    return out
+
+
+def write_frames(writer: VideoWriter, frames: Iterable[np.ndarray]) -> float:
+    """Hands each of ``frames`` to ``writer``; returns the seconds that took (the encoding)."""
+    encode = 0.0
+    for image in frames:
+        t0 = time.perf_counter()
+        writer.write(image)
+        encode += time.perf_counter() - t0
+    return encode
+
+
+def run_video(video: str | Path, out: str | Path, actor: str | Path | Actor | None = None,
+              track: str | Path | None = None, user: UserMotion = UserMotion(), force: bool = False,
+              params: TrackerParams | None = None, mask_only: bool = False,
+              weights: str | Path | None = None) -> RunResult:
+    """Analyse ``video`` and write ``out`` (.mp4 or .webm, side by side) and ``track`` (default:
+    ``out`` with the suffix ``.json``), and with ``weights`` the expression weights as a .csv
+    file (:func:`weights_csv`). ``actor``: an ``.actor`` file or an :class:`Actor` to
+    drive (default: the actor fitted on the first frame), shown in its own scene unless
+    ``mask_only`` (or it has none). All outputs or none are written; existing ones are
+    refused unless ``force``, an input always."""
+    out = video_output(out)
     track = out.with_suffix(".json") if track is None else Path(track)
     if track.suffix.lower() != ".json":
         raise InvalidInputError(f"the track file must end in .json, got {track.name!r}")
+    csv = None if weights is None else Path(weights)
+    if csv is not None and csv.suffix.lower() != ".csv":
+        raise InvalidInputError(f"the weights file must end in .csv, got {csv.name!r}")
     actor_path = actor if isinstance(actor, (str, Path)) else None
-    with Outputs([out, track], force, inputs=[video, actor_path]) as outputs:
+    with Outputs([out, track] + ([csv] if csv else []), force, inputs=[video, actor_path]) as outputs:
         target = load_actor(actor_path) if actor_path is not None else actor
-        encode = 0.0
         with (VideoReader(video) as reader, VideoWriter(outputs.stage(out), reader.fps) as writer,
               TrackWriter(outputs.stage(track)) as records):
             work = SideBySide(progress(reader, reader.frames or None, "running"), str(video), target, user, params,
                               records, mask_only)
-            for canvas in work:
-                t0 = time.perf_counter()
-                writer.write(canvas)
-                encode += time.perf_counter() - t0
-            result = work.result([out, track], encode)
+            encode = write_frames(writer, work)
+            result = work.result([out, track] + ([csv] if csv else []), encode)
             result.warnings.extend(reader.warnings)
             busy = sum(v for k, v in result.seconds.items() if k not in ("encode", "fit", "decode"))
             info = {"width": reader.width, "height": reader.height, "fps": reader.fps, "frames": result.frames}
             records.close(info, {"processing_seconds": round(busy, 4), "frames_processed": result.frames},
                           work.analysis.model_block, {"scene_departs": result.departs} if result.departs else None)
+            if csv is not None:
+                write_text(outputs.stage(csv), weights_csv(work.weights, reader.fps))
     return result
+
+
+def run_track(track: str | Path, out: str | Path, actor: str | Path | Actor | None = None,
+              user: UserMotion = UserMotion(), force: bool = False, mask_only: bool = False) -> RunResult:
+    """Play the motion of the ``facemime.track/1`` file ``track`` (from :func:`run_video`, or
+    expression weights written by hand; :mod:`facemime.animate.replay`) on ``actor`` (an
+    ``.actor`` file or an :class:`Actor`; default: the generic painted head) and write the
+    synthesised picture alone to ``out`` (.mp4 or .webm) at the track's size and frame rate: in
+    the actor's scene unless ``mask_only`` (or it has none), frames without a face dimmed, with
+    ``user`` motion added. Seconds: ``decode`` reading the track, ``synth``, ``encode``."""
+    from facemime.animate.replay import load_replay
+
+    out = video_output(out)
+    actor_path = actor if isinstance(actor, (str, Path)) else None
+    with Outputs([out], force, inputs=[track, actor_path]) as outputs:
+        seconds = dict.fromkeys(("decode", "track", "pose", "look", "synth", "compose"), 0.0)
+        t0 = time.perf_counter()
+        replay = load_replay(track, load_actor(actor_path) if actor_path is not None else actor)
+        puppet = replay.puppet(mask_only)
+        seconds["decode"] = time.perf_counter() - t0
+
+        def frames() -> Iterator[np.ndarray]:
+            for m in progress(replay.motion, len(replay.motion), "playing"):
+                t = time.perf_counter()
+                image = puppet.render(m.pose, m.offsets, replay.size, user, look=m.look)
+                seconds["synth"] += time.perf_counter() - t
+                yield image if m.face else (image * NO_FACE_DIM).astype(np.uint8)
+
+        with VideoWriter(outputs.stage(out), replay.fps) as writer:
+            encode = write_frames(writer, frames())
+    return RunResult(len(replay.motion), sum(not m.face for m in replay.motion), [out], [],
+                     {**seconds, "encode": encode})

@@ -133,26 +133,44 @@ def user_motion_options(f):
 
 
 @cli.command()
-@click.argument("video", type=click.Path(path_type=Path))
+@click.argument("video", metavar="VIDEO_OR_TRACK", type=click.Path(path_type=Path))
 @click.option("--actor", "actor_file", type=click.Path(path_type=Path),
-              help="NAME.actor to drive (from facemime fit; default: the face fitted on the first frame).")
+              help="NAME.actor to drive (from facemime fit; default: the face fitted on the first frame, or for a "
+                   "track file the generic head).")
 @click.option("--out", "out_file", type=click.Path(path_type=Path), required=True,
-              help="Side-by-side video to write (.mp4 or .webm): the original with contours | the synthesised picture.")
+              help="Side-by-side video to write (.mp4 or .webm): the original with contours | the synthesised picture "
+                   "(for a track file: the synthesised picture alone).")
 @click.option("--track", "track_file", type=click.Path(path_type=Path),
               help="facemime.track/1 JSON to write: contours, head pose and motion per frame (default: OUT with .json).")
+@click.option("--weights", "weights_file", type=click.Path(path_type=Path),
+              help="CSV to write with the expression weights per frame (frame,time_s,jawOpen,...), for a spreadsheet.")
 @user_motion_options
 @mask_only_option
 @click.option("--force", is_flag=True, help="Overwrite existing output files.")
-def run(video: Path, actor_file: Path | None, out_file: Path, track_file: Path | None, yaw: float, pitch: float,
-        roll: float, zoom: float, gain: float, mask_only: bool, force: bool) -> None:
+def run(video: Path, actor_file: Path | None, out_file: Path, track_file: Path | None, weights_file: Path | None,
+        yaw: float, pitch: float, roll: float, zoom: float, gain: float, mask_only: bool, force: bool) -> None:
     """Analyse the face in VIDEO (fit, track, head pose) and re-synthesise every frame on an actor,
-    in the actor's own scene (the picture it was fitted on)."""
-    from facemime.animate.run import run_video
+    in the actor's own scene (the picture it was fitted on). A TRACK.json (from run, or expression
+    weights written by hand) is played instead: its synthesised picture alone, at its size and
+    frame rate, with the motion options added; --track and --weights need a video."""
+    from facemime.animate.run import run_track, run_video
     from facemime.animate.synth import UserMotion
+    from facemime.errors import InvalidInputError
 
     user = UserMotion(yaw=yaw, pitch=pitch, roll=roll, zoom=zoom, gain=gain)
     t0 = time.perf_counter()
-    result = run_video(video, out_file, actor_file, track_file, user, force, mask_only=mask_only)
+    if video.suffix.lower() == ".json":
+        if track_file is not None or weights_file is not None:
+            raise InvalidInputError(f"--track and --weights write what run measures on a video; {video} is a "
+                                    "track file already")
+        result = run_track(video, out_file, actor_file, user, force, mask_only)
+        wall = time.perf_counter() - t0
+        click.echo(str(out_file))
+        missing = f"; no face in {result.frames_without_face} frames" if result.frames_without_face else ""
+        click.echo(f"played {result.frames} frames of {video} in {wall:.1f} s ({result.frames / wall:.0f} frames/s)"
+                   f"{missing}", err=True)
+        return
+    result = run_video(video, out_file, actor_file, track_file, user, force, mask_only=mask_only, weights=weights_file)
     wall = time.perf_counter() - t0
     for w in result.warnings:
         click.echo(f"facemime: warning: {w}", err=True)
@@ -171,10 +189,11 @@ def run(video: Path, actor_file: Path | None, out_file: Path, track_file: Path |
 
 
 @cli.command()
-@click.argument("video", type=click.Path(path_type=Path))
+@click.argument("video", metavar="VIDEO_OR_TRACK", type=click.Path(path_type=Path))
 @click.option("--actor", "actor_file", type=click.Path(path_type=Path),
               help="NAME.actor of this person that the receiver already holds: the stream names it instead of "
-                   "carrying it (default: fit one on the first frame and carry it).")
+                   "carrying it (default: fit one on the first frame, or for a track file the generic head, "
+                   "and carry it).")
 @click.option("--quality", type=click.IntRange(0, 10), help="0 (coarsest) to 10 (finest); default 5, under 2 kbit/s.")
 @click.option("--rate", type=float, help="Target rate of the motion, kbit/s: the finest quality that fits (instead of --quality).")
 @click.option("--keyframe", type=float, default=1.0, show_default=True,
@@ -189,7 +208,8 @@ def run(video: Path, actor_file: Path | None, out_file: Path, track_file: Path |
 def encode(video: Path, actor_file: Path | None, quality: int | None, rate: float | None, keyframe: float, packet: float,
            embed_actor: bool, appearance: float, out_file: Path, force: bool) -> None:
     """Analyse the face in VIDEO and write its motion as a facemime stream: a couple of kilobits
-    a second, plus the actor once."""
+    a second, plus the actor once. A TRACK.json (from run, or expression weights written by hand)
+    is coded from its recorded motion instead, at its size and frame rate (no --appearance)."""
     from facemime.codec.files import encode_video
     from facemime.codec.stream import DEFAULT_QUALITY, Settings
     from facemime.errors import InvalidInputError
@@ -261,6 +281,26 @@ def view(source: Path, actor_file: Path | None, port: int, no_browser: bool, mas
             server.serve_forever()
         finally:
             server.server_close()
+
+
+@cli.command()
+@click.argument("track", type=click.Path(path_type=Path))
+@click.option("--actor", "actor_file", type=click.Path(path_type=Path),
+              help="NAME.actor to carry the performance (default: the generic head, as view plays a track file).")
+@click.option("--out", "out_file", type=click.Path(path_type=Path), required=True,
+              help="PERFORMANCE.glb to write: binary glTF 2.0, the textured head, its expression morph targets and "
+                   "one animation (weights and head pose) at the track's frame rate.")
+@click.option("--force", is_flag=True, help="Overwrite the output file.")
+def export(track: Path, actor_file: Path | None, out_file: Path, force: bool) -> None:
+    """Export the performance of TRACK.json (from facemime run) as a glTF 2.0 file for Blender,
+    three.js, Unity or Unreal: the actor's textured mesh in metres, y up, its named expression
+    controls (ARKit names) as morph targets, and their weights and the head pose per frame."""
+    from facemime.export import export_track
+
+    result = export_track(track, out_file, actor_file, force)
+    click.echo(str(result.path))
+    click.echo(f"exported {result.frames} frames, {result.controls} morph targets, {result.bytes} bytes "
+               f"in {result.seconds:.2f} s", err=True)
 
 
 @cli.command()

@@ -5,8 +5,10 @@ Encoding analyses the whole video first (fit, track, head pose, knot offsets), l
 of the knots' motion from this clip (its principal directions; sent once, in the header), picks
 each parameter's starting table from the clip, then codes the frames. With a target rate, it
 takes the finest quality whose motion fits. With an appearance budget, it reads the video again
-and puts appearance updates (:mod:`facemime.codec.appearance`) between the packets. Decoding
-needs only the stream and, when the stream does not carry it, the actor.
+and puts appearance updates (:mod:`facemime.codec.appearance`) between the packets. A track
+file (``.json``: from ``facemime run``, or expression weights written by hand) is coded from its
+recorded motion instead of analysing a video (:func:`track_clip`). Decoding needs only the
+stream and, when the stream does not carry it, the actor.
 """
 
 from __future__ import annotations
@@ -110,6 +112,19 @@ def analyse(video: str | Path, actor: Actor | None = None) -> Clip:
                     list(analysis.warnings) + list(reader.warnings), time.perf_counter() - t0)
 
 
+def track_clip(track: str | Path, actor: Actor | None = None) -> Clip:
+    """The motion of the ``facemime.track/1`` file ``track`` as a clip, on ``actor`` (default:
+    the generic painted head) as ``view`` plays it (:mod:`facemime.animate.replay`): the track's
+    size and frame rate, its motion measured on the actor itself."""
+    from facemime.animate.replay import load_replay
+
+    t0 = time.perf_counter()
+    replay = load_replay(track, actor)
+    if not any(m.face for m in replay.motion):
+        raise InputFileError(f"track {track} has no frame with a face")
+    return Clip(replay.actor, replay.fps, replay.size, replay.in_actor_units(), [], time.perf_counter() - t0)
+
+
 def _look(frame: FrameMotion) -> Look:
     # a frame's look; neutral for motion made without one (FrameMotion before it had a look)
     return getattr(frame, "look", None) or Look()
@@ -164,11 +179,13 @@ def with_appearance(video: str | Path, clip: Clip, header: bytes, actor_chunk: b
 def encode_video(video: str | Path, out: str | Path, actor: str | Path | None = None, settings: Settings = Settings(),
                  rate: float | None = None, carry_actor: bool | None = None, force: bool = False,
                  appearance: float = 0.0) -> EncodeResult:
-    """Analyse ``video`` and write the stream ``out`` (``.fmstream``). ``actor``: an ``.actor``
-    file the receiver holds (the stream names it; default: fit one on the first frame, and the
-    stream carries it). ``rate``: the motion's target, kbit/s: the finest quality that fits
-    (``settings.quality`` is then ignored). ``carry_actor``: put the actor in the stream (default:
-    only when it was fitted here). ``appearance``: kbit/s for appearance updates (0: none)."""
+    """Analyse ``video`` and write the stream ``out`` (``.fmstream``); a ``video`` ending in
+    ``.json`` is a track file whose motion is coded instead (:func:`track_clip`). ``actor``: an
+    ``.actor`` file the receiver holds (the stream names it; default: fit one on the first frame,
+    or for a track file the generic painted head, and the stream carries it). ``rate``: the
+    motion's target, kbit/s: the finest quality that fits (``settings.quality`` is then ignored).
+    ``carry_actor``: put the actor in the stream (default: only when it was not given).
+    ``appearance``: kbit/s for appearance updates (0: none; a track file has no appearance)."""
     out = Path(out)
     if out.suffix.lower() != SUFFIX:
         raise InvalidInputError(f"the stream must end in {SUFFIX}, got {out.name!r}")
@@ -176,10 +193,13 @@ def encode_video(video: str | Path, out: str | Path, actor: str | Path | None = 
         raise InvalidInputError(f"the target rate must be a positive number of kbit/s, got {rate}")
     if not (np.isfinite(appearance) and 0 <= appearance <= MAX_APPEARANCE):
         raise InvalidInputError(f"the appearance budget must be 0-{MAX_APPEARANCE:g} kbit/s, got {appearance}")
+    from_track = Path(video).suffix.lower() == ".json"
+    if from_track and appearance > 0:
+        raise InvalidInputError(f"appearance updates are taken from a video, and {video} is a track file")
     check_outputs([out], force, inputs=[video, actor])
     given = load_actor(actor) if actor is not None else None
     carry = given is None if carry_actor is None else carry_actor
-    clip = analyse(video, given)
+    clip = track_clip(video, given) if from_track else analyse(video, given)
     t0 = time.perf_counter()
     faces = [m.offsets for m in clip.motion if m.face]
     basis = Basis.learn(np.array(faces).reshape(len(faces), -1, 2), MAX_COEFFICIENTS)

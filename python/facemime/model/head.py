@@ -118,7 +118,7 @@ class HeadModel:
         """Vertices with deformation units (and shape units) applied: (N, 3) float64.
 
         >>> head = generic_head()
-        >>> moved = head.deform({"jaw_drop": 1.0})
+        >>> moved = head.deform({"jawOpen": 0.5})
         >>> bool(moved[head.groups["mouth_outer_lower"][5], 1] < head.vertices[head.groups["mouth_outer_lower"][5], 1])
         True
         """

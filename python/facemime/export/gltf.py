@@ -1,0 +1,125 @@
+"""A minimal binary glTF 2.0 (``.glb``) writer: one JSON chunk and one binary chunk, built with
+numpy and :mod:`struct` (the format is a 12-byte header and two length-prefixed chunks, and every
+array goes out as one little-endian buffer view, so a library would add a dependency and a copy
+of every array without making this clearer).
+
+:class:`Glb` collects the JSON document and the binary buffer; :meth:`Glb.accessor` stores an
+array and describes it. Axes and units are the caller's: glTF's are right-handed, metres, +y up,
+the asset's front towards +z (see :mod:`facemime.export.performance`).
+"""
+
+from __future__ import annotations
+
+import json
+import struct
+from typing import Any
+
+import numpy as np
+
+GLB_MAGIC = 0x46546C67  # "glTF"
+JSON_CHUNK = 0x4E4F534A  # "JSON"
+BIN_CHUNK = 0x004E4942  # "BIN\0"
+ARRAY_BUFFER = 34962
+ELEMENT_ARRAY_BUFFER = 34963
+#: glTF component types of the numpy dtypes written.
+COMPONENTS = {np.dtype("<f4"): 5126, np.dtype("<u4"): 5125, np.dtype("<u2"): 5123, np.dtype("<u1"): 5121}
+#: glTF accessor types by the number of components per element.
+TYPES = {1: "SCALAR", 2: "VEC2", 3: "VEC3", 4: "VEC4"}
+
+
+class Glb:
+    """A glTF document being built, with its binary buffer.
+
+    >>> g = Glb()
+    >>> g.accessor(np.zeros((3, 2), np.float32))
+    0
+    >>> data = g.bytes()
+    >>> struct.unpack_from("<III", data) == (GLB_MAGIC, 2, len(data))
+    True
+    """
+
+    def __init__(self, generator: str = "facemime"):
+        self.doc: dict[str, Any] = {"asset": {"version": "2.0", "generator": generator}}
+        self._pieces: list[bytes] = []
+        self._length = 0
+
+    def add(self, kind: str, entry: dict[str, Any]) -> int:
+        """Append ``entry`` to the document's list ``kind`` (``nodes``, ``meshes``, ...); its index."""
+        items = self.doc.setdefault(kind, [])
+        items.append(entry)
+        return len(items) - 1
+
+    def view(self, data: bytes, target: int | None = None) -> int:
+        """Store ``data`` as a buffer view (4-byte aligned, as glTF needs for floats); its index."""
+        pad = -self._length % 4
+        if pad:
+            self._pieces.append(b"\0" * pad)
+            self._length += pad
+        entry: dict[str, Any] = {"buffer": 0, "byteOffset": self._length, "byteLength": len(data)}
+        if target is not None:
+            entry["target"] = target
+        self._pieces.append(data)
+        self._length += len(data)
+        return self.add("bufferViews", entry)
+
+    def accessor(self, array: np.ndarray, target: int | None = None, bounds: bool = False) -> int:
+        """Store ``array`` ((count,) or (count, 1-4) of float32, uint32, uint16 or uint8) and
+        describe it; ``bounds``: write its per-component ``min`` and ``max`` (glTF needs them on
+        positions and animation times). Its accessor index."""
+        a = np.ascontiguousarray(array, dtype=array.dtype.newbyteorder("<"))
+        width = 1 if a.ndim == 1 else a.shape[1]
+        entry: dict[str, Any] = {"bufferView": self.view(a.tobytes(), target), "componentType": COMPONENTS[a.dtype],
+                                 "count": int(a.shape[0]), "type": TYPES[width]}
+        if bounds:
+            flat = a.reshape(len(a), width)
+            cast = float if a.dtype.kind == "f" else int
+            entry["min"] = [cast(v) for v in flat.min(axis=0)]
+            entry["max"] = [cast(v) for v in flat.max(axis=0)]
+        return self.add("accessors", entry)
+
+    def bytes(self) -> bytes:
+        """The ``.glb`` file: header, JSON chunk (padded with spaces), binary chunk (with zeros)."""
+        if self._length:
+            self.doc["buffers"] = [{"byteLength": self._length + (-self._length % 4)}]
+        text = json.dumps(self.doc, separators=(",", ":")).encode()
+        text += b" " * (-len(text) % 4)
+        blob = b"".join(self._pieces)
+        blob += b"\0" * (-len(blob) % 4)
+        chunks = struct.pack("<II", len(text), JSON_CHUNK) + text
+        if blob:
+            chunks += struct.pack("<II", len(blob), BIN_CHUNK) + blob
+        return struct.pack("<III", GLB_MAGIC, 2, 12 + len(chunks)) + chunks
+
+
+def read_glb(data: bytes) -> tuple[dict[str, Any], bytes]:
+    """The JSON document and binary chunk of a ``.glb`` file's bytes (for checks; no validation
+    beyond the header and chunk types).
+
+    >>> doc, blob = read_glb(Glb("x").bytes())
+    >>> doc["asset"], blob
+    ({'version': '2.0', 'generator': 'x'}, b'')
+    """
+    magic, version, length = struct.unpack_from("<III", data)
+    if magic != GLB_MAGIC or version != 2 or length != len(data):
+        raise ValueError("not a glTF 2.0 binary file")
+    size, kind = struct.unpack_from("<II", data, 12)
+    if kind != JSON_CHUNK:
+        raise ValueError("the first chunk of a .glb must be JSON")
+    doc = json.loads(data[20:20 + size])
+    rest = 20 + size
+    blob = b""
+    if rest < len(data):
+        size, kind = struct.unpack_from("<II", data, rest)
+        blob = data[rest + 8:rest + 8 + size] if kind == BIN_CHUNK else b""
+    return doc, blob
+
+
+def accessor_array(doc: dict[str, Any], blob: bytes, index: int) -> np.ndarray:
+    """The array of accessor ``index`` (tightly packed views only, as :class:`Glb` writes them)."""
+    acc = doc["accessors"][index]
+    view = doc["bufferViews"][acc["bufferView"]]
+    dtype = next(d for d, c in COMPONENTS.items() if c == acc["componentType"])
+    width = next(n for n, t in TYPES.items() if t == acc["type"])
+    start = view.get("byteOffset", 0) + acc.get("byteOffset", 0)
+    a = np.frombuffer(blob, dtype, acc["count"] * width, start)
+    return a if width == 1 else a.reshape(-1, width)

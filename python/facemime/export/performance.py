@@ -1,0 +1,225 @@
+"""``facemime export``: a tracked performance as a binary glTF 2.0 file (``.glb``).
+
+The file holds one scene with one node, the head: the actor's mesh (positions in metres, the
+model's millimetres × 0.001; its axes are glTF's: x to the subject's left, y up, z towards the
+viewer, the asset's front; triangles counter-clockwise seen from outside, glTF's front faces),
+its texture as an embedded PNG (texture coordinates from the image's top-left, as glTF's are;
+no flip), an unlit material (``KHR_materials_unlit``: the texture as it is, as facemime draws
+it), one morph target per expression control (the displacement at weight 1, in metres, named in
+``mesh.extras.targetNames``, which three.js and Blender read), and one animation with a key per
+track frame at ``index / fps`` seconds: the weights (``path: "weights"``) and the head's pose as
+the node's rotation, translation and scale (:mod:`facemime.export.animation`; linear).
+
+The pose's pixels are mapped relative to the first frame at the size the head is shown in
+facemime's own picture with ``--mask-only`` (the measured scale times the ratio of the eye
+distances, :class:`facemime.animate.synth.Puppet`); ``scenes[0].extras.facemime`` records the
+video's ``size`` (pixels), ``metres_per_pixel`` and ``origin`` (the pixel on the world origin),
+what an orthographic camera needs to see each frame as facemime draws it. The mouth's interior
+(the cavity and teeth facemime paints behind the lips) and the irises (repainted in the texture)
+are not in the file.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+
+from facemime import __version__
+from facemime.errors import InputFileError, InvalidInputError
+from facemime.animate.replay import track_settings
+from facemime.export.animation import POSE_KEYS, node_keys
+from facemime.export.gltf import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, Glb
+from facemime.fit.actor import Actor, generic_actor
+from facemime.fit.placement import model_iod
+from facemime.io.contours_json import TRACK_FORMAT, ContourFileError, load_document, read_motion
+from facemime.io.outputs import check_outputs, write_bytes
+
+#: Metres per model unit, by the model's ``unit``.
+METRES = {"mm": 0.001, "cm": 0.01, "m": 1.0}
+LINEAR = 9729
+CLAMP = 33071
+
+
+@dataclass(frozen=True, eq=False)
+class Performance:
+    """What an exported file holds.
+
+    Attributes
+    ----------
+    actor : Actor
+        The head, its texture and model (vertices in model units, see :data:`METRES`).
+    names : tuple of str
+        The expression controls (morph targets), E of them.
+    fields : (E, N, 3) float array
+        Each control's vertex displacement at weight 1, model units.
+    times : (T,) float array
+        Seconds of each frame (``index / fps``).
+    weights : (T, E) float array
+        Each frame's control weights, 0..1.
+    poses : (T, 6) float array
+        Each frame's pose as facemime shows it alone (:data:`POSE_KEYS`; degrees, pixels per model
+        unit, pixels).
+    size : (int, int)
+        The video's (width, height), pixels.
+    """
+
+    actor: Actor
+    names: tuple[str, ...]
+    fields: np.ndarray
+    times: np.ndarray
+    weights: np.ndarray
+    poses: np.ndarray
+    size: tuple[int, int]
+
+    @property
+    def metres_per_unit(self) -> float:
+        unit = self.actor.model.unit
+        if unit not in METRES:
+            raise InvalidInputError(f"the actor's model is in {unit!r}; export needs one in {', '.join(METRES)}")
+        return METRES[unit]
+
+
+def glb_bytes(perf: Performance) -> bytes:
+    """The ``.glb`` file of ``perf`` (see the module docstring)."""
+    m = perf.metres_per_unit
+    model = perf.actor.model
+    g = Glb(f"facemime {__version__}")
+    n = len(model.vertices)
+    index_type = np.uint16 if n < 65535 else np.uint32
+    attributes = {"POSITION": g.accessor((model.vertices * m).astype(np.float32), ARRAY_BUFFER, bounds=True),
+                  "TEXCOORD_0": g.accessor(model.uv.astype(np.float32), ARRAY_BUFFER)}
+    indices = g.accessor(model.triangles.astype(index_type).ravel(), ELEMENT_ARRAY_BUFFER)
+    primitive: dict[str, Any] = {"attributes": attributes, "indices": indices, "mode": 4}
+    mesh: dict[str, Any] = {"name": "face", "primitives": [primitive]}
+    if perf.names:
+        primitive["targets"] = [{"POSITION": g.accessor((f * m).astype(np.float32), ARRAY_BUFFER, bounds=True)}
+                                for f in perf.fields]
+        mesh["weights"] = [float(w) for w in perf.weights[0]]
+        mesh["extras"] = {"targetNames": list(perf.names)}
+    ok, png = cv2.imencode(".png", cv2.cvtColor(perf.actor.texture, cv2.COLOR_RGB2BGR))
+    if not ok:
+        raise InvalidInputError("cannot encode the actor's texture as PNG")
+    image = g.add("images", {"bufferView": g.view(png.tobytes()), "mimeType": "image/png"})
+    sampler = g.add("samplers", {"magFilter": LINEAR, "minFilter": LINEAR, "wrapS": CLAMP, "wrapT": CLAMP})
+    texture = g.add("textures", {"source": image, "sampler": sampler})
+    primitive["material"] = g.add("materials", {
+        "name": "face", "pbrMetallicRoughness": {"baseColorTexture": {"index": texture}, "metallicFactor": 0.0},
+        "extensions": {"KHR_materials_unlit": {}}})
+    g.doc["extensionsUsed"] = ["KHR_materials_unlit"]
+    translation, rotation, scale = node_keys(perf.poses, m)
+    node = g.add("nodes", {"name": model.name, "mesh": g.add("meshes", mesh), "rotation": rotation[0].tolist()})
+    first = perf.poses[0]
+    per_pixel = m / float(first[3])
+    g.doc["scenes"] = [{"name": "performance", "nodes": [node], "extras": {"facemime": {
+        "size": list(perf.size), "metres_per_pixel": per_pixel, "origin": [float(first[4]), float(first[5])],
+        "pose_mapping": "rotation Rz(roll)Rx(pitch)Ry(yaw); scale relative to the first frame; translation: "
+                        "pixel shift from the first frame times metres_per_pixel, image y down = -y"}}}]
+    g.doc["scene"] = 0
+    times = g.accessor(perf.times.astype(np.float32), bounds=True)
+    channels = [("translation", translation), ("rotation", rotation), ("scale", scale)]
+    if perf.names:
+        channels.append(("weights", perf.weights.reshape(-1)))
+    samplers, targets = [], []
+    for k, (path, values) in enumerate(channels):
+        samplers.append({"input": times, "output": g.accessor(values.astype(np.float32)), "interpolation": "LINEAR"})
+        targets.append({"sampler": k, "target": {"node": node, "path": path}})
+    g.add("animations", {"name": "performance", "channels": targets, "samplers": samplers})
+    return g.bytes()
+
+
+def _file_weights(path: Path, names: tuple[str, ...]) -> np.ndarray | None:
+    """(T, E) weights stored in the track's frames (``weights``: name -> value), in the order of
+    ``names``, a missing name 0; None when a frame has none."""
+    frames = load_document(path, "track", TRACK_FORMAT)["frames"]
+    if not all(isinstance(f, dict) and "weights" in f for f in frames):
+        return None
+    out = np.zeros((len(frames), len(names)))
+    slot = {n: k for k, n in enumerate(names)}
+    for t, f in enumerate(frames):
+        w = f["weights"]
+        if not isinstance(w, dict):
+            raise ContourFileError(f"{path}: frame entry {t} has malformed 'weights'")
+        for name, value in w.items():
+            if name not in slot:
+                raise ContourFileError(f"{path}: frame entry {t} weighs {name!r}, not a control of this actor "
+                                       f"({', '.join(names)})")
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 1.0:
+                raise ContourFileError(f"{path}: frame entry {t} weight {name!r} must be a number in [0, 1]")
+            out[t, slot[name]] = value
+    return out
+
+
+def load_performance(track: str | Path, actor: Actor | None = None) -> Performance:
+    """The performance of a ``facemime.track/1`` file written by ``facemime run`` on ``actor``
+    (default: the generic painted head, as ``facemime view`` plays a track file): the frames'
+    ``weights`` when every frame has them, else solved from their knot offsets and eye closure."""
+    from facemime.animate.expressions import Expressions
+
+    track = Path(track)
+    video, block, frames = read_motion(track)
+    size, fps, sizes, iod = track_settings(str(track), video, block)
+    index = np.array([f["index"] for f in frames])
+    if index.dtype.kind != "i" or (len(index) > 1 and (np.diff(index) <= 0).any()) or index[0] < 0:
+        raise ContourFileError(f"{track}: frame indices must be whole numbers, increasing")
+    actor = actor or generic_actor(size)
+    model = actor.model
+    try:
+        ex = Expressions.of(model)
+    except (KeyError, IndexError, ValueError) as e:  # a head without the generic head's groups
+        raise InvalidInputError(f"actor {model.name!r} is not a facemime head with expression controls ({e})") from None
+    names = tuple(ex.names)
+    knots = block.get("knots", ex.deformer.knots.tolist())
+    if len(knots) != len(ex.deformer.knots) or not all(isinstance(k, int) and 0 <= k < len(model.vertices)
+                                                       for k in knots):
+        raise InvalidInputError(f"the track's motion has {len(knots)} knots of another head model than actor "
+                                f"{model.name!r} ({len(ex.deformer.knots)} knots, {len(model.vertices)} vertices)")
+    weights = _file_weights(track, names)
+    if weights is None:  # solved as the actor would play the knots: offsets scaled per feature (Puppet)
+        ratio = (ex.deformer.feature_sizes() / sizes)[:, None]
+        offsets = np.stack([f["offsets"] for f in frames]) * ratio
+        closure = np.stack([f["look"].closure for f in frames])
+        weights = np.asarray(ex.solve(offsets, closure), np.float64)
+    ratio = 1.0 if iod is None else iod / model_iod(model)
+    poses = np.array([[f["pose"][k] for k in POSE_KEYS] for f in frames])
+    poses[:, 3] *= ratio
+    return Performance(actor, names, np.asarray(ex.fields, np.float64), index / fps, weights, poses, size)
+
+
+@dataclass(frozen=True)
+class ExportResult:
+    """What an export wrote: ``path``, ``frames``, ``controls`` (morph targets), ``bytes`` and
+    ``seconds`` (wall time, reading the track to writing the file)."""
+
+    path: Path
+    frames: int
+    controls: int
+    bytes: int
+    seconds: float
+
+
+def export_track(track: str | Path, out: str | Path, actor: str | Path | Actor | None = None,
+                 force: bool = False) -> ExportResult:
+    """Write the performance of ``track`` (``facemime.track/1`` from ``facemime run``) on
+    ``actor`` (an ``.actor`` file or an :class:`Actor`; default the generic head) to ``out``
+    (``.glb``); an existing ``out`` is refused unless ``force``."""
+    from facemime.io.actor_file import load_actor
+
+    t0 = time.perf_counter()
+    out = Path(out)
+    if out.suffix.lower() != ".glb":
+        raise InvalidInputError(f"the output must end in .glb, got {out.name!r}")
+    actor_path = actor if isinstance(actor, (str, Path)) else None
+    check_outputs([out], force, inputs=[track, actor_path])
+    if not Path(track).is_file():
+        raise InputFileError(f"track file {track} does not exist" if not Path(track).exists()
+                             else f"track file {track} is not a file")
+    chosen = load_actor(actor_path) if actor_path is not None else actor
+    perf = load_performance(track, chosen)
+    data = glb_bytes(perf)
+    write_bytes(out, data)
+    return ExportResult(out, len(perf.times), len(perf.names), len(data), time.perf_counter() - t0)
