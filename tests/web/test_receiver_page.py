@@ -87,3 +87,19 @@ def test_the_pages_picture_matches_the_python_decoders(page, receiver_page, stre
     # irises not moved gave 36.5 dB on frame 40
     assert psnr(got, expected) >= 50.0
     assert psnr(picture(page, 0, size), python_picture(decoder, frames, 0)) >= 65.0
+
+
+def test_a_file_chosen_on_the_page_plays_and_a_bad_one_is_refused_in_a_line(page, receiver_page, stream, tmp_path):
+    data, _, frames = stream
+    good, bad = tmp_path / "call.fmstream", tmp_path / "junk.fmstream"
+    good.write_bytes(data)
+    bad.write_bytes(b"not a stream at all" * 50)
+    page.goto(receiver_page.as_uri())
+    page.set_input_files("#file", str(bad))
+    page.wait_for_function("() => !document.getElementById('message').hidden "
+                           "&& document.getElementById('message').textContent.startsWith('cannot play')")
+    assert "junk.fmstream: this is not a facemime stream" in page.inner_text("#message")
+    page.set_input_files("#file", str(good))
+    page.wait_for_function(f"() => window.facemime.frames.length === {len(frames)} && "
+                           "window.facemime.stats().drawn > 10")
+    assert page.is_hidden("#message")
