@@ -30,6 +30,7 @@ Prints one table per feature group and, last, one JSON line with every figure.
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import time
 from dataclasses import replace
@@ -77,8 +78,9 @@ def variants() -> dict[str, Method]:
     }
 
 
-def run_tracker(frames: list[np.ndarray], init: dict | None,
-                method: Method) -> tuple[list[dict], int, list[int], float]:
+def run_tracker(
+    frames: list[np.ndarray], init: dict | None, method: Method
+) -> tuple[list[dict], int, list[int], float]:
     """The contours of frames 1.. tracked from ``init`` (None: the first frame's landmarks),
     the frames with a lost feature, those re-detected, and the seconds of the landmark checks."""
     tracker = FaceTracker(frames[0], init, *method)
@@ -95,7 +97,7 @@ def run_lk(frames: list[np.ndarray], init: dict) -> list[dict]:
     sizes = [len(init[n]) for n in CONTOUR_NAMES]
     pts = np.concatenate([init[n] for n in CONTOUR_NAMES]).astype(np.float32)
     out = []
-    for prev, cur in zip(grays, grays[1:]):
+    for prev, cur in itertools.pairwise(grays):
         lk = {"winSize": (21, 21), "maxLevel": 3}
         p1, st1, _ = cv2.calcOpticalFlowPyrLK(prev, cur, pts.reshape(-1, 1, 2), None, **lk)
         back, st2, _ = cv2.calcOpticalFlowPyrLK(cur, prev, p1, None, **lk)
@@ -124,10 +126,18 @@ def main() -> None:
     ap.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data")
     ap.add_argument("--videos", default=",".join(VIDEOS))
     ap.add_argument("--variants", action="store_true", help="also run other image operators H")
-    ap.add_argument("--starts", type=int, default=1, help="starts of the default tracker: the reference and "
-                    f"N-1 with {START_NOISE} px of noise on it")
-    ap.add_argument("--automatic", action="store_true", help="also start the default tracker from the automatic "
-                    "fit of the first frame (as `facemime track` without --init)")
+    ap.add_argument(
+        "--starts",
+        type=int,
+        default=1,
+        help=f"starts of the default tracker: the reference and N-1 with {START_NOISE} px of noise on it",
+    )
+    ap.add_argument(
+        "--automatic",
+        action="store_true",
+        help="also start the default tracker from the automatic "
+        "fit of the first frame (as `facemime track` without --init)",
+    )
     args = ap.parse_args()
     cv2.setNumThreads(1)
     methods = variants() if args.variants else dict(list(variants().items())[:2])
@@ -179,34 +189,66 @@ def main() -> None:
         for m in names:
             s = pooled[m][g]
             pv = " ".join(f"{v}={per_video[v][m][g]['mean']:.3f}" for v in per_video)
-            print(f"  {m:48s} {s['mean']:7.4f} {s['median']:7.4f} {s['p90']:7.4f} {100 * s['failure_rate']:6.2f} {s['drift']:7.4f}   {pv}")
+            print(
+                f"  {m:48s} {s['mean']:7.4f} {s['median']:7.4f} {s['p90']:7.4f} "
+                f"{100 * s['failure_rate']:6.2f} {s['drift']:7.4f}   {pv}"
+            )
     for m in methods:
         print(f"frames with a lost feature, {m}: {lost[m]}")
-        print(f"frames re-detected, {m}: {dict((v, len(r)) for v, r in redetected[m].items())}")
-        print(f"landmark checks, {m}: ms per frame, amortised, one thread: "
-              + ", ".join(f"{v} {ms:.3f}" for v, ms in checks_ms[m].items()))
+        print(f"frames re-detected, {m}: { {v: len(r) for v, r in redetected[m].items()} }")
+        print(
+            f"landmark checks, {m}: ms per frame, amortised, one thread: "
+            + ", ".join(f"{v} {ms:.3f}" for v, ms in checks_ms[m].items())
+        )
     default = next(iter(methods))
     spread = [{"seed": 0, "pooled": {g: pooled[default][g] for g in GROUPS}, "frames_with_lost": lost[default]}]
-    spread += [{"seed": seed, "pooled": {g: pooled_summary(starts[seed][g]) for g in GROUPS},
-                "frames_with_lost": starts_lost[seed]} for seed in starts]
+    spread += [
+        {
+            "seed": seed,
+            "pooled": {g: pooled_summary(starts[seed][g]) for g in GROUPS},
+            "frames_with_lost": starts_lost[seed],
+        }
+        for seed in starts
+    ]
     if starts:
-        print(f"\nstarts of the default tracker (seed 0: the reference; numbers: {START_NOISE} px of noise on it; "
-              "automatic: the fit of the first frame)")
-        print("       seed  " + "  ".join(f"{g + ' mean / fail%':>26s}" for g in GROUPS) + "  frames with a lost feature")
+        print(
+            f"\nstarts of the default tracker (seed 0: the reference; numbers: {START_NOISE} px of noise on it; "
+            "automatic: the fit of the first frame)"
+        )
+        print(
+            "       seed  " + "  ".join(f"{g + ' mean / fail%':>26s}" for g in GROUPS) + "  frames with a lost feature"
+        )
         for run in spread:
-            figures = "  ".join(f"{run['pooled'][g]['mean']:17.4f} / {100 * run['pooled'][g]['failure_rate']:5.2f}"
-                                for g in GROUPS)
+            figures = "  ".join(
+                f"{run['pooled'][g]['mean']:17.4f} / {100 * run['pooled'][g]['failure_rate']:5.2f}" for g in GROUPS
+            )
             print(f"  {run['seed']!s:>9s}  {figures}  {sum(run['frames_with_lost'].values())}")
     if "automatic" in starts_video:
         auto, ref = starts_video["automatic"], default
         print("\nautomatic start against the reference start, per video: mean NME / failure % (reference -> automatic)")
         for video in per_video:
-            print(f"  {video:10s} " + "  ".join(
-                f"{g} {per_video[video][ref][g]['mean']:.4f}/{100 * per_video[video][ref][g]['failure_rate']:.1f}"
-                f" -> {auto[video][g]['mean']:.4f}/{100 * auto[video][g]['failure_rate']:.1f}" for g in GROUPS))
-    print(json.dumps({"pooled": pooled, "per_video": per_video, "frames_with_lost": lost, "redetected": redetected,
-                      "checks_ms_per_frame": checks_ms,
-                      "starts": spread[1:], "starts_per_video": starts_video}, allow_nan=True))
+            print(
+                f"  {video:10s} "
+                + "  ".join(
+                    f"{g} {per_video[video][ref][g]['mean']:.4f}/{100 * per_video[video][ref][g]['failure_rate']:.1f}"
+                    f" -> {auto[video][g]['mean']:.4f}/{100 * auto[video][g]['failure_rate']:.1f}"
+                    for g in GROUPS
+                )
+            )
+    print(
+        json.dumps(
+            {
+                "pooled": pooled,
+                "per_video": per_video,
+                "frames_with_lost": lost,
+                "redetected": redetected,
+                "checks_ms_per_frame": checks_ms,
+                "starts": spread[1:],
+                "starts_per_video": starts_video,
+            },
+            allow_nan=True,
+        )
+    )
 
 
 if __name__ == "__main__":

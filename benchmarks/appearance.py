@@ -32,16 +32,15 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-import classic_codecs  # noqa: E402
-from fidelity import regions, scores  # noqa: E402
-
-from facemime.animate.deform import Deformer  # noqa: E402
-from facemime.animate.synth import Puppet  # noqa: E402
-from facemime.codec.appearance import Appearance  # noqa: E402
-from facemime.codec.files import analyse, encode_clip, with_appearance  # noqa: E402
-from facemime.codec.stream import MotionDecoder, Settings  # noqa: E402
-from facemime.fit.placement import model_iod  # noqa: E402
-from facemime.io.video import VideoReader  # noqa: E402
+import classic_codecs
+from facemime.animate.deform import Deformer
+from facemime.animate.synth import Puppet
+from facemime.codec.appearance import Appearance
+from facemime.codec.files import analyse, encode_clip, with_appearance
+from facemime.codec.stream import MotionDecoder, Settings
+from facemime.fit.placement import model_iod
+from facemime.io.video import VideoReader
+from fidelity import regions, scores
 
 VIDEOS = ("lp_d0", "lp_d3", "lp_d6", "lp_d12", "mt_sun", "mt_yongen", "st_aoc", "st_kh", "vr_1", "vr_2")
 ROOT = Path(__file__).resolve().parents[1]
@@ -79,14 +78,24 @@ def one_video(path: Path, ref: dict, budgets: list[float], every: int) -> dict:
             if f.index in masks:
                 pictures[f.index] = puppet.render(f.pose, f.offsets, clip.size, look=f.look).copy()
         kbit = sum(map(len, chunks)) * 8 / 1000 / seconds
-        curve.append({"budget": budget, "kbit_s": kbit, "appearance_kbit_s": kbit - motion_kbit,
-                      "updates": updates.applied, "face": face_scores(pictures, real, masks)})
+        curve.append(
+            {
+                "budget": budget,
+                "kbit_s": kbit,
+                "appearance_kbit_s": kbit - motion_kbit,
+                "updates": updates.applied,
+                "face": face_scores(pictures, real, masks),
+            }
+        )
     frames_rgb = list(VideoReader(path))
     classic = {}
     for codec in ("libx264", "libsvtav1"):
         floor = classic_codecs.floor(frames_rgb, clip.fps, codec)
-        classic[codec] = {"kbit_s": floor["kbit_s"], "quantiser": floor["quantiser"],
-                          "face": face_scores({i: floor["frames"][i] for i in chosen}, real, masks)}
+        classic[codec] = {
+            "kbit_s": floor["kbit_s"],
+            "quantiser": floor["quantiser"],
+            "face": face_scores({i: floor["frames"][i] for i in chosen}, real, masks),
+        }
     return {"actor_bytes": len(actor_chunk), "motion_kbit_s": motion_kbit, "curve": curve, "classic": classic}
 
 
@@ -102,10 +111,14 @@ def main() -> None:
     for name in args.videos.split(","):
         ref = dict(np.load(args.data / "video" / f"{name}.landmarks.npz"))
         r = rows[name] = one_video(args.data / "video" / f"{name}.mp4", ref, budgets, args.every)
-        points = "  ".join(f"{p['budget']:g}: {p['kbit_s']:.2f} kbit/s {p['face'][0]:.2f} dB {p['face'][1]:.3f} "
-                           f"({p['updates']} updates)" for p in r["curve"])
-        classic = "  ".join(f"{c}: {v['kbit_s']:.1f} kbit/s {v['face'][0]:.2f} dB {v['face'][1]:.3f}"
-                            for c, v in r["classic"].items())
+        points = "  ".join(
+            f"{p['budget']:g}: {p['kbit_s']:.2f} kbit/s {p['face'][0]:.2f} dB {p['face'][1]:.3f} "
+            f"({p['updates']} updates)"
+            for p in r["curve"]
+        )
+        classic = "  ".join(
+            f"{c}: {v['kbit_s']:.1f} kbit/s {v['face'][0]:.2f} dB {v['face'][1]:.3f}" for c, v in r["classic"].items()
+        )
         print(f"{name:10s} actor {r['actor_bytes']} B | {points} | {classic}", flush=True)
     print(json.dumps(rows, default=float))
 

@@ -35,8 +35,10 @@ SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "video"
 
 def machine() -> str:
     load = os.getloadavg()
-    return (f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
-            f"load average {load[0]:.1f} at the start (a shared VM)")
+    return (
+        f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
+        f"load average {load[0]:.1f} at the start (a shared VM)"
+    )
 
 
 def cluster(workers: int):
@@ -45,14 +47,21 @@ def cluster(workers: int):
 
     from facemime.batch.worker import THREAD_VARIABLES
 
-    return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0",
-                        silence_logs=logging.ERROR, env={v: "1" for v in THREAD_VARIABLES})
+    return LocalCluster(
+        n_workers=workers,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=":0",
+        silence_logs=logging.ERROR,
+        env=dict.fromkeys(THREAD_VARIABLES, "1"),
+    )
 
 
 def warm(client) -> None:
     """Import the tracker in every worker (as the first task would) before timing."""
+
     def load() -> None:
-        import facemime.batch.worker  # noqa: F401
+        import facemime.batch.worker
         import facemime.track.video  # noqa: F401
 
     client.run(load)
@@ -60,6 +69,7 @@ def warm(client) -> None:
 
 def cpu_seconds(client) -> float:
     """CPU seconds (user + system, all threads) the workers' processes have used so far."""
+
     def used() -> float:
         r = resource.getrusage(resource.RUSAGE_SELF)
         return r.ru_utime + r.ru_stime
@@ -108,19 +118,29 @@ def speedup(rounds: int) -> dict:
             seconds, frames, cpu = batch_once(videos, workers)
             times[workers].append(seconds)
             cpus[workers].append(cpu)
-            print(f"  {workers} worker(s): {seconds:.2f} s, {frames / seconds:.0f} frames/s, workers' CPU {cpu:.1f} s "
-                  f"({cpu / seconds:.2f} cores busy)", flush=True)
+            print(
+                f"  {workers} worker(s): {seconds:.2f} s, {frames / seconds:.0f} frames/s, workers' CPU {cpu:.1f} s "
+                f"({cpu / seconds:.2f} cores busy)",
+                flush=True,
+            )
     one, two = statistics.median(times[1]), statistics.median(times[2])
     decode, decoded = decode_seconds(videos)
-    return {"videos": len(videos), "frames": frames, "seconds_1": times[1], "seconds_2": times[2],
-            "frames_per_s_1": frames / one, "frames_per_s_2": frames / two, "speedup": one / two,
-            "per_frame_ms_1": 1000 * one / frames,
-            "cpu_ms_per_frame_1": 1000 * statistics.median(cpus[1]) / frames,
-            "cpu_ms_per_frame_2": 1000 * statistics.median(cpus[2]) / frames,
-            "cores_busy_1": statistics.median(c / s for c, s in zip(cpus[1], times[1])),
-            "cores_busy_2": statistics.median(c / s for c, s in zip(cpus[2], times[2])),
-            "decode_cpu_ms_per_frame": 1000 * decode / decoded,
-            "video_minutes": sum(_duration(v) for v in videos) / 60}
+    return {
+        "videos": len(videos),
+        "frames": frames,
+        "seconds_1": times[1],
+        "seconds_2": times[2],
+        "frames_per_s_1": frames / one,
+        "frames_per_s_2": frames / two,
+        "speedup": one / two,
+        "per_frame_ms_1": 1000 * one / frames,
+        "cpu_ms_per_frame_1": 1000 * statistics.median(cpus[1]) / frames,
+        "cpu_ms_per_frame_2": 1000 * statistics.median(cpus[2]) / frames,
+        "cores_busy_1": statistics.median(c / s for c, s in zip(cpus[1], times[1])),
+        "cores_busy_2": statistics.median(c / s for c, s in zip(cpus[2], times[2])),
+        "decode_cpu_ms_per_frame": 1000 * decode / decoded,
+        "video_minutes": sum(_duration(v) for v in videos) / 60,
+    }
 
 
 def _duration(video: Path) -> float:
@@ -157,9 +177,15 @@ def simulate(tasks: int, task_ms: float, per_frame_ms: float, workers: int = 2) 
         wall = time.perf_counter() - t0
     overhead = (wall * workers - tasks * task_ms / 1000) / tasks
     video10 = 250 * per_frame_ms / 1000
-    return {"tasks": tasks, "task_ms": task_ms, "workers": workers, "wall_s": wall,
-            "overhead_ms_per_task": 1000 * overhead, "work_10s_video_s": video10,
-            "overhead_share_of_10s_video": overhead / video10}
+    return {
+        "tasks": tasks,
+        "task_ms": task_ms,
+        "workers": workers,
+        "wall_s": wall,
+        "overhead_ms_per_task": 1000 * overhead,
+        "work_10s_video_s": video10,
+        "overhead_share_of_10s_video": overhead / video10,
+    }
 
 
 def main() -> None:
@@ -168,22 +194,30 @@ def main() -> None:
     parser.add_argument("--simulate", action="store_true", help="measure the scheduler's overhead per task instead")
     parser.add_argument("--tasks", type=int, default=2000)
     parser.add_argument("--task-ms", type=float, default=5.0, help="compute per simulated task, ms")
-    parser.add_argument("--per-frame-ms", type=float, default=4.6,
-                        help="one worker's wall ms per frame (from the speed-up run) for the 10 s video's work")
+    parser.add_argument(
+        "--per-frame-ms",
+        type=float,
+        default=4.6,
+        help="one worker's wall ms per frame (from the speed-up run) for the 10 s video's work",
+    )
     args = parser.parse_args()
     print(machine(), flush=True)
     if args.simulate:
         r = simulate(args.tasks, args.task_ms, args.per_frame_ms)
         print(json.dumps(r, indent=1))
-        print(f"scheduler overhead {r['overhead_ms_per_task']:.2f} ms per task = "
-              f"{100 * r['overhead_share_of_10s_video']:.2f}% of a 10 s video's work "
-              f"({r['work_10s_video_s']:.2f} s on one worker)")
+        print(
+            f"scheduler overhead {r['overhead_ms_per_task']:.2f} ms per task = "
+            f"{100 * r['overhead_share_of_10s_video']:.2f}% of a 10 s video's work "
+            f"({r['work_10s_video_s']:.2f} s on one worker)"
+        )
         return
     r = speedup(args.rounds)
     print(json.dumps(r, indent=1))
-    print(f"speed-up 2 workers over 1: {r['speedup']:.2f}x ({r['frames_per_s_2']:.0f} vs {r['frames_per_s_1']:.0f} "
-          f"frames/s; decoding alone {r['decode_cpu_ms_per_frame']:.2f} CPU ms a frame of the "
-          f"{r['per_frame_ms_1']:.2f} ms wall a frame on one worker)")
+    print(
+        f"speed-up 2 workers over 1: {r['speedup']:.2f}x ({r['frames_per_s_2']:.0f} vs {r['frames_per_s_1']:.0f} "
+        f"frames/s; decoding alone {r['decode_cpu_ms_per_frame']:.2f} CPU ms a frame of the "
+        f"{r['per_frame_ms_1']:.2f} ms wall a frame on one worker)"
+    )
 
 
 if __name__ == "__main__":

@@ -38,22 +38,32 @@ from playwright.sync_api import sync_playwright
 from facemime.codec.stream import MotionDecoder
 
 ROOT = Path(__file__).resolve().parents[1]
-ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
-        "--disable-component-update", "--disable-sync"]
+ARGS = [
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
 
 
 def one_call(browser, video: Path, record: Path, drop: float) -> dict:
-    proc = subprocess.Popen([sys.executable, "-m", "facemime", "call", str(video), "--port", "0", "--no-browser",
-                             "--record", str(record)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "facemime", "call", str(video), "--port", "0", "--no-browser", "--record", str(record)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         url = proc.stdout.readline().strip()
         if not url.startswith("http"):
             raise RuntimeError(f"call did not start: {proc.stderr.read()}")
         page = browser.new_page()
         page.goto(url + (f"?drop={drop}&seed=7" if drop else ""))
-        out, err = proc.communicate(timeout=600)
-        page.wait_for_function("() => document.getElementById('message').textContent.includes('ended')",
-                               timeout=10_000)
+        _out, err = proc.communicate(timeout=600)
+        page.wait_for_function("() => document.getElementById('message').textContent.includes('ended')", timeout=10_000)
         stats = page.evaluate("() => window.facemime.stats()")
         frames = page.evaluate("() => window.facemime.frames")
         page.close()
@@ -67,8 +77,11 @@ def one_call(browser, video: Path, record: Path, drop: float) -> dict:
     if not drop:
         m = len(decoder.info.basis.raw)
         exact = len(frames) == len(expected) and all(
-            g["index"] == f.index and g["face"] == f.face and np.array_equal(decoder.info.basis.offsets(
-                np.array(g["values"])[6:6 + m]), f.offsets) for g, f in zip(frames, expected))
+            g["index"] == f.index
+            and g["face"] == f.face
+            and np.array_equal(decoder.info.basis.offsets(np.array(g["values"])[6 : 6 + m]), f.offsets)
+            for g, f in zip(frames, expected)
+        )
     summary = err.strip().splitlines()[-1] if err.strip() else ""  # the sender's: rate, bytes, requests
     # the stream's first second apart: the page sets the actor up then (its irises found on the
     # texture), and the frames that came meanwhile wait for it
@@ -77,14 +90,23 @@ def one_call(browser, video: Path, record: Path, drop: float) -> dict:
     start = [ms for index, ms in stats["latencies"] if index < fps0]
     draw = np.array(stats["drawTimes"])
     fps = stats["header"]["fps"][0] / stats["header"]["fps"][1]
-    return {"frames": len(frames), "fps": fps, "summary": summary, "exact": exact,
-            "latency_median_ms": float(np.median(lat)) if len(lat) else None,
-            "latency_p95_ms": float(np.percentile(lat, 95)) if len(lat) else None,
-            "start_latency_max_ms": max(start) if start else None, "setup_ms": stats["setupMs"],
-            "draw_mean_ms": float(draw.mean()), "draw_p95_ms": float(np.percentile(draw, 95)),
-            "headroom": 1000 / fps / float(draw.mean()),
-            "lost_packets": stats.get("lost_packets"), "concealed": stats.get("concealed"),
-            "dropped": stats["dropped"], "intra_requests": stats["intraRequests"]}
+    return {
+        "frames": len(frames),
+        "fps": fps,
+        "summary": summary,
+        "exact": exact,
+        "latency_median_ms": float(np.median(lat)) if len(lat) else None,
+        "latency_p95_ms": float(np.percentile(lat, 95)) if len(lat) else None,
+        "start_latency_max_ms": max(start) if start else None,
+        "setup_ms": stats["setupMs"],
+        "draw_mean_ms": float(draw.mean()),
+        "draw_p95_ms": float(np.percentile(draw, 95)),
+        "headroom": 1000 / fps / float(draw.mean()),
+        "lost_packets": stats.get("lost_packets"),
+        "concealed": stats.get("concealed"),
+        "dropped": stats["dropped"],
+        "intra_requests": stats["intraRequests"],
+    }
 
 
 def ms(v: float | None) -> str:
@@ -105,12 +127,15 @@ def main() -> None:
                 t0 = time.perf_counter()
                 r = one_call(browser, args.data / "video" / f"{name}.mp4", Path(tmp) / f"{name}-{drop}.fmstream", drop)
                 figures[f"{name}@{drop}"] = r
-                print(f"{name:10s} drop {drop:.2f}: {r['frames']} frames, latency median "
-                      f"{ms(r['latency_median_ms'])} p95 {ms(r['latency_p95_ms'])} (first second: set-up "
-                      f"{ms(r['setup_ms'])}, worst {ms(r['start_latency_max_ms'])}), draw {r['draw_mean_ms']:.2f} ms "
-                      f"(p95 {r['draw_p95_ms']:.2f}; headroom {r['headroom']:.0f}x), lost {r['lost_packets']} packets, "
-                      f"concealed {r['concealed']}, intra asked {r['intra_requests']}, exact {r['exact']} "
-                      f"[{time.perf_counter() - t0:.0f} s]\n    sender: {r['summary']}", flush=True)
+                print(
+                    f"{name:10s} drop {drop:.2f}: {r['frames']} frames, latency median "
+                    f"{ms(r['latency_median_ms'])} p95 {ms(r['latency_p95_ms'])} (first second: set-up "
+                    f"{ms(r['setup_ms'])}, worst {ms(r['start_latency_max_ms'])}), draw {r['draw_mean_ms']:.2f} ms "
+                    f"(p95 {r['draw_p95_ms']:.2f}; headroom {r['headroom']:.0f}x), lost {r['lost_packets']} packets, "
+                    f"concealed {r['concealed']}, intra asked {r['intra_requests']}, exact {r['exact']} "
+                    f"[{time.perf_counter() - t0:.0f} s]\n    sender: {r['summary']}",
+                    flush=True,
+                )
         browser.close()
     print(json.dumps(figures))
 

@@ -42,16 +42,19 @@ import numpy as np
 from facemime.io.video import VideoReader
 
 #: Options that leave the first frame the only key frame.
-ONE_KEY_FRAME = {"libx264": {"x264-params": "keyint=100000:min-keyint=100000:scenecut=0"},
-                 "libsvtav1": {"svtav1-params": "keyint=-1:scd=0"}}
+ONE_KEY_FRAME = {
+    "libx264": {"x264-params": "keyint=100000:min-keyint=100000:scenecut=0"},
+    "libsvtav1": {"svtav1-params": "keyint=-1:scd=0"},
+}
 #: The slowest preset used, per codec (see the module docstring for why SVT-AV1's is 0).
 PRESET = {"libx264": "veryslow", "libsvtav1": "0"}
 #: The coarsest quantisers, per codec; the floor is whichever gives the fewest bytes.
 FLOOR = {"libx264": ("crf=51", "qp=51"), "libsvtav1": ("crf=63", "qp=63")}
 
 
-def encode(frames: list[np.ndarray], fps: float, codec: str, crf_or_qp: int | str,
-           preset: str | int) -> tuple[int, list[np.ndarray]]:
+def encode(
+    frames: list[np.ndarray], fps: float, codec: str, crf_or_qp: int | str, preset: str | int
+) -> tuple[int, list[np.ndarray]]:
     """Encode RGB uint8 (H, W, 3) frames at ``fps`` frames/s with ``codec`` ("libx264" or "libsvtav1")
     into an MP4 in memory; return its size in bytes and its frames decoded to RGB uint8 at the input
     size (odd sizes are padded by the edge pixels for 4:2:0 and cropped back)."""
@@ -67,13 +70,21 @@ def floor(frames: list[np.ndarray], fps: float, codec: str) -> dict:
     results = [_encode(frames, fps, codec, q, PRESET[codec]) for q in FLOOR[codec]]
     best = min(range(len(results)), key=lambda i: results[i][0])
     size, decoded, seconds = results[best]
-    return {**_entry(codec, PRESET[codec], FLOOR[codec][best], size, seconds, len(frames), fps), "frames": decoded,
-            "tried": {q: r[0] for q, r in zip(FLOOR[codec], results)}}
+    return {
+        **_entry(codec, PRESET[codec], FLOOR[codec][best], size, seconds, len(frames), fps),
+        "frames": decoded,
+        "tried": {q: r[0] for q, r in zip(FLOOR[codec], results)},
+    }
 
 
-def curve(frames: list[np.ndarray], fps: float, codec: str, settings: list[int | str],
-          score: Callable[[list[np.ndarray]], object] | None = None,
-          preset: str | int | None = None) -> list[dict]:
+def curve(
+    frames: list[np.ndarray],
+    fps: float,
+    codec: str,
+    settings: list[int | str],
+    score: Callable[[list[np.ndarray]], object] | None = None,
+    preset: str | int | None = None,
+) -> list[dict]:
     """One point per quantiser in ``settings``, at ``preset`` (default :data:`PRESET`): {"codec", "preset",
     "quantiser", "bytes", "kbit_s", "seconds"} as in :func:`floor`, with "score": ``score(decoded
     frames)`` when a score function is given (the frames are then not kept), else "frames"."""
@@ -91,19 +102,23 @@ def luma_psnr(a: np.ndarray, b: np.ndarray) -> float:
     """PSNR in dB of the BT.601 luma of two RGB uint8 frames, over the whole frame."""
     weights = np.array([0.299, 0.587, 0.114])
     mse = float(np.mean((a @ weights - b @ weights) ** 2))
-    return 10 * np.log10(255 ** 2 / mse) if mse > 0 else float("inf")
+    return 10 * np.log10(255**2 / mse) if mse > 0 else float("inf")
 
 
-def _encode(frames: list[np.ndarray], fps: float, codec: str, crf_or_qp: int | str,
-            preset: str | int) -> tuple[int, list[np.ndarray], float]:
+def _encode(
+    frames: list[np.ndarray], fps: float, codec: str, crf_or_qp: int | str, preset: str | int
+) -> tuple[int, list[np.ndarray], float]:
     """:func:`encode`, and the encoding's wall time in seconds (decoding excluded)."""
     mode, value = _quantiser(crf_or_qp).split("=")
     h, w = frames[0].shape[:2]
     pad = ((0, h % 2), (0, w % 2), (0, 0))
     buffer = io.BytesIO()
     with av.open(buffer, "w", format="mp4") as container:
-        stream = container.add_stream(codec, rate=Fraction(fps).limit_denominator(1001),
-                                      options={mode: str(value), "preset": str(preset), **ONE_KEY_FRAME[codec]})
+        stream = container.add_stream(
+            codec,
+            rate=Fraction(fps).limit_denominator(1001),
+            options={mode: str(value), "preset": str(preset), **ONE_KEY_FRAME[codec]},
+        )
         stream.width, stream.height, stream.pix_fmt = w + w % 2, h + h % 2, "yuv420p"
         start = time.perf_counter()
         for frame in frames:
@@ -118,19 +133,26 @@ def _encode(frames: list[np.ndarray], fps: float, codec: str, crf_or_qp: int | s
             decoded.append(frame.to_ndarray(format="rgb24")[:h, :w])
             keys.append(frame.key_frame)
     if len(decoded) != len(frames) or not keys[0] or any(keys[1:]):
-        raise RuntimeError(f"{codec} {crf_or_qp}: {len(decoded)} frames decoded of {len(frames)}, "
-                           f"key frames at {[i for i, k in enumerate(keys) if k]} (only 0 expected)")
+        raise RuntimeError(
+            f"{codec} {crf_or_qp}: {len(decoded)} frames decoded of {len(frames)}, "
+            f"key frames at {[i for i, k in enumerate(keys) if k]} (only 0 expected)"
+        )
     return len(data), decoded, seconds
 
 
-def _entry(codec: str, preset: str | int, quantiser: int | str, size: int, seconds: float, n: int,
-           fps: float) -> dict:
-    return {"codec": codec, "preset": str(preset), "quantiser": _quantiser(quantiser), "bytes": size,
-            "kbit_s": size * 8 / 1000 / (n / fps), "seconds": seconds}
+def _entry(codec: str, preset: str | int, quantiser: int | str, size: int, seconds: float, n: int, fps: float) -> dict:
+    return {
+        "codec": codec,
+        "preset": str(preset),
+        "quantiser": _quantiser(quantiser),
+        "bytes": size,
+        "kbit_s": size * 8 / 1000 / (n / fps),
+        "seconds": seconds,
+    }
 
 
 def _quantiser(crf_or_qp: int | str) -> str:
-    """"crf=N" for an int, else the string as given."""
+    """ "crf=N" for an int, else the string as given."""
     return f"crf={crf_or_qp}" if isinstance(crf_or_qp, int) else crf_or_qp
 
 
@@ -152,8 +174,11 @@ def main() -> None:
         f = floor(frames, fps, codec)
         psnr = np.mean([luma_psnr(a, b) for a, b in zip(frames, f["frames"])])
         tried = ", ".join(f"{q} {b} B" for q, b in f["tried"].items())
-        print(f"{codec:10s} preset {f['preset']:8s} {f['quantiser']:7s} {f['bytes']:7d} B {f['kbit_s']:6.2f} kbit/s "
-              f"encode {f['seconds']:6.1f} s  luma PSNR (whole frame) {psnr:5.2f} dB   [{tried}]", flush=True)
+        print(
+            f"{codec:10s} preset {f['preset']:8s} {f['quantiser']:7s} {f['bytes']:7d} B {f['kbit_s']:6.2f} kbit/s "
+            f"encode {f['seconds']:6.1f} s  luma PSNR (whole frame) {psnr:5.2f} dB   [{tried}]",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":

@@ -7,7 +7,8 @@ Per video, the clip is analysed once (actor fitted on frame 0, every frame track
   qualities 0, 1, 2, 3, 5 (the default), 7, 10 and with ``--rate 1``, and the decoded face's luma
   PSNR and SSIM (11×11 Gaussian window; the eyes as decoded too) inside the face (the convex
   hull of the reference Face Mesh points of each frame), next to the unquantised synthesis (the
-  analysis's own pose, offsets and look). The one-time bytes beside it: header (with the clip's basis) and actor (WebP texture).
+  analysis's own pose, offsets and look). The one-time bytes beside it: header (with the clip's basis) and actor
+  (WebP texture).
 - **Representations** at the default steps: the 60 knots' 120 coordinates directly; a basis
   learned from the *other* nine videos (what a basis shipped with the package would do on an
   unseen face); the clip's own basis (the format's choice) with 8, 16 and 24 vectors.
@@ -44,25 +45,25 @@ import cv2
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-import classic_codecs  # noqa: E402
-from synthesis import ssim_map  # noqa: E402
-
-from facemime import _core  # noqa: E402
-from facemime.animate.deform import Deformer  # noqa: E402
-from facemime.animate.synth import Puppet  # noqa: E402
-from facemime.codec.files import MAX_COEFFICIENTS, Clip, analyse, encode_clip  # noqa: E402
-from facemime.codec.params import BASIS_ONE, Basis  # noqa: E402
-from facemime.codec.stream import MotionDecoder, MotionEncoder, Settings  # noqa: E402
-from facemime.fit.placement import model_iod  # noqa: E402
-from facemime.io.video import VideoReader  # noqa: E402
+import classic_codecs
+from facemime import _core
+from facemime.animate.deform import Deformer
+from facemime.animate.synth import Puppet
+from facemime.codec.files import MAX_COEFFICIENTS, Clip, analyse, encode_clip
+from facemime.codec.params import BASIS_ONE, Basis
+from facemime.codec.stream import MotionDecoder, MotionEncoder, Settings
+from facemime.fit.placement import model_iod
+from facemime.io.video import VideoReader
+from synthesis import ssim_map
 
 VIDEOS = ("lp_d0", "lp_d3", "lp_d6", "lp_d12", "vr_1", "vr_2", "mt_sun", "mt_yongen", "st_aoc", "st_kh")
 QUALITIES = (0, 1, 2, 3, 5, 7, 10)
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def face_masks(landmarks: np.ndarray, valid: np.ndarray, shape: tuple[int, int],
-               frames: list[int]) -> dict[int, np.ndarray]:
+def face_masks(
+    landmarks: np.ndarray, valid: np.ndarray, shape: tuple[int, int], frames: list[int]
+) -> dict[int, np.ndarray]:
     """Frame -> boolean mask of the hull of its reference Face Mesh points (valid frames only)."""
     out = {}
     for i in frames:
@@ -77,13 +78,14 @@ def luma(img: np.ndarray) -> np.ndarray:
     return cv2.cvtColor(img, cv2.COLOR_RGB2GRAY).astype(np.float64)
 
 
-def score(images: dict[int, np.ndarray], real: dict[int, np.ndarray],
-          masks: dict[int, np.ndarray]) -> tuple[float, float]:
+def score(
+    images: dict[int, np.ndarray], real: dict[int, np.ndarray], masks: dict[int, np.ndarray]
+) -> tuple[float, float]:
     """Mean luma PSNR (dB) and SSIM inside the face over the scored frames."""
     psnr, ssim = [], []
     for i, m in masks.items():
         a, b = luma(images[i]), real[i]
-        psnr.append(10 * np.log10(255.0 ** 2 / max(((a - b) ** 2)[m].mean(), 1e-9)))
+        psnr.append(10 * np.log10(255.0**2 / max(((a - b) ** 2)[m].mean(), 1e-9)))
         ssim.append(float(ssim_map(a, b)[m].mean()))
     return float(np.mean(psnr)), float(np.mean(ssim))
 
@@ -112,8 +114,10 @@ class Scene:
     def quality(self, frames) -> tuple[float, float]:
         """Face luma PSNR and SSIM of the synthesis of ``frames`` (decoded or analysed: their
         pose, offsets and look)."""
-        images = {i: self.puppet.render(frames[i].pose, frames[i].offsets, self.clip.size, look=frames[i].look)
-                  for i in self.masks}
+        images = {
+            i: self.puppet.render(frames[i].pose, frames[i].offsets, self.clip.size, look=frames[i].look)
+            for i in self.masks
+        }
         return score(images, self.real, self.masks)
 
     def coded(self, settings: Settings, basis: Basis | None = None) -> dict:
@@ -122,8 +126,13 @@ class Scene:
         dec = MotionDecoder()
         frames = dec.push(header + actor + b"".join(packets)) + dec.finish()
         psnr, ssim = self.quality(frames)
-        return {"kbit_s": sum(map(len, packets)) * 8 / 1000 / self.duration, "header_bytes": len(header),
-                "actor_bytes": len(actor), "psnr": psnr, "ssim": ssim}
+        return {
+            "kbit_s": sum(map(len, packets)) * 8 / 1000 / self.duration,
+            "header_bytes": len(header),
+            "actor_bytes": len(actor),
+            "psnr": psnr,
+            "ssim": ssim,
+        }
 
 
 def identity_basis(knots: int) -> Basis:
@@ -145,8 +154,15 @@ def lossy(scene: Scene, drop: float, seeds: int = 10) -> dict:
         psnr, ssim = scene.quality(frames)
         runs.append((len(packets) - len(kept), dec.stats["concealed"] + missing, psnr, ssim))
     dropped, concealed, psnr, ssim = np.mean(runs, axis=0)
-    return {"packets": len(packets), "dropped": dropped, "concealed": concealed, "frames": len(scene.clip.motion),
-            "psnr": psnr, "ssim": ssim, "seeds": seeds}
+    return {
+        "packets": len(packets),
+        "dropped": dropped,
+        "concealed": concealed,
+        "frames": len(scene.clip.motion),
+        "psnr": psnr,
+        "ssim": ssim,
+        "seeds": seeds,
+    }
 
 
 def classic(scene: Scene) -> dict:
@@ -155,8 +171,15 @@ def classic(scene: Scene) -> dict:
     for codec in ("libx264", "libsvtav1"):
         f = classic_codecs.floor(frames, scene.clip.fps, codec)
         psnr, ssim = score(dict(enumerate(f["frames"])), scene.real, scene.masks)
-        out[codec] = {"kbit_s": f["kbit_s"], "bytes": f["bytes"], "quantiser": f["quantiser"], "preset": f["preset"],
-                      "seconds": f["seconds"], "psnr": psnr, "ssim": ssim}
+        out[codec] = {
+            "kbit_s": f["kbit_s"],
+            "bytes": f["bytes"],
+            "quantiser": f["quantiser"],
+            "preset": f["preset"],
+            "seconds": f["seconds"],
+            "psnr": psnr,
+            "ssim": ssim,
+        }
     return out
 
 
@@ -170,14 +193,14 @@ def texture_sizes(scene: Scene) -> dict:
             data = cv2.imencode("." + fmt, bgr, [flag, q])[1]
             back = cv2.cvtColor(cv2.imdecode(data, cv2.IMREAD_COLOR), cv2.COLOR_BGR2RGB)
             mse = ((luma(back) - luma(tex)) ** 2).mean()
-            out[f"{fmt}{q}"] = {"bytes": len(data), "psnr": 10 * np.log10(255.0 ** 2 / max(mse, 1e-9))}
+            out[f"{fmt}{q}"] = {"bytes": len(data), "psnr": 10 * np.log10(255.0**2 / max(mse, 1e-9))}
     return out
 
 
 def speed(scene: Scene) -> dict:
     """Decoding to parameters (Rust core, one core), through the Python decoder, and to pictures;
     encoding's time against the analysis's."""
-    header, actor, packets = encode_clip(scene.clip, Settings(), False, scene.basis)
+    header, _actor, packets = encode_clip(scene.clip, Settings(), False, scene.basis)
     stream = header + b"".join(packets)
     n = len(scene.clip.motion)
     t0, reps = time.perf_counter(), 0
@@ -207,8 +230,13 @@ def speed(scene: Scene) -> dict:
         enc.push(m.face, m.lost, m.pose, m.offsets)
     enc.finish()
     encode_seconds = time.perf_counter() - t0
-    return {"decode_core_fps": core_fps, "decode_python_fps": python_fps, "decode_pictures_fps": picture_fps,
-            "run_synthesis_fps": synth_fps, "encode_share_of_analysis": encode_seconds / scene.analysis_seconds}
+    return {
+        "decode_core_fps": core_fps,
+        "decode_python_fps": python_fps,
+        "decode_pictures_fps": picture_fps,
+        "run_synthesis_fps": synth_fps,
+        "encode_share_of_analysis": encode_seconds / scene.analysis_seconds,
+    }
 
 
 def fuzz(stream: bytes, count: int, seed: int = 1) -> dict:
@@ -226,17 +254,17 @@ def fuzz(stream: bytes, count: int, seed: int = 1) -> dict:
             if how == 0:
                 data[i] ^= 1 << rng.randrange(8)
             elif how == 1:
-                del data[i:i + rng.randrange(1, 200)]
+                del data[i : i + rng.randrange(1, 200)]
             elif how == 2:
                 data[i:i] = rng.randbytes(rng.randrange(1, 50))
             elif how == 3:
                 j = rng.randrange(len(data))
-                data[i:i + 50], data[j:j + 50] = data[j:j + 50], data[i:i + 50]
+                data[i : i + 50], data[j : j + 50] = data[j : j + 50], data[i : i + 50]
             else:
                 del data[i:]
         dec = _core.StreamDecoder(bool(k % 2))
         for a in range(0, len(data), 997):
-            dec.push(bytes(data[a:a + 997]))
+            dec.push(bytes(data[a : a + 997]))
         dec.finish()
         tried += 1
     return {"streams": tried, "crashed": 0}
@@ -266,49 +294,72 @@ def main() -> None:
             if sum(map(len, packets)) * 8 / 1000 / s.duration <= 1.0:
                 at_rate = {"quality": q, **s.coded(Settings(quality=q))}
                 break
-        report["videos"][name] = {"frames": len(s.clip.motion), "fps": s.clip.fps, "size": s.clip.size,
-                                  "unquantised": {"psnr": base[0], "ssim": base[1]}, "curve": curve, "rate_1": at_rate,
-                                  "lossy_5pct": lossy(s, 0.05)}
-        print(f"{name}: {len(s.clip.motion)} frames, {len(s.masks)} scored, {time.perf_counter() - t0:.0f} s",
-              flush=True)
-    print(f"\n{'video':10s} {'unquant. dB':>11s} " + " ".join(f"{'q' + str(q):>17s}" for q in QUALITIES)
-          + f" {'--rate 1':>19s}   (motion kbit/s, ΔPSNR dB / ΔSSIM against the unquantised synthesis)")
+        report["videos"][name] = {
+            "frames": len(s.clip.motion),
+            "fps": s.clip.fps,
+            "size": s.clip.size,
+            "unquantised": {"psnr": base[0], "ssim": base[1]},
+            "curve": curve,
+            "rate_1": at_rate,
+            "lossy_5pct": lossy(s, 0.05),
+        }
+        print(
+            f"{name}: {len(s.clip.motion)} frames, {len(s.masks)} scored, {time.perf_counter() - t0:.0f} s", flush=True
+        )
+    print(
+        f"\n{'video':10s} {'unquant. dB':>11s} "
+        + " ".join(f"{'q' + str(q):>17s}" for q in QUALITIES)
+        + f" {'--rate 1':>19s}   (motion kbit/s, ΔPSNR dB / ΔSSIM against the unquantised synthesis)"
+    )
     for name, v in report["videos"].items():
         u = v["unquantised"]
-        delta = lambda c: f"{c['psnr'] - u['psnr']:+.2f}/{c['ssim'] - u['ssim']:+.4f}"  # noqa: E731
+        delta = lambda c, u=u: f"{c['psnr'] - u['psnr']:+.2f}/{c['ssim'] - u['ssim']:+.4f}"  # noqa: E731
         cells = [f"{c['kbit_s']:5.2f} {delta(c)}" for c in v["curve"].values()]
         r = v["rate_1"]
         cells.append(f"q{r['quality']} {r['kbit_s']:4.2f} {delta(r)}" if r else "-")
         print(f"{name:10s} {u['psnr']:6.2f}/{u['ssim']:.3f} " + " ".join(f"{c:>17s}" for c in cells))
     default = [v["curve"][5] for v in report["videos"].values()]
-    print(f"\ndefault (quality 5): motion max {max(d['kbit_s'] for d in default):.2f} kbit/s; one-time bytes: header "
-          f"{min(d['header_bytes'] for d in default)}-{max(d['header_bytes'] for d in default)}, actor "
-          f"{min(d['actor_bytes'] for d in default)}-{max(d['actor_bytes'] for d in default)}")
-    print("lossy channel, 5% of packets dropped: " + "  ".join(
-        f"{n}: {v['lossy_5pct']['concealed']:.0f}/{v['lossy_5pct']['frames']} concealed, "
-        f"{v['lossy_5pct']['psnr'] - v['curve'][5]['psnr']:+.2f} dB" for n, v in report["videos"].items()))
+    print(
+        f"\ndefault (quality 5): motion max {max(d['kbit_s'] for d in default):.2f} kbit/s; one-time bytes: header "
+        f"{min(d['header_bytes'] for d in default)}-{max(d['header_bytes'] for d in default)}, actor "
+        f"{min(d['actor_bytes'] for d in default)}-{max(d['actor_bytes'] for d in default)}"
+    )
+    print(
+        "lossy channel, 5% of packets dropped: "
+        + "  ".join(
+            f"{n}: {v['lossy_5pct']['concealed']:.0f}/{v['lossy_5pct']['frames']} concealed, "
+            f"{v['lossy_5pct']['psnr'] - v['curve'][5]['psnr']:+.2f} dB"
+            for n, v in report["videos"].items()
+        )
+    )
 
     # representations, at the default quality's steps
     reps = {}
     for name, s in scenes.items():
         others = np.concatenate([o.offsets for n, o in scenes.items() if n != name]) if len(scenes) > 1 else s.offsets
         knots = s.offsets.shape[1]
-        variants = {"knots directly": (replace(Settings(), coefficients=2 * knots), identity_basis(knots)),
-                    "other videos' basis 16": (Settings(), Basis.learn(others, 16)),
-                    "other videos' basis 24": (replace(Settings(), coefficients=24), Basis.learn(others, 24)),
-                    "own basis 8": (replace(Settings(), coefficients=8), s.basis),
-                    "own basis 16": (Settings(), s.basis),
-                    "own basis 24": (replace(Settings(), coefficients=24), s.basis)}
+        variants = {
+            "knots directly": (replace(Settings(), coefficients=2 * knots), identity_basis(knots)),
+            "other videos' basis 16": (Settings(), Basis.learn(others, 16)),
+            "other videos' basis 24": (replace(Settings(), coefficients=24), Basis.learn(others, 24)),
+            "own basis 8": (replace(Settings(), coefficients=8), s.basis),
+            "own basis 16": (Settings(), s.basis),
+            "own basis 24": (replace(Settings(), coefficients=24), s.basis),
+        }
         reps[name] = {k: s.coded(st, b) for k, (st, b) in variants.items()}
     report["representations"] = reps
-    print(f"\n{'representation':24s} {'max kbit/s':>10s} {'mean kbit/s':>11s} {'mean ΔPSNR':>10s} {'mean ΔSSIM':>10s} "
-          f"{'worst ΔSSIM':>11s}")
+    print(
+        f"\n{'representation':24s} {'max kbit/s':>10s} {'mean kbit/s':>11s} {'mean ΔPSNR':>10s} {'mean ΔSSIM':>10s} "
+        f"{'worst ΔSSIM':>11s}"
+    )
     for k in next(iter(reps.values())):
         rows = [(reps[n][k], report["videos"][n]["unquantised"]) for n in reps]
-        print(f"{k:24s} {max(r['kbit_s'] for r, _ in rows):10.2f} {np.mean([r['kbit_s'] for r, _ in rows]):11.2f} "
-              f"{np.mean([r['psnr'] - u['psnr'] for r, u in rows]):+10.3f} "
-              f"{np.mean([r['ssim'] - u['ssim'] for r, u in rows]):+10.4f} "
-              f"{min(r['ssim'] - u['ssim'] for r, u in rows):+11.4f}")
+        print(
+            f"{k:24s} {max(r['kbit_s'] for r, _ in rows):10.2f} {np.mean([r['kbit_s'] for r, _ in rows]):11.2f} "
+            f"{np.mean([r['psnr'] - u['psnr'] for r, u in rows]):+10.3f} "
+            f"{np.mean([r['ssim'] - u['ssim'] for r, u in rows]):+10.4f} "
+            f"{min(r['ssim'] - u['ssim'] for r, u in rows):+11.4f}"
+        )
 
     report["classic"] = {}
     for name in filter(None, args.classic.split(",")):
@@ -316,17 +367,25 @@ def main() -> None:
         c = classic(s)
         ours = report["videos"][name]["curve"][5] if name in report["videos"] else s.coded(Settings())
         report["classic"][name] = {**c, "facemime": ours}
-        print(f"\n{name}: facemime {ours['kbit_s']:.2f} kbit/s {ours['psnr']:.2f} dB SSIM {ours['ssim']:.3f} | "
-              + " | ".join(f"{k} ({v['quantiser']}, preset {v['preset']}) {v['kbit_s']:.1f} kbit/s {v['psnr']:.2f} dB "
-                           f"SSIM {v['ssim']:.3f}: {v['kbit_s'] / ours['kbit_s']:.0f}x facemime's rate"
-                           for k, v in c.items()),
-              flush=True)
+        print(
+            f"\n{name}: facemime {ours['kbit_s']:.2f} kbit/s {ours['psnr']:.2f} dB SSIM {ours['ssim']:.3f} | "
+            + " | ".join(
+                f"{k} ({v['quantiser']}, preset {v['preset']}) {v['kbit_s']:.1f} kbit/s {v['psnr']:.2f} dB "
+                f"SSIM {v['ssim']:.3f}: {v['kbit_s'] / ours['kbit_s']:.0f}x facemime's rate"
+                for k, v in c.items()
+            ),
+            flush=True,
+        )
 
     first = scenes[names[0]]
     report["texture"] = texture_sizes(first)
-    print(f"\ntexture of {names[0]}'s actor ({first.clip.actor.texture.shape[1]}x{first.clip.actor.texture.shape[0]}): "
-          + ", ".join(f"{k} {v['bytes']} B {v['psnr']:.1f} dB" if isinstance(v, dict) else f"{k} {v} B"
-                      for k, v in report["texture"].items()))
+    print(
+        f"\ntexture of {names[0]}'s actor ({first.clip.actor.texture.shape[1]}x{first.clip.actor.texture.shape[0]}): "
+        + ", ".join(
+            f"{k} {v['bytes']} B {v['psnr']:.1f} dB" if isinstance(v, dict) else f"{k} {v} B"
+            for k, v in report["texture"].items()
+        )
+    )
     cpus = os.sched_getaffinity(0)
     os.sched_setaffinity(0, {min(cpus)})
     try:
@@ -335,11 +394,13 @@ def main() -> None:
     finally:
         os.sched_setaffinity(0, cpus)
     sp = report["speed"]
-    print(f"\nspeed on one core ({sp['video']}): decoding to parameters {sp['decode_core_fps']:.0f} frames/s "
-          f"(Rust core), {sp['decode_python_fps']:.0f} through MotionDecoder; to pictures "
-          f"{sp['decode_pictures_fps']:.0f} frames/s against run's synthesis {sp['run_synthesis_fps']:.0f}; "
-          f"encoding {100 * sp['encode_share_of_analysis']:.2f}% of the analysis")
-    header, actor, packets = encode_clip(first.clip, Settings(), True, first.basis)
+    print(
+        f"\nspeed on one core ({sp['video']}): decoding to parameters {sp['decode_core_fps']:.0f} frames/s "
+        f"(Rust core), {sp['decode_python_fps']:.0f} through MotionDecoder; to pictures "
+        f"{sp['decode_pictures_fps']:.0f} frames/s against run's synthesis {sp['run_synthesis_fps']:.0f}; "
+        f"encoding {100 * sp['encode_share_of_analysis']:.2f}% of the analysis"
+    )
+    header, _actor, packets = encode_clip(first.clip, Settings(), True, first.basis)
     report["fuzz"] = fuzz(header + b"".join(packets), args.fuzz)
     print(f"fuzz: {report['fuzz']['streams']} mutated or random streams decoded, none crashed")
     print(json.dumps(report, default=float))

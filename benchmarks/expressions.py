@@ -45,7 +45,7 @@ from facemime.fit.placement import model_iod
 from facemime.io.video import VideoReader
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from synthesis import regions  # noqa: E402
+from synthesis import regions
 
 VIDEOS = ("lp_d0", "lp_d3", "lp_d6", "lp_d12", "mt_sun", "mt_yongen", "st_aoc", "st_kh", "vr_1", "vr_2")
 ROOT = Path(__file__).resolve().parents[1]
@@ -73,7 +73,7 @@ def mouth_psnr(puppet: Puppet, frames, motion, offsets, z) -> float:
         img = puppet.render(m.pose, offsets[i], (frame.shape[1], frame.shape[0]), look=m.look)
         mask = regions(z["landmarks"][i], float(z["iod"][i]), frame.shape[:2])["mouth"]
         mse = ((img.astype(np.float64) - frame)[mask] ** 2).mean()
-        values.append(10 * np.log10(255.0 ** 2 / max(mse, 1e-9)))
+        values.append(10 * np.log10(255.0**2 / max(mse, 1e-9)))
     return float(np.mean(values))
 
 
@@ -97,7 +97,7 @@ def main() -> None:
             knots = np.array([n not in BLINKS for n in NAMES])
             unit = (unit_patterns(model) / np.array([MAGNITUDES[n] for n in NAMES])[:, None, None])[knots]
             unit = (unit * expressions.deformer.feature_sizes()[None, :, None]).reshape(knots.sum(), -1)
-            amplitudes.append(np.maximum(offsets.reshape(len(offsets), -1) @ unit.T / (unit ** 2).sum(1), 0.0))
+            amplitudes.append(np.maximum(offsets.reshape(len(offsets), -1) @ unit.T / (unit**2).sum(1), 0.0))
             print(f"{name}: {len(frames)} frames", flush=True)
             continue
         t0 = time.perf_counter()
@@ -105,10 +105,14 @@ def main() -> None:
         seconds = time.perf_counter() - t0
         rebuilt = expressions.offsets(weights)
         iod = model_iod(model)
-        row = {"frames": len(frames), "coverage_iod": float(np.linalg.norm(rebuilt - offsets, axis=2).mean() / iod),
-               "zero_weights_iod": float(np.linalg.norm(offsets, axis=2).mean() / iod),
-               "solve_s": seconds, "solve_s_per_1000": 1000 * seconds / len(frames),
-               "saturated": float((weights[:, :-2] >= 1.0).mean())}
+        row = {
+            "frames": len(frames),
+            "coverage_iod": float(np.linalg.norm(rebuilt - offsets, axis=2).mean() / iod),
+            "zero_weights_iod": float(np.linalg.norm(offsets, axis=2).mean() / iod),
+            "solve_s": seconds,
+            "solve_s_per_1000": 1000 * seconds / len(frames),
+            "saturated": float((weights[:, :-2] >= 1.0).mean()),
+        }
         if not args.no_psnr:
             z = np.load(args.data / "video" / f"{name}.landmarks.npz")
             puppet = Puppet(analysis.actor, expressions.deformer.feature_sizes(), iod, analysis.actor.pose)

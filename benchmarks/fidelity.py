@@ -42,8 +42,6 @@ import cv2
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from synthesis import ssim_map  # noqa: E402
-
 from facemime.animate.analysis import Analysis
 from facemime.animate.look import Look
 from facemime.animate.synth import Puppet
@@ -51,13 +49,16 @@ from facemime.codec.files import Clip, encode_clip
 from facemime.codec.stream import Settings
 from facemime.fit.placement import model_iod
 from facemime.io.video import VideoReader
+from synthesis import ssim_map
 
 VIDEOS = ("lp_d0", "lp_d3", "lp_d6", "lp_d12", "mt_sun", "mt_yongen", "st_aoc", "st_kh", "vr_1", "vr_2")
 ROOT = Path(__file__).resolve().parents[1]
 IRIS = (468, 473)
 LIDS = ((159, 145), (386, 374))
-RINGS = ((33, 246, 161, 160, 159, 158, 157, 173, 133, 155, 154, 153, 145, 144, 163, 7),
-         (362, 398, 384, 385, 386, 387, 388, 466, 263, 249, 390, 373, 374, 380, 381, 382))
+RINGS = (
+    (33, 246, 161, 160, 159, 158, 157, 173, 133, 155, 154, 153, 145, 144, 163, 7),
+    (362, 398, 384, 385, 386, 387, 388, 466, 263, 249, 390, 373, 374, 380, 381, 382),
+)
 #: A reference eye is shut below this opening (IOD); a measured one above this closure.
 SHUT = 0.03
 CLOSED = 0.6
@@ -84,8 +85,10 @@ def regions(points: np.ndarray, iod: float, shape: tuple[int, int]) -> dict[str,
 def scores(synth: np.ndarray, real: np.ndarray, masks: dict[str, np.ndarray]) -> dict[str, tuple[float, float]]:
     ys, yr = luma(synth), luma(real)
     s = ssim_map(ys, yr)
-    return {n: (10 * np.log10(255.0 ** 2 / max(((ys - yr)[m] ** 2).mean(), 1e-9)), float(s[m].mean()))
-            for n, m in masks.items()}
+    return {
+        n: (10 * np.log10(255.0**2 / max(((ys - yr)[m] ** 2).mean(), 1e-9)), float(s[m].mean()))
+        for n, m in masks.items()
+    }
 
 
 def runs(flags: np.ndarray) -> list[tuple[int, int]]:
@@ -128,10 +131,14 @@ def one_video(path: Path, ref: dict, still: Path | None) -> dict:
         frozen_iris = np.array([f.to_image(k) for f, k in zip(s.frames, key.iris)])
         frozen_opening = key.opening * np.array([f.width for f in s.frames])
         iris_ref = p[list(IRIS), :2]
-        eye_err.append([np.linalg.norm(s.iris_xy() - iris_ref, axis=1).mean() / iod[i],
-                        np.abs(s.opening_px() - opening_ref).mean() / iod[i],
-                        np.linalg.norm(frozen_iris - iris_ref, axis=1).mean() / iod[i],
-                        np.abs(frozen_opening - opening_ref).mean() / iod[i]])
+        eye_err.append(
+            [
+                np.linalg.norm(s.iris_xy() - iris_ref, axis=1).mean() / iod[i],
+                np.abs(s.opening_px() - opening_ref).mean() / iod[i],
+                np.linalg.norm(frozen_iris - iris_ref, axis=1).mean() / iod[i],
+                np.abs(frozen_opening - opening_ref).mean() / iod[i],
+            ]
+        )
         looks = {"look": m.look, "none": Look()}
         renders = {v: puppet.render(m.pose, m.offsets, size, look=looks[v]).copy() for v in VARIANTS}
         masks = regions(p, float(iod[i]), frame.shape[:2])
@@ -139,8 +146,10 @@ def one_video(path: Path, ref: dict, still: Path | None) -> dict:
             for r, value in scores(img, frame, masks).items():
                 out[v][r].append(value)
         if still is not None and i == still_at:
-            cv2.imwrite(str(still / f"{path.stem}.png"),
-                        cv2.cvtColor(np.hstack([frame, renders["look"], renders["none"]]), cv2.COLOR_RGB2BGR))
+            cv2.imwrite(
+                str(still / f"{path.stem}.png"),
+                cv2.cvtColor(np.hstack([frame, renders["look"], renders["none"]]), cv2.COLOR_RGB2BGR),
+            )
     clip = Clip(analysis.actor, 30.0, size, motions, [], 0.0)
     rates = {}
     for name, ms in (("look", motions), ("none", [replace(x, look=Look()) for x in motions])):
@@ -149,10 +158,17 @@ def one_video(path: Path, ref: dict, still: Path | None) -> dict:
     e = np.array(eye_err).mean(axis=0)
     blinks_ref, blinks_ours = runs(np.array(shut_ref)), runs(np.array(shut_ours))
     caught = sum(any(a <= d and c <= b for c, d in blinks_ours) for a, b in blinks_ref)
-    return {"iris": e[0], "opening": e[1], "frozen_iris": e[2], "frozen_opening": e[3],
-            "blinks_reference": len(blinks_ref), "blinks_measured": len(blinks_ours), "blinks_caught": caught,
-            "kbit_s": rates,
-            **{f"{v} {r}": list(np.mean(out[v][r], axis=0)) for v in VARIANTS for r in ("face", "eyes")}}
+    return {
+        "iris": e[0],
+        "opening": e[1],
+        "frozen_iris": e[2],
+        "frozen_opening": e[3],
+        "blinks_reference": len(blinks_ref),
+        "blinks_measured": len(blinks_ours),
+        "blinks_caught": caught,
+        "kbit_s": rates,
+        **{f"{v} {r}": list(np.mean(out[v][r], axis=0)) for v in VARIANTS for r in ("face", "eyes")},
+    }
 
 
 def main() -> None:
@@ -167,14 +183,19 @@ def main() -> None:
     for name in args.videos.split(","):
         ref = dict(np.load(args.data / "video" / f"{name}.landmarks.npz"))
         r = rows[name] = one_video(args.data / "video" / f"{name}.mp4", ref, args.stills)
-        print(f"{name:10s} iris {r['iris']:.3f} (frozen {r['frozen_iris']:.3f})  opening {r['opening']:.3f} "
-              f"(frozen {r['frozen_opening']:.3f})  blinks {r['blinks_caught']}/{r['blinks_reference']} "
-              f"(measured {r['blinks_measured']})  face Y " +
-              " / ".join(f"{v} {r[v + ' face'][0]:.2f} {r[v + ' face'][1]:.3f}" for v in VARIANTS) +
-              "  eyes Y " + " / ".join(f"{r[v + ' eyes'][0]:.2f}" for v in VARIANTS) +
-              f"  kbit/s {r['kbit_s']['look']:.2f} (none {r['kbit_s']['none']:.2f})", flush=True)
-    mean = {k: float(np.mean([r[k] for r in rows.values()])) for k in ("iris", "opening", "frozen_iris",
-                                                                        "frozen_opening")}
+        print(
+            f"{name:10s} iris {r['iris']:.3f} (frozen {r['frozen_iris']:.3f})  opening {r['opening']:.3f} "
+            f"(frozen {r['frozen_opening']:.3f})  blinks {r['blinks_caught']}/{r['blinks_reference']} "
+            f"(measured {r['blinks_measured']})  face Y "
+            + " / ".join(f"{v} {r[v + ' face'][0]:.2f} {r[v + ' face'][1]:.3f}" for v in VARIANTS)
+            + "  eyes Y "
+            + " / ".join(f"{r[v + ' eyes'][0]:.2f}" for v in VARIANTS)
+            + f"  kbit/s {r['kbit_s']['look']:.2f} (none {r['kbit_s']['none']:.2f})",
+            flush=True,
+        )
+    mean = {
+        k: float(np.mean([r[k] for r in rows.values()])) for k in ("iris", "opening", "frozen_iris", "frozen_opening")
+    }
     for v in VARIANTS:
         for reg in ("face", "eyes"):
             mean[f"{v} {reg}"] = list(np.mean([r[f"{v} {reg}"] for r in rows.values()], axis=0))

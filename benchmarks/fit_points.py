@@ -40,8 +40,10 @@ def group_errors(points: dict[str, np.ndarray], landmarks: np.ndarray, iod: floa
     ref = reference_points(landmarks)
     out = {}
     for group, names in GROUPS.items():
-        errs = [float(np.linalg.norm(points[n][0] - ref[n][0])) if n in POINT_INDICES
-                else curve_error(points[n], ref[n]) for n in names]
+        errs = [
+            float(np.linalg.norm(points[n][0] - ref[n][0])) if n in POINT_INDICES else curve_error(points[n], ref[n])
+            for n in names
+        ]
         out[group] = float(np.mean(errs)) / iod
     return out
 
@@ -76,13 +78,26 @@ def main() -> None:
             rows[name][method] = errors | {"seconds": seconds}
     print(f"{'image':10} " + " ".join(f"{g + ' facemime/cascades':>30}" for g in GROUPS) + "   seconds")
     for name, r in rows.items():
-        print(f"{name:10} " + " ".join(f"{r['facemime'][g]:>15.4f}/{r['cascades'][g]:<14.4f}" for g in GROUPS)
-              + f"   {r['facemime']['seconds']:.3f}/{r['cascades']['seconds']:.3f}")
-    summary = {m: {g: {"mean": float(np.mean([r[m][g] for r in rows.values()])),
-                       "max": float(np.max([r[m][g] for r in rows.values()]))} for g in GROUPS} for m in methods}
+        print(
+            f"{name:10} "
+            + " ".join(f"{r['facemime'][g]:>15.4f}/{r['cascades'][g]:<14.4f}" for g in GROUPS)
+            + f"   {r['facemime']['seconds']:.3f}/{r['cascades']['seconds']:.3f}"
+        )
+    summary = {
+        m: {
+            g: {
+                "mean": float(np.mean([r[m][g] for r in rows.values()])),
+                "max": float(np.max([r[m][g] for r in rows.values()])),
+            }
+            for g in GROUPS
+        }
+        for m in methods
+    }
     for stat in ("mean", "max"):
-        print(f"{stat:10} " + " ".join(f"{summary['facemime'][g][stat]:>15.4f}/{summary['cascades'][g][stat]:<14.4f}"
-                                       for g in GROUPS))
+        print(
+            f"{stat:10} "
+            + " ".join(f"{summary['facemime'][g][stat]:>15.4f}/{summary['cascades'][g][stat]:<14.4f}" for g in GROUPS)
+        )
     worst = max(summary["facemime"][g]["max"] for g in GROUPS)
     print(f"every group of every image within 0.03 (facemime): {'yes' if worst <= 0.03 else 'no'} (worst {worst:.4f})")
     print(json.dumps({"images": rows, "summary": summary}))

@@ -117,10 +117,12 @@ def _eyes(gray: np.ndarray, box: np.ndarray) -> tuple[np.ndarray, bool]:
     hits = []
     for angle in EYE_ANGLES:
         turn = cv2.getRotationMatrix2D(centre, angle, 1.0)
-        roi = (cv2.warpAffine(gray, turn, gray.shape[::-1]) if angle else gray)[top:bottom, x:x + w]
+        roi = (cv2.warpAffine(gray, turn, gray.shape[::-1]) if angle else gray)[top:bottom, x : x + w]
         back = cv2.invertAffineTransform(turn)
         for name in ("haarcascade_eye.xml", "haarcascade_eye_tree_eyeglasses.xml"):
-            for ex, ey, ew, eh in _cascade(name).detectMultiScale(roi, 1.05, 3, minSize=(size, size), maxSize=(w // 3, w // 3)):
+            for ex, ey, ew, eh in _cascade(name).detectMultiScale(
+                roi, 1.05, 3, minSize=(size, size), maxSize=(w // 3, w // 3)
+            ):
                 hits.append(back[:, :2] @ (x + ex + ew / 2, top + ey + eh / 2) + back[:, 2])
     eyes, support = prior.copy(), np.zeros(2, int)
     pts = np.array(hits).reshape(-1, 2)

@@ -23,6 +23,7 @@ The last line of output is one JSON object (memory in MiB, times in seconds).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import subprocess
@@ -71,8 +72,9 @@ def make_4k(source: Path, path: Path, frames: int = 30) -> None:
         enc.width, enc.height, enc.pix_fmt = 3840, 2160, "yuv420p"
         enc.options = {"crf": "20", "preset": "ultrafast"}
         for _, frame in zip(range(frames), src.decode(stream)):
-            canvas[:, 840:3000] = cv2.resize(frame.to_ndarray(format="rgb24"), (2160, 2160),
-                                            interpolation=cv2.INTER_CUBIC)
+            canvas[:, 840:3000] = cv2.resize(
+                frame.to_ndarray(format="rgb24"), (2160, 2160), interpolation=cv2.INTER_CUBIC
+            )
             out.mux(enc.encode(av.VideoFrame.from_ndarray(canvas, format="rgb24")))
         out.mux(enc.encode())
 
@@ -104,8 +106,9 @@ def start(args: list[str], log: Path) -> subprocess.Popen:
     """Start ``args`` under ``/usr/bin/time``, which writes its peak resident memory to ``log``
     with the suffix ``.maxrss``, and with its output to ``log`` (a pipe would fill and stop it)."""
     with open(log, "wb") as f:
-        return subprocess.Popen([TIME, "-f", "%M", "-o", str(log.with_suffix(".maxrss"))] + args, stdout=f,
-                                stderr=subprocess.STDOUT)
+        return subprocess.Popen(
+            [TIME, "-f", "%M", "-o", str(log.with_suffix(".maxrss"))] + args, stdout=f, stderr=subprocess.STDOUT
+        )
 
 
 def finish(proc: subprocess.Popen, log: Path) -> float:
@@ -141,10 +144,8 @@ def soak(args: list[str], log: Path, every: float) -> tuple[list[tuple[float, fl
     while proc.poll() is None:
         if (mib := rss(proc.pid)) is not None:
             samples.append((time.perf_counter() - t0, mib))
-        try:
+        with contextlib.suppress(subprocess.TimeoutExpired):
             proc.wait(timeout=every)
-        except subprocess.TimeoutExpired:
-            pass
     return samples, finish(proc, log), time.perf_counter() - t0
 
 
@@ -181,8 +182,14 @@ def plot(samples: list[tuple[float, float]], path: Path, title: str, limit: floa
     if t_max > 1:
         cv2.line(img, (px(1), py(limit)), (px(t_max), py(limit)), (0, 0, 220), 1, cv2.LINE_AA)
         cv2.putText(img, "+10% of 1 min", (px(1) + 6, py(limit) - 6), font, 0.45, (0, 0, 220), 1, cv2.LINE_AA)
-    cv2.polylines(img, [np.stack([[px(a) for a in t], [py(b) for b in m]], 1).astype(np.int32)], False,
-                  (200, 80, 0), 2, cv2.LINE_AA)
+    cv2.polylines(
+        img,
+        [np.stack([[px(a) for a in t], [py(b) for b in m]], 1).astype(np.int32)],
+        False,
+        (200, 80, 0),
+        2,
+        cv2.LINE_AA,
+    )
     cv2.putText(img, title, (left, 25), font, 0.55, black, 1, cv2.LINE_AA)
     cv2.putText(img, "minutes", (w // 2 - 30, h - 8), font, 0.5, black, 1, cv2.LINE_AA)
     cv2.putText(img, "MiB", (5, top - 10), font, 0.5, black, 1, cv2.LINE_AA)
@@ -204,8 +211,11 @@ def main() -> None:
     ap.add_argument("--every", type=float, default=10.0, help="seconds between memory samples")
     ap.add_argument("--no-peak", action="store_true", help="skip the 4K peak measurements")
     ap.add_argument("--no-soak", action="store_true", help="skip the soak")
-    ap.add_argument("--copy-soak", action="store_true",
-                    help="also soak a copy of the long video through VideoReader and VideoWriter alone")
+    ap.add_argument(
+        "--copy-soak",
+        action="store_true",
+        help="also soak a copy of the long video through VideoReader and VideoWriter alone",
+    )
     a = ap.parse_args()
     a.tmp.mkdir(parents=True, exist_ok=True)
     source = a.data / "video" / f"{a.video}.mp4"
@@ -214,10 +224,13 @@ def main() -> None:
         clip = a.tmp / "4k.mp4"
         make_4k(source, clip)
         cli = [py, "-m", "facemime"]
-        runs = {"python_and_reader_imports": [py, "-c", READ, "-"], "read": [py, "-c", READ, str(clip), "0"],
-                "read_slow_caller": [py, "-c", READ, str(clip), "0.1"],
-                "track": cli + ["track", str(clip), "--out", str(a.tmp / "4k.track.json"), "--force"],
-                "run": cli + ["run", str(clip), "--out", str(a.tmp / "4k.run.mp4"), "--force"]}
+        runs = {
+            "python_and_reader_imports": [py, "-c", READ, "-"],
+            "read": [py, "-c", READ, str(clip), "0"],
+            "read_slow_caller": [py, "-c", READ, str(clip), "0.1"],
+            "track": cli + ["track", str(clip), "--out", str(a.tmp / "4k.track.json"), "--force"],
+            "run": cli + ["run", str(clip), "--out", str(a.tmp / "4k.run.mp4"), "--force"],
+        }
         for name, args in runs.items():
             mib, seconds = peak(args, a.tmp / f"{name}.log")
             report[f"peak_{name}_mib"] = round(mib, 1)
@@ -233,18 +246,30 @@ def main() -> None:
             samples, top, seconds = soak(args, a.tmp / f"soak_{kind}.log", a.every)
             first, most, grew, slope = growth(samples)
             png = a.tmp / f"soak_{kind}_rss.png"
-            plot(samples, png, f"{SOAKS[kind]}, {a.minutes:g} min video ({frames} frames): resident memory",
-                 1.1 * first)
+            plot(
+                samples, png, f"{SOAKS[kind]}, {a.minutes:g} min video ({frames} frames): resident memory", 1.1 * first
+            )
             (a.tmp / f"soak_{kind}_rss.json").write_text(json.dumps(samples))
-            print(f"soak ({kind}): {seconds:.0f} s, {frames / seconds:.1f} frames/s; RSS {first:.0f} MiB at 1 min, "
-                  f"at most {most:.0f} MiB after ({100 * grew:+.1f} %), {samples[-1][1]:.0f} MiB at the end, "
-                  f"peak {top:.0f} MiB; steady growth {slope:.1f} MiB/min ({slope / 60 * MIB / (frames / seconds):.0f} "
-                  f"bytes a frame); {'GROWS' if grew > 0.10 else 'flat'}; plot {png}", flush=True)
-            report[f"soak_{kind}"] = dict(minutes=a.minutes, frames=frames, seconds=round(seconds, 1),
-                                          rss_at_1min_mib=round(first, 1), rss_max_after_1min_mib=round(most, 1),
-                                          rss_end_mib=round(samples[-1][1], 1), peak_mib=round(top, 1),
-                                          growth=round(grew, 4), grows=grew > 0.10,
-                                          steady_mib_per_min=round(slope, 2), png=str(png))
+            print(
+                f"soak ({kind}): {seconds:.0f} s, {frames / seconds:.1f} frames/s; RSS {first:.0f} MiB at 1 min, "
+                f"at most {most:.0f} MiB after ({100 * grew:+.1f} %), {samples[-1][1]:.0f} MiB at the end, "
+                f"peak {top:.0f} MiB; steady growth {slope:.1f} MiB/min ({slope / 60 * MIB / (frames / seconds):.0f} "
+                f"bytes a frame); {'GROWS' if grew > 0.10 else 'flat'}; plot {png}",
+                flush=True,
+            )
+            report[f"soak_{kind}"] = {
+                "minutes": a.minutes,
+                "frames": frames,
+                "seconds": round(seconds, 1),
+                "rss_at_1min_mib": round(first, 1),
+                "rss_max_after_1min_mib": round(most, 1),
+                "rss_end_mib": round(samples[-1][1], 1),
+                "peak_mib": round(top, 1),
+                "growth": round(grew, 4),
+                "grows": grew > 0.10,
+                "steady_mib_per_min": round(slope, 2),
+                "png": str(png),
+            }
     print(json.dumps(report))
 
 

@@ -39,8 +39,15 @@ def visible_far_to_near(points: np.ndarray, depth: np.ndarray, triangles: np.nda
     return visible[np.argsort(depth[triangles[visible]].mean(axis=1))]
 
 
-def opencv_common(out: np.ndarray, texture: np.ndarray, uv: np.ndarray, points: np.ndarray, depth: np.ndarray,
-                  triangles: np.ndarray, interpolation: int) -> None:
+def opencv_common(
+    out: np.ndarray,
+    texture: np.ndarray,
+    uv: np.ndarray,
+    points: np.ndarray,
+    depth: np.ndarray,
+    triangles: np.ndarray,
+    interpolation: int,
+) -> None:
     """The common per-triangle warp: float32 mask from fillConvexPoly, warpAffine of the source
     rectangle, composite ``dst * (1 - mask) + warped * mask`` (``out`` is float32)."""
     th, tw = texture.shape[:2]
@@ -56,14 +63,22 @@ def opencv_common(out: np.ndarray, texture: np.ndarray, uv: np.ndarray, points: 
         t2r = (t2 - r2[:2]).astype(np.float32)
         mask = np.zeros((rh, rw, 3), np.float32)
         cv2.fillConvexPoly(mask, np.int32(t2r), (1.0, 1.0, 1.0), 16, 0)
-        crop = texture[r1[1]:r1[1] + r1[3], r1[0]:r1[0] + r1[2]]
-        warped = cv2.warpAffine(crop, cv2.getAffineTransform(t1r, t2r), (rw, rh), flags=interpolation,
-                                borderMode=cv2.BORDER_REFLECT_101)
-        out[y:y + rh, x:x + rw] = out[y:y + rh, x:x + rw] * (1.0 - mask) + warped * mask
+        crop = texture[r1[1] : r1[1] + r1[3], r1[0] : r1[0] + r1[2]]
+        warped = cv2.warpAffine(
+            crop, cv2.getAffineTransform(t1r, t2r), (rw, rh), flags=interpolation, borderMode=cv2.BORDER_REFLECT_101
+        )
+        out[y : y + rh, x : x + rw] = out[y : y + rh, x : x + rw] * (1.0 - mask) + warped * mask
 
 
-def opencv_lean(out: np.ndarray, texture: np.ndarray, uv: np.ndarray, points: np.ndarray, depth: np.ndarray,
-                triangles: np.ndarray, interpolation: int) -> None:
+def opencv_lean(
+    out: np.ndarray,
+    texture: np.ndarray,
+    uv: np.ndarray,
+    points: np.ndarray,
+    depth: np.ndarray,
+    triangles: np.ndarray,
+    interpolation: int,
+) -> None:
     """The same warp with a uint8 mask and ``np.copyto`` into a uint8 image: a stronger peer."""
     th, tw = texture.shape[:2]
     src_all = (uv * [tw, th] - 0.5).astype(np.float32)
@@ -77,7 +92,7 @@ def opencv_lean(out: np.ndarray, texture: np.ndarray, uv: np.ndarray, points: np
             continue
         sx, sy, sw, sh = cv2.boundingRect(src)
         sx, sy = max(sx, 0), max(sy, 0)
-        crop = texture[sy:sy + sh, sx:sx + sw]
+        crop = texture[sy : sy + sh, sx : sx + sw]
         m = cv2.getAffineTransform((src - [sx, sy]).astype(np.float32), (dst - [x0, y0]).astype(np.float32))
         warped = cv2.warpAffine(crop, m, (x1 - x0, y1 - y0), flags=interpolation, borderMode=cv2.BORDER_REFLECT_101)
         mask = np.zeros((y1 - y0, x1 - x0), np.uint8)
@@ -102,26 +117,38 @@ def main() -> None:
     head = generic_head()
     texture = painted_texture(head, 512)
     results: dict[str, float] = {}
-    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores visible; "
-          f"one core used; {len(head.vertices)} vertices, {len(head.triangles)} triangles, 512x512 texture")
+    print(
+        f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores visible; "
+        f"one core used; {len(head.vertices)} vertices, {len(head.triangles)} triangles, 512x512 texture"
+    )
     for w, h in SIZES:
         base = Pose.framing(head.vertices, (w, h), 0.95)
         out = np.empty((h, w, 3), np.uint8)
-        poses = [Pose(yaw=8 * np.sin(i / 7), pitch=4 * np.sin(i / 5), roll=3 * np.sin(i / 9),
-                      scale=base.scale, tx=base.tx, ty=base.ty) for i in range(64)]
+        poses = [
+            Pose(
+                yaw=8 * np.sin(i / 7),
+                pitch=4 * np.sin(i / 5),
+                roll=3 * np.sin(i / 9),
+                scale=base.scale,
+                tx=base.tx,
+                ty=base.ty,
+            )
+            for i in range(64)
+        ]
         out_f = np.empty((h, w, 3), np.float32)
         for filt, interp in (("nearest", cv2.INTER_NEAREST), ("bilinear", cv2.INTER_LINEAR)):
-            def ours(i: int) -> None:
+
+            def ours(i: int, poses: list = poses, out: np.ndarray = out, filt: str = filt) -> None:
                 pts, z = project(head.vertices, poses[i % 64])
                 fill(out, BACKGROUND)
                 render_mesh_into(out, texture, head.uv, pts, z, head.triangles, filter=filt)
 
-            def common(i: int) -> None:
+            def common(i: int, poses: list = poses, out_f: np.ndarray = out_f, interp: int = interp) -> None:
                 pts, z = project(head.vertices, poses[i % 64])
                 out_f.fill(BACKGROUND)
                 opencv_common(out_f, texture, head.uv, pts, z, head.triangles, interp)
 
-            def lean(i: int) -> None:
+            def lean(i: int, poses: list = poses, out: np.ndarray = out, interp: int = interp) -> None:
                 pts, z = project(head.vertices, poses[i % 64])
                 fill(out, BACKGROUND)
                 opencv_lean(out, texture, head.uv, pts, z, head.triangles, interp)
@@ -134,8 +161,10 @@ def main() -> None:
             results[f"fps_opencv_lean_{key}"] = round(fps_lean, 1)
             results[f"ratio_{key}"] = round(fps / fps_cv, 2)
             results[f"ratio_lean_{key}"] = round(fps / fps_lean, 2)
-            print(f"{w}x{h} {filt:8s}  facemime {fps:8.1f} frames/s | opencv {fps_cv:7.1f} ({fps / fps_cv:5.1f}x) "
-                  f"| opencv lean {fps_lean:7.1f} ({fps / fps_lean:5.1f}x)")
+            print(
+                f"{w}x{h} {filt:8s}  facemime {fps:8.1f} frames/s | opencv {fps_cv:7.1f} ({fps / fps_cv:5.1f}x) "
+                f"| opencv lean {fps_lean:7.1f} ({fps / fps_lean:5.1f}x)"
+            )
     results["ratio_vs_opencv"] = results["ratio_640x480_bilinear"]
     print(json.dumps(results))
 

@@ -91,7 +91,7 @@ def scores(synth: np.ndarray, real: np.ndarray, masks: dict[str, np.ndarray]) ->
     out = {}
     for name, m in masks.items():
         mse = diff[m].mean()
-        out[name] = (10 * np.log10(255.0 ** 2 / max(mse, 1e-9)), float(s[m].mean()))
+        out[name] = (10 * np.log10(255.0**2 / max(mse, 1e-9)), float(s[m].mean()))
     return out
 
 
@@ -120,8 +120,16 @@ class Inpainted:
         self.triangles = scene.triangles[(scene.follow[scene.triangles] == 1.0).all(axis=1)]
         self.uv = (scene.rest + 0.5) / [w, h]
         hole = np.zeros((h, w), np.uint8)  # the first ring's triangles, rasterised
-        render_mesh_into(hole, np.full((1, 1), 255, np.uint8), self.uv, scene.rest, np.zeros(len(scene.rest)),
-                         self.triangles, filter="nearest", cull=False)
+        render_mesh_into(
+            hole,
+            np.full((1, 1), 255, np.uint8),
+            self.uv,
+            scene.rest,
+            np.zeros(len(scene.rest)),
+            self.triangles,
+            filter="nearest",
+            cull=False,
+        )
         grow = max(1, int(round(PLATE_GROW * min(w, h))))
         hole = cv2.dilate(hole, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * grow + 1, 2 * grow + 1)))
         self.plate = cv2.inpaint(self.key, hole, 5, cv2.INPAINT_TELEA)
@@ -138,7 +146,7 @@ class Inpainted:
 
 def save_still(path: Path, pictures: list[np.ndarray], labels: list[str]) -> None:
     """``pictures`` (RGB, one size) side by side under a strip with their ``labels``, as a PNG."""
-    h, w = pictures[0].shape[:2]
+    _h, w = pictures[0].shape[:2]
     strip = np.full((28, w * len(pictures), 3), 255, np.uint8)
     for k, label in enumerate(labels):
         cv2.putText(strip, label, (k * w + 8, 20), cv2.FONT_HERSHEY_SIMPLEX, 0.6, (0, 0, 0), 1, cv2.LINE_AA)
@@ -146,8 +154,9 @@ def save_still(path: Path, pictures: list[np.ndarray], labels: list[str]) -> Non
     cv2.imwrite(str(path), cv2.cvtColor(np.vstack([strip, np.hstack(pictures)]), cv2.COLOR_RGB2BGR))
 
 
-def quality(path: Path, landmarks: np.ndarray, valid: np.ndarray, iod: np.ndarray,
-            still: Path | None = None) -> tuple[dict[str, dict[str, list]], list[float]]:
+def quality(
+    path: Path, landmarks: np.ndarray, valid: np.ndarray, iod: np.ndarray, still: Path | None = None
+) -> tuple[dict[str, dict[str, list]], list[float]]:
     """method -> region -> [(PSNR dB, SSIM) per scored frame] over frames 1.. with reference
     points, and every frame's departure from the scene (:func:`departure`, as ``run`` reports)."""
     out = {m: {r: [] for r in REGIONS} for m in METHODS}
@@ -165,14 +174,20 @@ def quality(path: Path, landmarks: np.ndarray, valid: np.ndarray, iod: np.ndarra
         m = analysis.update(frame)
         if not valid[i] and not (still is not None and i == still_at):
             continue
-        renders = {"scene": scene.render(m.pose, m.offsets, size), "mask only": mask.render(m.pose, m.offsets, size),
-                   "frozen picture": frozen}
+        renders = {
+            "scene": scene.render(m.pose, m.offsets, size),
+            "mask only": mask.render(m.pose, m.offsets, size),
+            "frozen picture": frozen,
+        }
         renders["scene, inpainted"] = inpainted.render()
         vertices, pose = scene.shown
         departures.append(departure(frame, renders["scene"], project(vertices[scene.scene.anchors], pose)[0]))
         if still is not None and i == still_at:
-            save_still(still, [frame, renders["scene"], renders["mask only"], renders["scene, inpainted"]],
-                       [f"real {path.stem} #{i}", "scene", "mask only", "scene, inpainted"])
+            save_still(
+                still,
+                [frame, renders["scene"], renders["mask only"], renders["scene, inpainted"]],
+                [f"real {path.stem} #{i}", "scene", "mask only", "scene, inpainted"],
+            )
         if not valid[i]:
             continue
         masks = regions(landmarks[i], float(iod[i]), frame.shape[:2])
@@ -190,8 +205,12 @@ def one_pass(path: Path, mask_only: bool) -> dict[str, float]:
         for _ in work:
             pass
     result = work.result([])
-    return {"fps": result.fps, "frames": result.frames, "fit_seconds": result.seconds["fit"],
-            **{f"share_{k}": v for k, v in result.shares.items()}}
+    return {
+        "fps": result.fps,
+        "frames": result.frames,
+        "fit_seconds": result.seconds["fit"],
+        **{f"share_{k}": v for k, v in result.shares.items()},
+    }
 
 
 def speed(path: Path) -> dict[str, dict[str, float] | float]:
@@ -215,8 +234,12 @@ def speed(path: Path) -> dict[str, dict[str, float] | float]:
         t0 = time.perf_counter()
         whole = run_video(path, Path(tmp) / "out.mp4", force=True)
         wall = time.perf_counter() - t0
-    return {**best, "scene_over_mask": best["scene"]["fps"] / best["mask only"]["fps"],
-            "fps_run_with_encoding_wall": whole.frames / wall, "encode_seconds": whole.seconds["encode"]}
+    return {
+        **best,
+        "scene_over_mask": best["scene"]["fps"] / best["mask only"]["fps"],
+        "fps_run_with_encoding_wall": whole.frames / wall,
+        "encode_seconds": whole.seconds["encode"],
+    }
 
 
 def targets(v: dict) -> dict[str, bool]:
@@ -252,14 +275,24 @@ def main() -> None:
         still = None if args.stills is None else args.stills / f"{name}.png"
         q, d = quality(args.data / "video" / f"{name}.mp4", z["landmarks"], z["valid"], z["iod"], still)
         departs[name] = float(np.mean(np.array(d) > DEPARTS_AT))
-        per_video[name] = {m: {r: dict(zip(("psnr", "ssim"), np.mean(vals, axis=0).tolist())) for r, vals in by.items()}
-                           for m, by in q.items()}
+        per_video[name] = {
+            m: {r: dict(zip(("psnr", "ssim"), np.mean(vals, axis=0).tolist())) for r, vals in by.items()}
+            for m, by in q.items()
+        }
         checks[name], frames[name] = targets(per_video[name]), len(q["scene"]["face"])
         table(per_video[name], f"{name}: {frames[name]} frames scored in {time.perf_counter() - t0:.1f} s")
-        print(f"targets not met: {', '.join(k for k, ok in checks[name].items() if not ok) or 'none'}; "
-              f"frames that depart from the scene: {100 * departs[name]:.0f}%", flush=True)
-    pooled = {m: {r: {k: float(np.mean([per_video[v][m][r][k] for v in per_video])) for k in ("psnr", "ssim")}
-                  for r in REGIONS} for m in METHODS}
+        print(
+            f"targets not met: {', '.join(k for k, ok in checks[name].items() if not ok) or 'none'}; "
+            f"frames that depart from the scene: {100 * departs[name]:.0f}%",
+            flush=True,
+        )
+    pooled = {
+        m: {
+            r: {k: float(np.mean([per_video[v][m][r][k] for v in per_video])) for k in ("psnr", "ssim")}
+            for r in REGIONS
+        }
+        for m in METHODS
+    }
     table(pooled, f"mean over {len(per_video)} videos")
     print(f"\n{'face region':12s} {'PSNR scene':>11s} {'mask only':>10s} {'SSIM scene':>11s} {'mask only':>10s}")
     for v in per_video:
@@ -271,14 +304,28 @@ def main() -> None:
     sp = speed(args.data / "video" / f"{args.speed}.mp4")
     for mode in ("scene", "mask only"):
         p = sp[mode]
-        print(f"run on {args.speed} ({p['frames']} frames), {mode}, one core, encoding excluded: "
-              f"{p['fps']:.0f} frames/s; shares: "
-              + ", ".join(f"{k[6:]} {100 * x:.0f}%" for k, x in p.items() if k.startswith("share_")))
-    print(f"scene / mask only: {sp['scene_over_mask']:.2f}; target >= 200 frames/s in the scene: "
-          f"{'met' if sp['scene']['fps'] >= 200 else 'NOT MET'}")
+        print(
+            f"run on {args.speed} ({p['frames']} frames), {mode}, one core, encoding excluded: "
+            f"{p['fps']:.0f} frames/s; shares: "
+            + ", ".join(f"{k[6:]} {100 * x:.0f}%" for k, x in p.items() if k.startswith("share_"))
+        )
+    print(
+        f"scene / mask only: {sp['scene_over_mask']:.2f}; target >= 200 frames/s in the scene: "
+        f"{'met' if sp['scene']['fps'] >= 200 else 'NOT MET'}"
+    )
     print(f"the whole run with H.264 encoding, all cores: {sp['fps_run_with_encoding_wall']:.0f} frames/s wall clock")
-    print(json.dumps({"pooled": pooled, "per_video": per_video, "frames": frames, "targets": checks,
-                      "departs": departs, "speed": sp}))
+    print(
+        json.dumps(
+            {
+                "pooled": pooled,
+                "per_video": per_video,
+                "frames": frames,
+                "targets": checks,
+                "departs": departs,
+                "speed": sp,
+            }
+        )
+    )
 
 
 if __name__ == "__main__":

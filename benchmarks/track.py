@@ -30,6 +30,7 @@ import os
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # one core: no BLAS threads (set before numpy loads)
 
 import argparse
+import itertools
 import json
 import platform
 import time
@@ -43,8 +44,7 @@ import cv2
 import numpy as np
 
 import facemime.track.tracker as tracker_module
-from facemime.track import motion
-from facemime.track import Tracker
+from facemime.track import Tracker, motion
 from facemime.track.contours import CONTOUR_NAMES, from_face_mesh
 from facemime.track.redetect import FaceTracker
 
@@ -65,6 +65,7 @@ class StageClock:
                 return fn(*args, **kwargs)
             finally:
                 self.seconds[label] += time.perf_counter() - t0
+
         return timed
 
 
@@ -83,16 +84,24 @@ class TimedMethods:
 
 def stage_seconds(frames: list[np.ndarray], init: dict[str, np.ndarray], clock: StageClock) -> float:
     """Seconds the default tracker took on frames 1.., its native stages timed into ``clock``."""
-    with mock.patch.object(motion.HeadMotion, "_detect", clock.wrap("corner detection", motion.HeadMotion._detect)), \
-            mock.patch.object(tracker_module, "build_field", clock.wrap("image field", tracker_module.build_field)):
+    with (
+        mock.patch.object(motion.HeadMotion, "_detect", clock.wrap("corner detection", motion.HeadMotion._detect)),
+        mock.patch.object(tracker_module, "build_field", clock.wrap("image field", tracker_module.build_field)),
+    ):
         tracker = Tracker(frames[0], init)
         clock.seconds.clear()  # the first frame's set-up is not a frame's work
-        solver = tracker._solver  # noqa: SLF001 - benchmark instrumentation
+        solver = tracker._solver
         field0, solver0 = solver.times
-        tracker._solver = TimedMethods(solver, clock, {"solve": "snake solver",  # noqa: SLF001
-                                                       "evaluate": "snake solver"})
-        head = tracker._motion  # noqa: SLF001
-        head._head = TimedMethods(head._head, clock, {"follow": "head motion (grey levels, pyramid, optical flow)"})  # noqa: SLF001
+        tracker._solver = TimedMethods(
+            solver,
+            clock,
+            {
+                "solve": "snake solver",
+                "evaluate": "snake solver",
+            },
+        )
+        head = tracker._motion
+        head._head = TimedMethods(head._head, clock, {"follow": "head motion (grey levels, pyramid, optical flow)"})
         t0 = time.perf_counter()
         for frame in frames[1:]:
             tracker.update(frame)
@@ -122,7 +131,7 @@ def lk_seconds(frames: list[np.ndarray], pts: np.ndarray) -> float:
     grays = [cv2.cvtColor(f, cv2.COLOR_RGB2GRAY) for f in frames]
     t0 = time.perf_counter()
     p = pts.reshape(-1, 1, 2).astype(np.float32)
-    for prev, cur in zip(grays, grays[1:]):
+    for prev, cur in itertools.pairwise(grays):
         p1, st1, _ = cv2.calcOpticalFlowPyrLK(prev, cur, p, None, winSize=(21, 21), maxLevel=3)
         back, st2, _ = cv2.calcOpticalFlowPyrLK(cur, prev, p1, None, winSize=(21, 21), maxLevel=3)
         ok = (st1.ravel() == 1) & (st2.ravel() == 1) & (np.linalg.norm((back - p).reshape(-1, 2), axis=1) <= 1.0)
@@ -135,9 +144,9 @@ def track_seconds(frames: list[np.ndarray], init: dict[str, np.ndarray]) -> tupl
     in the snake solver (the frame's passes, timed by the core, and any further solve calls),
     and the solver's iterations."""
     tracker, clock = Tracker(frames[0], init), StageClock()
-    solver = tracker._solver  # noqa: SLF001 - benchmark instrumentation
+    solver = tracker._solver
     before = solver.times[1]
-    tracker._solver = TimedMethods(solver, clock, {"solve": "snakes"})  # noqa: SLF001
+    tracker._solver = TimedMethods(solver, clock, {"solve": "snakes"})
     iterations, t0 = 0, time.perf_counter()
     for frame in frames[1:]:
         iterations += tracker.update(frame).iterations
@@ -171,8 +180,16 @@ def main() -> None:
     if args.repeats < 1:
         ap.error("--repeats must be at least 1")
     cv2.setNumThreads(1)
-    totals = {"frames": 0, "decode": 0.0, "tracker": 0.0, "snakes": 0.0, "lk": 0.0, "iterations": 0, "checked": 0.0,
-              "checks": 0.0}
+    totals = {
+        "frames": 0,
+        "decode": 0.0,
+        "tracker": 0.0,
+        "snakes": 0.0,
+        "lk": 0.0,
+        "iterations": 0,
+        "checked": 0.0,
+        "checks": 0.0,
+    }
     starts = {}
     stages, staged = defaultdict(float), 0.0  # with --stages: seconds per stage, and in all
     for video in VIDEOS:
@@ -180,8 +197,15 @@ def main() -> None:
         frames, _ = decode(path, args.frames)
         init = from_face_mesh(np.load(args.data / "video" / f"{video}.landmarks.npz")["landmarks"][0])
         pts = np.concatenate([init[n] for n in CONTOUR_NAMES])
-        best = {"decode": np.inf, "tracker": np.inf, "snakes": np.inf, "lk": np.inf, "start": np.inf,
-                "checked": np.inf, "checks": np.inf}
+        best = {
+            "decode": np.inf,
+            "tracker": np.inf,
+            "snakes": np.inf,
+            "lk": np.inf,
+            "start": np.inf,
+            "checked": np.inf,
+            "checks": np.inf,
+        }
         start_seconds(frames[0])  # the face models load once per process
         # The runs of the three measurements alternate, so that a slow spell of a shared machine
         # does not fall on one of them only; each keeps its fastest run.
@@ -200,10 +224,13 @@ def main() -> None:
             for label, seconds in clock.seconds.items():
                 stages[label] += seconds
         n = len(frames) - 1
-        print(f"{video}: {n} frames  decode {len(frames) / best['decode']:7.0f} fps  tracker {n / best['tracker']:6.0f} fps  "
-              f"snakes alone {n / best['snakes']:7.0f} fps  LK+FB {n / best['lk']:6.0f} fps  "
-              f"with re-detection {n / best['checked']:6.0f} fps (checks {1e3 * best['checks'] / n:.3f} ms/frame)  "
-              f"automatic start {1e3 * best['start']:.1f} ms")
+        print(
+            f"{video}: {n} frames  decode {len(frames) / best['decode']:7.0f} fps  tracker "
+            f"{n / best['tracker']:6.0f} fps  "
+            f"snakes alone {n / best['snakes']:7.0f} fps  LK+FB {n / best['lk']:6.0f} fps  "
+            f"with re-detection {n / best['checked']:6.0f} fps (checks {1e3 * best['checks'] / n:.3f} ms/frame)  "
+            f"automatic start {1e3 * best['start']:.1f} ms"
+        )
         starts[video] = 1e3 * best["start"]
         totals["frames"] += n
         totals["decode"] += best["decode"] * n / len(frames)
@@ -225,17 +252,21 @@ def main() -> None:
         "automatic_start_ms": starts,
         "repeats": args.repeats,
     }
-    print(f"all: tracker {result['fps_tracker']:.0f} fps ({result['tracker_vs_decode']:.2f}x decoding, "
-          f"{result['tracker_vs_lk']:.2f}x LK), snakes alone {result['fps_snakes']:.0f} fps, "
-          f"{result['mean_iterations']:.1f} iterations per frame; with re-detection {result['fps_with_redetection']:.0f} "
-          f"fps (its checks {result['checks_ms_per_frame']:.3f} ms a frame); automatic start "
-          + ", ".join(f"{v} {ms:.1f} ms" for v, ms in starts.items()))
+    print(
+        f"all: tracker {result['fps_tracker']:.0f} fps ({result['tracker_vs_decode']:.2f}x decoding, "
+        f"{result['tracker_vs_lk']:.2f}x LK), snakes alone {result['fps_snakes']:.0f} fps, "
+        f"{result['mean_iterations']:.1f} iterations per frame; with re-detection {result['fps_with_redetection']:.0f} "
+        f"fps (its checks {result['checks_ms_per_frame']:.3f} ms a frame); automatic start "
+        + ", ".join(f"{v} {ms:.1f} ms" for v, ms in starts.items())
+    )
     if args.stages:
         ms = {label: 1e3 * seconds / n for label, seconds in sorted(stages.items(), key=lambda kv: -kv[1])}
         ms["the rest (Python, smaller native calls)"] = 1e3 * staged / n - sum(ms.values())
         result["stages_ms"] = ms
-        print(f"where a frame's {1e3 * staged / n:.2f} ms go (one run, calls timed): "
-              + ", ".join(f"{label} {v:.2f}" for label, v in ms.items()))
+        print(
+            f"where a frame's {1e3 * staged / n:.2f} ms go (one run, calls timed): "
+            + ", ".join(f"{label} {v:.2f}" for label, v in ms.items())
+        )
     print(json.dumps(result))
 
 

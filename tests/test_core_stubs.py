@@ -14,8 +14,11 @@ def stub_items():
     tree = ast.parse(STUB.read_text())
     params = lambda f: [a.arg for a in f.args.args]  # noqa: E731
     funcs = {n.name: params(n) for n in tree.body if isinstance(n, ast.FunctionDef)}
-    classes = {n.name: {m.name: params(m) for m in n.body if isinstance(m, ast.FunctionDef)}
-               for n in tree.body if isinstance(n, ast.ClassDef)}
+    classes = {
+        n.name: {m.name: params(m) for m in n.body if isinstance(m, ast.FunctionDef)}
+        for n in tree.body
+        if isinstance(n, ast.ClassDef)
+    }
     names = {n.target.id for n in tree.body if isinstance(n, ast.AnnAssign)}
     return funcs, classes, names
 

@@ -111,9 +111,7 @@ def symmetrise(p: np.ndarray) -> np.ndarray:
 def triangulate(xy: np.ndarray, segments: list[tuple[int, int]], holes: list[np.ndarray]) -> np.ndarray:
     import triangle
 
-    tri = triangle.triangulate(
-        {"vertices": xy, "segments": np.array(segments), "holes": np.array(holes)}, "p"
-    )
+    tri = triangle.triangulate({"vertices": xy, "segments": np.array(segments), "holes": np.array(holes)}, "p")
     if len(tri["vertices"]) != len(xy):
         raise SystemExit("triangulation added Steiner points: a constraint crosses another")
     t = tri["triangles"]
@@ -146,8 +144,9 @@ def update_units(path: Path) -> None:
     """Recompute only the deformation units of the model file at ``path`` (from its vertices,
     triangles and groups), leaving the rest byte for byte: for when the controls change."""
     model = json.loads(path.read_text())
-    model["deformation_units"] = deformation_units(np.array(model["vertices"]), np.array(model["triangles"]),
-                                                   model["groups"])
+    model["deformation_units"] = deformation_units(
+        np.array(model["vertices"]), np.array(model["triangles"]), model["groups"]
+    )
     write(model, path)
 
 
@@ -156,8 +155,10 @@ def write(model: dict, out: Path) -> None:
     # One vertex / triangle / entry per line keeps the file readable and its diffs small.
     text = text.replace("],[", "],\n[").replace('},"', '},\n"')
     out.write_text(text + "\n")
-    print(f"{out}: {len(model['vertices'])} vertices, {len(model['triangles'])} triangles, "
-          f"{len(model['deformation_units'])} deformation units")
+    print(
+        f"{out}: {len(model['vertices'])} vertices, {len(model['triangles'])} triangles, "
+        f"{len(model['deformation_units'])} deformation units"
+    )
 
 
 def build(video_dir: Path) -> dict:
@@ -192,15 +193,20 @@ def build(video_dir: Path) -> dict:
     v[il[1:-1], 1] -= 0.05  # closed, but not zero-width: the lower curve sits just below
     lo, hi = v[:, :2].min(0), v[:, :2].max(0)
     margin = 0.04 * (hi - lo)
-    uv = np.column_stack([(v[:, 0] - lo[0] + margin[0]) / (hi[0] - lo[0] + 2 * margin[0]),
-                          (hi[1] + margin[1] - v[:, 1]) / (hi[1] - lo[1] + 2 * margin[1])])
+    uv = np.column_stack(
+        [
+            (v[:, 0] - lo[0] + margin[0]) / (hi[0] - lo[0] + 2 * margin[0]),
+            (hi[1] + margin[1] - v[:, 1]) / (hi[1] - lo[1] + 2 * margin[1]),
+        ]
+    )
     return {
         "format": "facemime.head/1",
         "name": "facemime generic head",
         "unit": "mm",
-        "axes": "right-handed: x to the subject's left, y up, z towards the camera; origin between the outer eye corners",
+        "axes": "right-handed: x to the subject's left, y up, z towards the camera; origin between the outer "
+        "eye corners",
         "source": "mean of the first frames of six face videos (MediaPipe Face Mesh points with depth), "
-                  "Procrustes-aligned, symmetrised, thinned; built by tools/build_generic_head.py",
+        "Procrustes-aligned, symmetrised, thinned; built by tools/build_generic_head.py",
         "vertices": np.round(v, 3).tolist(),
         "triangles": tris.tolist(),
         "uv": np.round(uv, 5).tolist(),

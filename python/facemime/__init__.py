@@ -12,6 +12,6 @@ Conventions used across the package:
 """
 
 from facemime._core import __version__
-from facemime.errors import FacemimeError, InvalidInputError, InputFileError, ModelFormatError
+from facemime.errors import FacemimeError, InputFileError, InvalidInputError, ModelFormatError
 
-__all__ = ["__version__", "FacemimeError", "InvalidInputError", "InputFileError", "ModelFormatError"]
+__all__ = ["FacemimeError", "InputFileError", "InvalidInputError", "ModelFormatError", "__version__"]

@@ -32,10 +32,9 @@ from facemime.fit.placement import model_iod
 from facemime.fit.preview import preview_sheet
 from facemime.fit.run import fit_actor
 from facemime.io import VideoWriter, write_image
-from facemime.io.outputs import Outputs, write_bytes
 from facemime.io.actor_file import actor_bytes
 from facemime.io.contours_json import track_document, write_json
-from facemime.io.outputs import write_text
+from facemime.io.outputs import Outputs, write_bytes, write_text
 from facemime.metrics import group_nme, summarize
 from facemime.progress import track
 from facemime.render.projection import project
@@ -47,7 +46,15 @@ SIZE = (512, 512)
 #: The part of the astronaut photo the demo shows, (x, y, side) pixels: her head and shoulders,
 #: enlarged to :data:`SIZE` (the distance between her outer eye corners becomes about 130 px).
 FRAMING = (105, 10, 240)
-FILES = ("astronaut.actor", "astronaut.png", "performance.mp4", "resynthesis.mp4", "track.json", "stills.png", "report.html")
+FILES = (
+    "astronaut.actor",
+    "astronaut.png",
+    "performance.mp4",
+    "resynthesis.mp4",
+    "track.json",
+    "stills.png",
+    "report.html",
+)
 
 
 @dataclass
@@ -67,22 +74,30 @@ def performance(t: float) -> tuple[dict[str, float], dict[str, float]]:
     She talks throughout, opens the mouth wide around 2.5 s, raises the brows twice and frowns
     once, smiles, and turns and tilts the head."""
     talk = max(0.0, np.sin(2 * np.pi * 2.1 * t)) * (0.35 + 0.25 * np.sin(2 * np.pi * 0.37 * t) ** 2)
-    wide = np.exp(-((t - 2.6) / 0.35) ** 2)
+    wide = np.exp(-(((t - 2.6) / 0.35) ** 2))
     # expression weights (facemime.animate.expressions): the lower lip down up to 12 mm, the
     # corners out up to 2 mm each and up 3 mm, the brows up 6 mm and down 4 mm on the generic head
     stretch = 0.08 * np.sin(2 * np.pi * 0.3 * t) ** 2
-    smile = 0.19 * np.exp(-((t - 4.4) / 0.5) ** 2)
-    brows = 0.9 * np.exp(-((t - 1.2) / 0.35) ** 2) + 0.9 * np.exp(-((t - 3.6) / 0.35) ** 2)
-    down = 0.6 * np.exp(-((t - 5.2) / 0.3) ** 2)
+    smile = 0.19 * np.exp(-(((t - 4.4) / 0.5) ** 2))
+    brows = 0.9 * np.exp(-(((t - 1.2) / 0.35) ** 2)) + 0.9 * np.exp(-(((t - 3.6) / 0.35) ** 2))
+    down = 0.6 * np.exp(-(((t - 5.2) / 0.3) ** 2))
     units = {
         "jawOpen": 0.33 * min(1.0, 0.7 * talk + 1.0 * wide),
-        "mouthStretchLeft": stretch, "mouthStretchRight": stretch,
-        "mouthSmileLeft": smile, "mouthSmileRight": smile,
-        "browInnerUp": 0.4 * brows, "browOuterUpLeft": 0.4 * brows, "browOuterUpRight": 0.4 * brows,
-        "browDownLeft": 0.48 * down, "browDownRight": 0.48 * down,
+        "mouthStretchLeft": stretch,
+        "mouthStretchRight": stretch,
+        "mouthSmileLeft": smile,
+        "mouthSmileRight": smile,
+        "browInnerUp": 0.4 * brows,
+        "browOuterUpLeft": 0.4 * brows,
+        "browOuterUpRight": 0.4 * brows,
+        "browDownLeft": 0.48 * down,
+        "browDownRight": 0.48 * down,
     }
-    angles = {"yaw": 16 * np.sin(2 * np.pi * t / 4.0), "pitch": 5 * np.sin(2 * np.pi * t / 3.1),
-              "roll": 6 * np.sin(2 * np.pi * t / 5.3)}
+    angles = {
+        "yaw": 16 * np.sin(2 * np.pi * t / 4.0),
+        "pitch": 5 * np.sin(2 * np.pi * t / 3.1),
+        "roll": 6 * np.sin(2 * np.pi * t / 5.3),
+    }
     return units, angles
 
 
@@ -118,10 +133,15 @@ def _demo(files: list[Path], paths: list[Path], seconds: float) -> DemoResult:
     timing: dict[str, float] = {}
 
     # 1. The actor.
-    photo = cv2.cvtColor(cv2.imdecode(np.frombuffer(resources.files("facemime.data").joinpath("astronaut.jpg").read_bytes(),
-                                                    np.uint8), cv2.IMREAD_COLOR), cv2.COLOR_BGR2RGB)
+    photo = cv2.cvtColor(
+        cv2.imdecode(
+            np.frombuffer(resources.files("facemime.data").joinpath("astronaut.jpg").read_bytes(), np.uint8),
+            cv2.IMREAD_COLOR,
+        ),
+        cv2.COLOR_BGR2RGB,
+    )
     x0, y0, side = FRAMING
-    photo = cv2.resize(photo[y0:y0 + side, x0:x0 + side], SIZE, interpolation=cv2.INTER_CUBIC)
+    photo = cv2.resize(photo[y0 : y0 + side, x0 : x0 + side], SIZE, interpolation=cv2.INTER_CUBIC)
     t0 = time.perf_counter()
     actor = fit_actor(photo, "astronaut.jpg")[0]
     timing["fit"] = time.perf_counter() - t0
@@ -154,12 +174,23 @@ def _demo(files: list[Path], paths: list[Path], seconds: float) -> DemoResult:
     for group, names in GROUPS.items():
         per_frame = []
         for m, ref, pose in zip(motions[1:], truth[1:], truth_poses[1:]):
-            corners = project(actor.model.vertices[[actor.model.groups["eye_right"][0], actor.model.groups["eye_left"][4]]], pose)[0]
+            corners = project(
+                actor.model.vertices[[actor.model.groups["eye_right"][0], actor.model.groups["eye_left"][4]]], pose
+            )[0]
             per_frame.append(group_nme(m.contours, ref, names, float(np.linalg.norm(corners[1] - corners[0]))))
         nme[group] = summarize(np.array(per_frame))
     first = analysis.actor.pose
-    pose_error = {k: float(np.mean([abs((getattr(m.pose, k) - getattr(first, k)) - (getattr(p, k) - getattr(rest, k)))
-                                    for m, p in zip(motions, truth_poses)])) for k in ("yaw", "pitch", "roll")}
+    pose_error = {
+        k: float(
+            np.mean(
+                [
+                    abs((getattr(m.pose, k) - getattr(first, k)) - (getattr(p, k) - getattr(rest, k)))
+                    for m, p in zip(motions, truth_poses)
+                ]
+            )
+        )
+        for k in ("yaw", "pitch", "roll")
+    }
 
     # 4. Re-synthesise on the astronaut and on the second face.
     sizes, iod = analysis.deformer.feature_sizes(), model_iod(analysis.actor.model)
@@ -180,24 +211,53 @@ def _demo(files: list[Path], paths: list[Path], seconds: float) -> DemoResult:
                 stills.append(row)
     timing["re-synthesise (2 faces)"] = synth_seconds
     timing["encode videos"] = time.perf_counter() - t0 - synth_seconds
-    write_json(paths[4], track_document(
-        {"width": SIZE[0], "height": SIZE[1], "fps": FPS, "frames": count},
-        [{"index": i, "contours": m.contours, "confidence": m.confidence, "lost": m.lost, "redetected": m.redetected,
-          "face": m.face, "pose": pose_dict(m.pose), "offsets": m.offsets, "look": m.look.as_dict()}
-         for i, m in enumerate(motions)],
-        model=analysis.model_block))
+    write_json(
+        paths[4],
+        track_document(
+            {"width": SIZE[0], "height": SIZE[1], "fps": FPS, "frames": count},
+            [
+                {
+                    "index": i,
+                    "contours": m.contours,
+                    "confidence": m.confidence,
+                    "lost": m.lost,
+                    "redetected": m.redetected,
+                    "face": m.face,
+                    "pose": pose_dict(m.pose),
+                    "offsets": m.offsets,
+                    "look": m.look.as_dict(),
+                }
+                for i, m in enumerate(motions)
+            ],
+            model=analysis.model_block,
+        ),
+    )
     write_image(paths[5], _still_sheet(stills))
     write_text(paths[6], _report(nme, pose_error, timing, count, sorted(shown)))
     return DemoResult(files, count, {g: s["mean"] for g, s in nme.items()}, pose_error, timing)
 
 
-def _report(nme: dict[str, dict[str, float]], pose_error: dict[str, float], timing: dict[str, float],
-            frames: int, shown: list[int]) -> str:
-    rows = "".join(f"<tr><td>{html.escape(g.replace('_', ' '))}</td><td>{s['mean']:.4f}</td><td>{s['p90']:.4f}</td>"
-                   f"<td>{100 * s['failure_rate']:.1f}%</td></tr>" for g, s in nme.items())
+def _report(
+    nme: dict[str, dict[str, float]],
+    pose_error: dict[str, float],
+    timing: dict[str, float],
+    frames: int,
+    shown: list[int],
+) -> str:
+    rows = "".join(
+        f"<tr><td>{html.escape(g.replace('_', ' '))}</td><td>{s['mean']:.4f}</td><td>{s['p90']:.4f}</td>"
+        f"<td>{100 * s['failure_rate']:.1f}%</td></tr>"
+        for g, s in nme.items()
+    )
     pose_rows = "".join(f"<tr><td>{k}</td><td>{v:.1f}°</td></tr>" for k, v in pose_error.items())
-    time_rows = "".join(f"<tr><td>{html.escape(k)}</td><td>{v:.2f} s</td><td>{frames / max(v, 1e-9):.0f} frames/s</td></tr>"
-                        for k, v in timing.items() if k != "fit") + f"<tr><td>fit</td><td>{timing['fit']:.2f} s</td><td></td></tr>"
+    time_rows = (
+        "".join(
+            f"<tr><td>{html.escape(k)}</td><td>{v:.2f} s</td><td>{frames / max(v, 1e-9):.0f} frames/s</td></tr>"
+            for k, v in timing.items()
+            if k != "fit"
+        )
+        + f"<tr><td>fit</td><td>{timing['fit']:.2f} s</td><td></td></tr>"
+    )
     return f"""<!doctype html>
 <html lang="en"><head><meta charset="utf-8"><title>facemime demo</title>
 <style>body{{font:15px/1.45 system-ui,sans-serif;max-width:1560px;margin:2em auto;padding:0 1em;color:#222}}

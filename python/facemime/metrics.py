@@ -51,7 +51,9 @@ def curve_error(pred: object, ref: np.ndarray) -> float:
     return float((d_pr + d_rp) / 2.0)
 
 
-def group_nme(pred: Mapping[str, object] | None, ref: Mapping[str, np.ndarray], names: Sequence[str], iod: float) -> float:
+def group_nme(
+    pred: Mapping[str, object] | None, ref: Mapping[str, np.ndarray], names: Sequence[str], iod: float
+) -> float:
     """Mean NME of the curves ``names`` of one frame (+inf if any is missing)."""
     pred = pred or {}
     return float(np.mean([curve_error(pred.get(n), ref[n]) for n in names])) / iod
@@ -63,7 +65,7 @@ def summarize(per_frame: np.ndarray) -> dict[str, float]:
     v = np.asarray(per_frame, dtype=np.float64)
     finite = v[np.isfinite(v)]
     third = len(v) // 3
-    first, last = v[:third], v[len(v) - third:]
+    first, last = v[:third], v[len(v) - third :]
     mean_f = lambda x: float(np.mean(x[np.isfinite(x)])) if np.isfinite(x).any() else float("nan")  # noqa: E731
     return {
         "mean": float(finite.mean()) if finite.size else float("nan"),

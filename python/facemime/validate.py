@@ -3,6 +3,8 @@ line naming the argument, what was expected and what was given."""
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import numpy as np
 
 from facemime import _core
@@ -24,7 +26,9 @@ def float_array(name: str, a: object, shape: tuple[int | None, ...]) -> np.ndarr
     try:
         arr = np.ascontiguousarray(a, dtype=np.float64)
     except (TypeError, ValueError):
-        raise InvalidInputError(f"{name} must be a numeric array of shape {_shape_text(shape)}, got {_describe(a)}") from None
+        raise InvalidInputError(
+            f"{name} must be a numeric array of shape {_shape_text(shape)}, got {_describe(a)}"
+        ) from None
     if arr.ndim != len(shape) or any(s is not None and s != d for s, d in zip(shape, arr.shape)):
         raise InvalidInputError(f"{name} must have shape {_shape_text(shape)}, got {arr.shape}")
     if not np.isfinite(arr).all():
@@ -57,7 +61,9 @@ def image(name: str, a: object) -> np.ndarray:
 def image_size(name: str, size: object) -> tuple[int, int]:
     """``size`` as a (width, height) pair of positive ints within the core's limits."""
     try:
-        w, h = (int(v) for v in size)  # type: ignore[union-attr]
+        if not isinstance(size, Iterable):
+            raise TypeError
+        w, h = (int(v) for v in size)
     except (TypeError, ValueError):
         raise InvalidInputError(f"{name} must be a (width, height) pair of integers, got {size!r}") from None
     if w <= 0 or h <= 0:
@@ -74,7 +80,7 @@ def choice(name: str, value: object, allowed: tuple[str, ...]) -> str:
     """``value`` if it is one of ``allowed``."""
     if value not in allowed:
         raise InvalidInputError(f"{name} must be one of {', '.join(map(repr, allowed))}, got {value!r}")
-    return value  # type: ignore[return-value]
+    return str(value)
 
 
 def _shape_text(shape: tuple[int | None, ...]) -> str:

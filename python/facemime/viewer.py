@@ -2,8 +2,8 @@
 
 A video is analysed live as it plays (original with contours | synthesised picture: the face in
 its actor's scene, or alone with ``mask_only``); a track file written by ``facemime run`` replays
-its recorded motion (on an actor with a scene, relative to the track's first pose). Keys in the browser add motion, as the
-paper's keyboard did: arrows turn and tilt the head, ``q``/``e`` roll it, ``+``/``-`` zoom,
+its recorded motion (on an actor with a scene, relative to the track's first pose). Keys in the browser add
+motion, as the paper's keyboard did: arrows turn and tilt the head, ``q``/``e`` roll it, ``+``/``-`` zoom,
 ``x``/``z`` exaggerate or calm the mouth and brow motion, ``r`` resets, space pauses.
 
 The page shows an MJPEG stream (``/stream``); ``/key?k=NAME`` applies a key and answers the new
@@ -31,7 +31,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Iterator
-from contextlib import closing
+from contextlib import closing, suppress
 from http import HTTPStatus
 from http.client import LineTooLong
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
@@ -55,9 +55,17 @@ from facemime.track.overlay import draw_contours
 
 #: Key -> the change it makes to the user motion.
 KEYS = {
-    "ArrowLeft": {"yaw": -5.0}, "ArrowRight": {"yaw": 5.0}, "ArrowUp": {"pitch": -5.0}, "ArrowDown": {"pitch": 5.0},
-    "q": {"roll": 5.0}, "e": {"roll": -5.0}, "+": {"zoom": 1.1}, "=": {"zoom": 1.1}, "-": {"zoom": 1 / 1.1},
-    "x": {"gain": 1.25}, "z": {"gain": 0.8},
+    "ArrowLeft": {"yaw": -5.0},
+    "ArrowRight": {"yaw": 5.0},
+    "ArrowUp": {"pitch": -5.0},
+    "ArrowDown": {"pitch": 5.0},
+    "q": {"roll": 5.0},
+    "e": {"roll": -5.0},
+    "+": {"zoom": 1.1},
+    "=": {"zoom": 1.1},
+    "-": {"zoom": 1 / 1.1},
+    "x": {"gain": 1.25},
+    "z": {"gain": 0.8},
 }
 HELP = "arrows: turn and tilt · q/e: roll · +/-: zoom · x/z: more/less motion · r: reset · space: pause"
 #: The most bytes of a request's line and headers together.
@@ -109,21 +117,33 @@ class Viewer:
             with VideoReader(self.source) as reader:
                 for n, frame in enumerate(reader):
                     if frame.shape[:2] != self.size[::-1]:
-                        raise InputFileError(f"video {self.source} changes its frame size from {self.size[0]}x"
-                                             f"{self.size[1]} to {frame.shape[1]}x{frame.shape[0]} at frame {n}; "
-                                             "the viewer plays one frame size")
+                        raise InputFileError(
+                            f"video {self.source} changes its frame size from {self.size[0]}x"
+                            f"{self.size[1]} to {frame.shape[1]}x{frame.shape[0]} at frame {n}; "
+                            "the viewer plays one frame size"
+                        )
                     if analysis is None:
                         try:
                             analysis = Analysis(frame, str(self.source))
                         except NoFaceError as e:
                             raise NoFaceError(f"{e}; the video must start with a frontal face") from None
-                        puppet = Puppet(self._actor or analysis.actor, analysis.deformer.feature_sizes(),
-                                        model_iod(analysis.actor.model), analysis.actor.pose, self._mask_only)
+                        puppet = Puppet(
+                            self._actor or analysis.actor,
+                            analysis.deformer.feature_sizes(),
+                            model_iod(analysis.actor.model),
+                            analysis.actor.pose,
+                            self._mask_only,
+                        )
                         m = analysis.last
                     else:
                         m = analysis.update(frame)
-                    yield ((draw_contours(frame, m.contours, m.lost) if m.face else frame), m.pose, m.offsets, m.look,
-                           puppet)
+                    yield (
+                        (draw_contours(frame, m.contours, m.lost) if m.face else frame),
+                        m.pose,
+                        m.offsets,
+                        m.look,
+                        puppet,
+                    )
             if analysis is None:
                 raise InputFileError(f"video {self.source} has no frames")
 
@@ -160,7 +180,7 @@ class Viewer:
         with self._lock:
             self._frames.close()
 
-    def __enter__(self) -> "Viewer":
+    def __enter__(self) -> Viewer:
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -169,8 +189,14 @@ class Viewer:
     def state(self) -> dict:
         """The user motion and whether playback is paused, as a JSON-ready dict."""
         u = self.user
-        return {"yaw": u.yaw, "pitch": u.pitch, "roll": u.roll, "zoom": round(u.zoom, 4),
-                "exaggerate": round(u.gain, 4), "paused": self.paused}
+        return {
+            "yaw": u.yaw,
+            "pitch": u.pitch,
+            "roll": u.roll,
+            "zoom": round(u.zoom, 4),
+            "exaggerate": round(u.gain, 4),
+            "paused": self.paused,
+        }
 
 
 PAGE = """<!doctype html><html lang="en"><head><meta charset="utf-8"><title>facemime view</title>
@@ -238,7 +264,9 @@ class Broadcast:
         try:
             while True:
                 with self._changed:
-                    self._changed.wait_for(lambda: self._played >= want or self._closed or self.error is not None)
+                    self._changed.wait_for(
+                        lambda want=want: self._played >= want or self._closed or self.error is not None
+                    )
                     if self._closed or self._played < want:
                         return
                     oldest = self._played - len(self._recent) + 1
@@ -311,11 +339,11 @@ class ViewerServer(ThreadingHTTPServer):
 
     def process_request(self, request: Any, client_address: Any) -> None:
         if not self._slots.acquire(blocking=False):
-            try:
-                request.sendall(b"HTTP/1.0 503 Service Unavailable\r\nContent-Type: text/plain\r\n"
-                                b"Content-Length: 33\r\nConnection: close\r\n\r\ntoo many clients; try again later")
-            except OSError:
-                pass
+            with suppress(OSError):
+                request.sendall(
+                    b"HTTP/1.0 503 Service Unavailable\r\nContent-Type: text/plain\r\n"
+                    b"Content-Length: 33\r\nConnection: close\r\n\r\ntoo many clients; try again later"
+                )
             self.shutdown_request(request)
             return
         super().process_request(request, client_address)
@@ -366,8 +394,11 @@ def make_server(viewer: Viewer, port: int = 8765, timeout: float = 10.0, max_cli
             if not super().parse_request():
                 return False
             hosts, origin = self.headers.get_all("Host", []), self.headers.get("Origin")
-            if len(hosts) != 1 or not LOOPBACK_HOST.fullmatch(hosts[0]) or (
-                    origin is not None and not LOOPBACK_ORIGIN.fullmatch(origin)):
+            if (
+                len(hosts) != 1
+                or not LOOPBACK_HOST.fullmatch(hosts[0])
+                or (origin is not None and not LOOPBACK_ORIGIN.fullmatch(origin))
+            ):
                 self.send_error(HTTPStatus.FORBIDDEN, "only pages of this machine may use the viewer")
                 return False
             if self.headers.get("Content-Length", "0").strip() != "0" or "Transfer-Encoding" in self.headers:
@@ -386,7 +417,7 @@ def make_server(viewer: Viewer, port: int = 8765, timeout: float = 10.0, max_cli
         def _stopped(self) -> str:
             return broadcast.error or "the viewer has stopped"
 
-        def do_GET(self) -> None:  # noqa: N802 (http.server's name)
+        def do_GET(self) -> None:
             url = urlparse(self.path)
             if url.path == "/":
                 self._send((PAGE % (HELP, keys)).encode(), "text/html; charset=utf-8")
@@ -394,8 +425,7 @@ def make_server(viewer: Viewer, port: int = 8765, timeout: float = 10.0, max_cli
                 with closing(broadcast.frames()) as frames:
                     frame = next(frames, None)
                 if frame is None:
-                    self._send(self._stopped().encode(), "text/plain; charset=utf-8",
-                               HTTPStatus.SERVICE_UNAVAILABLE)
+                    self._send(self._stopped().encode(), "text/plain; charset=utf-8", HTTPStatus.SERVICE_UNAVAILABLE)
                 else:
                     self._send(frame[1], "image/jpeg")
             elif url.path == "/key":
@@ -424,8 +454,9 @@ def make_server(viewer: Viewer, port: int = 8765, timeout: float = 10.0, max_cli
                         self.wfile.write(part % (len(body), b"X-Frame: %d\r\n" % number, body))
                 if broadcast.error is not None:
                     body = jpeg(message_image(f"facemime: {broadcast.error}"))
-                    self.wfile.write(part % (len(body), b"X-Error: %s\r\n" % broadcast.error.encode("ascii", "replace"),
-                                             body))
+                    self.wfile.write(
+                        part % (len(body), b"X-Error: %s\r\n" % broadcast.error.encode("ascii", "replace"), body)
+                    )
                 self.wfile.write(b"--frame--\r\n")
             except (ConnectionError, TimeoutError):  # the client has gone, or is too slow
                 return

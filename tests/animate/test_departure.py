@@ -49,7 +49,7 @@ def test_a_blob_that_is_not_in_the_synthesis_departs_by_its_area(box, luma):
     outline = face_outline()
     x, y, w, h = box
     real = key.copy()
-    real[y:y + h, x:x + w] = luma
+    real[y : y + h, x : x + w] = luma
     share = departure(real, key, outline)
     area = w * h / surround_area(outline)
     assert share == pytest.approx(area, rel=0.15)
@@ -85,7 +85,9 @@ HAND = range(CLEAR, CLEAR + RISE + HOLD)
 
 def skin(frame, landmarks):
     """The face's own skin colour: the median of both cheeks (Face Mesh points 50 and 280)."""
-    patches = [frame[int(y) - 6:int(y) + 6, int(x) - 6:int(x) + 6].reshape(-1, 3) for x, y in landmarks[[50, 280], :2]]
+    patches = [
+        frame[int(y) - 6 : int(y) + 6, int(x) - 6 : int(x) + 6].reshape(-1, 3) for x, y in landmarks[[50, 280], :2]
+    ]
     return tuple(int(v) for v in np.median(np.concatenate(patches), axis=0))
 
 
@@ -133,8 +135,6 @@ def test_only_frames_with_the_hand_are_reported_and_the_ranges_say_which(hand_ru
         else:
             ranges.append([i, i])
     assert departs == ranges
-
-
 
 
 def test_a_hand_passing_in_front_of_the_face_is_reported(hand_run):

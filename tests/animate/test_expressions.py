@@ -98,8 +98,11 @@ def test_solving_offsets_made_from_known_weights_gives_them_back(expressions):
 
 
 def write_track(path, frames, model=None):
-    doc = {"format": "facemime.track/1", "frames": frames,
-           "video": {"width": 512, "height": 512, "fps": 25.0, "frames": len(frames)}}
+    doc = {
+        "format": "facemime.track/1",
+        "frames": frames,
+        "video": {"width": 512, "height": 512, "fps": 25.0, "frames": len(frames)},
+    }
     if model is not None:
         doc["model"] = model
     path.write_text(json.dumps(doc))
@@ -111,12 +114,20 @@ def test_weights_round_trip_through_the_track_file_and_bad_ones_are_refused(tmp_
     d = expressions.deformer
     model = {"unit": "mm", "knots": d.knots.tolist(), "feature_sizes": d.feature_sizes().tolist(), "iod": 90.0}
     named = [{n: float(x) for n, x in zip(NAMES, row) if x > 0} for row in w]
-    frames = [track_entry({"index": i, "contours": {}, "pose": POSE, "offsets": expressions.offsets(w[i]),
-                           "weights": named[i]}) for i in range(3)]
+    frames = [
+        track_entry(
+            {"index": i, "contours": {}, "pose": POSE, "offsets": expressions.offsets(w[i]), "weights": named[i]}
+        )
+        for i in range(3)
+    ]
     _, _, motion = read_motion(write_track(tmp_path / "t.json", frames, model))
     assert np.abs(np.array([m["weights"] for m in motion]) - w).max() <= 5e-5  # 4 decimals
-    for bad, message in (({"jawOpen": 1.5}, "must be a number in \\[0, 1\\]"), ({"smile": 0.2}, "unknown expression"),
-                         ([0.1, 0.2], "must be an object"), ({"jawOpen": "x"}, "must be a number")):
+    for bad, message in (
+        ({"jawOpen": 1.5}, "must be a number in \\[0, 1\\]"),
+        ({"smile": 0.2}, "unknown expression"),
+        ([0.1, 0.2], "must be an object"),
+        ({"jawOpen": "x"}, "must be a number"),
+    ):
         frames[1]["weights"] = bad
         with pytest.raises(ContourFileError, match=message) as e:
             read_motion(write_track(tmp_path / "bad.json", frames, model))
@@ -126,9 +137,11 @@ def test_weights_round_trip_through_the_track_file_and_bad_ones_are_refused(tmp_
 def test_a_performance_written_as_weights_plays_like_its_offsets(tmp_path, expressions):
     w = performance(3)
     w[:, NAMES.index("eyeBlinkLeft")] = [0.0, 0.5, 1.0]
-    authored = [{"index": i, "pose": POSE, "weights": {n: round(float(x), 4) for n, x in zip(NAMES, row) if x > 0}}
-                for i, row in enumerate(w)]
-    video, model, motion = read_motion(write_track(tmp_path / "authored.json", authored))  # no model block
+    authored = [
+        {"index": i, "pose": POSE, "weights": {n: round(float(x), 4) for n, x in zip(NAMES, row) if x > 0}}
+        for i, row in enumerate(w)
+    ]
+    _video, model, motion = read_motion(write_track(tmp_path / "authored.json", authored))  # no model block
     d = expressions.deformer
     assert model["knots"] == d.knots.tolist()
     w4 = np.round(w, 4)
@@ -137,10 +150,18 @@ def test_a_performance_written_as_weights_plays_like_its_offsets(tmp_path, expre
     assert np.allclose([m["look"].closure for m in motion], expressions.closure(w4))
     assert np.allclose(weights_to_motion(w4[1], d.feature_sizes())[0], offsets[1])
     # the same frames as the offsets (and look) written out
-    knots = [{"index": i, "pose": POSE, "offsets": offsets[i].tolist(),
-              "look": {"eye_right_closure": float(w4[i, NAMES.index("eyeBlinkRight")]),
-                       "eye_left_closure": float(w4[i, NAMES.index("eyeBlinkLeft")])}}
-             for i in range(3)]
+    knots = [
+        {
+            "index": i,
+            "pose": POSE,
+            "offsets": offsets[i].tolist(),
+            "look": {
+                "eye_right_closure": float(w4[i, NAMES.index("eyeBlinkRight")]),
+                "eye_left_closure": float(w4[i, NAMES.index("eyeBlinkLeft")]),
+            },
+        }
+        for i in range(3)
+    ]
     model_block = {"unit": "mm", "knots": d.knots.tolist(), "feature_sizes": d.feature_sizes().tolist(), "iod": 90.0}
     _, _, played = read_motion(write_track(tmp_path / "knots.json", knots, model_block))
     actor = generic_actor()

@@ -73,7 +73,15 @@ def test_another_actor_closes_its_eyes_with_the_measured_look(actor):
     open_ = puppet.render(actor.pose, np.zeros((60, 2)), (512, 512), look=Look()).copy()
     shut = puppet.render(actor.pose, np.zeros((60, 2)), (512, 512), look=Look(closure=[1.0, 0.0]))
     boxes = [project(actor.model.vertices[actor.model.groups[e]], actor.pose)[0] for e in EYES]
-    bright = lambda img, pts: (img[int(pts[:, 1].min()):int(pts[:, 1].max()) + 1,  # noqa: E731
-                                   int(pts[:, 0].min()):int(pts[:, 0].max()) + 1].min(axis=2) > 200).sum()
+
+    def bright(img, pts):
+        return (
+            img[
+                int(pts[:, 1].min()) : int(pts[:, 1].max()) + 1,
+                int(pts[:, 0].min()) : int(pts[:, 0].max()) + 1,
+            ].min(axis=2)
+            > 200
+        ).sum()
+
     assert bright(shut, boxes[0]) < 0.1 * bright(open_, boxes[0])
     assert bright(shut, boxes[1]) == pytest.approx(bright(open_, boxes[1]), rel=0.05)

@@ -6,7 +6,9 @@ from facemime.model import generic_head
 from facemime.render.projection import Pose, project
 
 
-@pytest.mark.parametrize("pose", [Pose(scale=2, tx=200, ty=220), Pose(yaw=25, pitch=-10, roll=8, scale=1.5, tx=160, ty=170)])
+@pytest.mark.parametrize(
+    "pose", [Pose(scale=2, tx=200, ty=220), Pose(yaw=25, pitch=-10, roll=8, scale=1.5, tx=160, ty=170)]
+)
 def test_lift_puts_visible_vertices_back_where_they_were(pose):
     head = generic_head()
     pts, depth = project(head.vertices, pose)
@@ -43,8 +45,9 @@ def test_fit_pose_recovers_a_known_pose_from_noisy_points():
     assert abs(pose.roll - 5) < 0.5 and abs(pose.tx - 260) < 1.5
 
 
-@pytest.mark.parametrize(("turn", "zoom", "shift"),
-                         [(0.0, 1.0, (14.0, -9.0)), (-6.0, 1.04, (5.0, 3.0)), (4.0, 0.97, (0.0, 0.0))])
+@pytest.mark.parametrize(
+    ("turn", "zoom", "shift"), [(0.0, 1.0, (14.0, -9.0)), (-6.0, 1.04, (5.0, 3.0)), (4.0, 0.97, (0.0, 0.0))]
+)
 def test_a_pose_moved_by_an_image_step_projects_where_the_step_puts_its_projection(turn, zoom, shift):
     """A frame whose pose the rigid points could not measure moves it by the head's step in the
     image (turn in degrees, y down: clockwise as seen)."""

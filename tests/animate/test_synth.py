@@ -64,8 +64,9 @@ def test_teeth_meet_in_a_grin_and_the_cavity_shows_once_the_mouth_opens_wide():
 
     def middle_column(opening):
         out = np.full((200, 300, 3), 120, np.uint8)
-        draw_mouth_interior(out, np.column_stack([x, 80.0 - 0.4 * opening * arch]),
-                            np.column_stack([x, 80.0 + 0.6 * opening * arch]))
+        draw_mouth_interior(
+            out, np.column_stack([x, 80.0 - 0.4 * opening * arch]), np.column_stack([x, 80.0 + 0.6 * opening * arch])
+        )
         column = out[:, 155].astype(int).mean(axis=1)  # between two gaps of the teeth
         return column[column != 120]
 
@@ -133,7 +134,9 @@ def test_motion_carries_to_a_face_of_other_proportions(actor):
     moved = puppet.vertices(offsets) - puppet.vertices(np.zeros((60, 2)))  # lips kept apart: both sealed alike
     assert np.allclose(moved[:40, 1], -4.0 * 1.3, atol=0.01)
     # The driven face keeps the measured face's size on screen.
-    assert puppet.pose(actor.pose).scale * model_iod(other.model) == pytest.approx(actor.pose.scale * model_iod(actor.model))
+    assert puppet.pose(actor.pose).scale * model_iod(other.model) == pytest.approx(
+        actor.pose.scale * model_iod(actor.model)
+    )
     with pytest.raises(InvalidInputError, match="knots"):
         Puppet(other, np.ones(12), 90.0)
 
@@ -166,8 +169,13 @@ def test_another_actor_plays_in_its_own_picture_moved_as_the_source_moves(actor,
     tall = np.zeros((768, 512, 3), np.uint8)
     tall[128:640] = frame
     moved_points = {k: np.asarray(v) + [0.0, 128.0] for k, v in points.items()}
-    target = smear_texture(actor.model, tall, fit_model(actor.model, moved_points), moved_points,
-                           {"file": "tall.png", "frame": 0, "width": 512, "height": 768})
+    target = smear_texture(
+        actor.model,
+        tall,
+        fit_model(actor.model, moved_points),
+        moved_points,
+        {"file": "tall.png", "frame": 0, "width": 512, "height": 768},
+    )
     sizes = Puppet(actor, np.ones(60), 1.0).deformer.feature_sizes()
     puppet = Puppet(target, sizes, model_iod(actor.model), actor.pose)
     rest = puppet.pose(actor.pose)  # the source at its key pose: the target at its own

@@ -28,7 +28,7 @@ def broken(shared, tmp_path_factory) -> dict[str, Path]:
     (ten flat grey frames)."""
     folder = tmp_path_factory.mktemp("broken")
     data = (shared / "video" / "lp_d12.mp4").read_bytes()
-    (folder / "truncated.mp4").write_bytes(data[:len(data) // 3])
+    (folder / "truncated.mp4").write_bytes(data[: len(data) // 3])
     (folder / "random.mp4").write_bytes(np.random.default_rng(0).bytes(50_000))
     with VideoWriter(folder / "noface.mp4", 25) as w:
         for _ in range(10):
@@ -40,8 +40,10 @@ def broken(shared, tmp_path_factory) -> dict[str, Path]:
 def clips(shared, tmp_path_factory) -> list[Path]:
     """Four short clips (30-45 frames) of four shared videos."""
     folder = tmp_path_factory.mktemp("clips")
-    return [cut(shared / "video" / f"{name}.mp4", n, folder / f"{name}.mp4")
-            for name, n in (("lp_d0", 30), ("vr_2", 35), ("st_aoc", 40), ("lp_d12", 45))]
+    return [
+        cut(shared / "video" / f"{name}.mp4", n, folder / f"{name}.mp4")
+        for name, n in (("lp_d0", 30), ("vr_2", 35), ("st_aoc", 40), ("lp_d12", 45))
+    ]
 
 
 @pytest.fixture(scope="module")
@@ -49,6 +51,7 @@ def scheduler() -> str:
     """The address of a local cluster of two worker processes, one thread each."""
     from distributed import LocalCluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
-                      silence_logs=logging.ERROR) as cluster:
+    with LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
+    ) as cluster:
         yield cluster.scheduler_address

@@ -47,16 +47,20 @@ def test_unreadable_folder(tmp_path, capsys, monkeypatch):
     assert err == f"facemime: error: cannot read folder {folder}: Permission denied"
 
 
-@pytest.mark.parametrize(("address", "message"), [
-    ("localhost:8786", "the scheduler address must look like tcp://HOST:PORT, got 'localhost:8786'"),
-    ("tcp://127.0.0.1:99999", "the scheduler address must look like tcp://HOST:PORT, got 'tcp://127.0.0.1:99999'"),
-    ("tcp://127.0.0.1:9", "cannot reach the Dask scheduler at tcp://127.0.0.1:9: "),
-])
+@pytest.mark.parametrize(
+    ("address", "message"),
+    [
+        ("localhost:8786", "the scheduler address must look like tcp://HOST:PORT, got 'localhost:8786'"),
+        ("tcp://127.0.0.1:99999", "the scheduler address must look like tcp://HOST:PORT, got 'tcp://127.0.0.1:99999'"),
+        ("tcp://127.0.0.1:9", "cannot reach the Dask scheduler at tcp://127.0.0.1:9: "),
+    ],
+)
 def test_bad_scheduler_address(tmp_path, capsys, clips, address, message):
     (tmp_path / "in").mkdir()
     os.symlink(clips[0], tmp_path / "in" / "a.mp4")
-    err = one_error(*run(capsys, "batch", str(tmp_path / "in"), "--out", str(tmp_path / "out"),
-                         "--scheduler", address)[::2])
+    err = one_error(
+        *run(capsys, "batch", str(tmp_path / "in"), "--out", str(tmp_path / "out"), "--scheduler", address)[::2]
+    )
     assert err.startswith(f"facemime: error: {message}")
 
 
@@ -88,7 +92,7 @@ def test_a_batch_killed_halfway_then_rerun_redoes_only_the_unfinished(tmp_path, 
     assert rerun.returncode == 0, rerun.stderr
     assert rerun.stdout == f"{out / 'manifest.jsonl'}\n"
     assert f"{len(clips) - len(first)} done, {len(first)} complete from before, 0 failed" in rerun.stderr
-    second = manifest(out)[len(first):]
+    second = manifest(out)[len(first) :]
     assert sorted(r["video"] for r in second) == sorted(c.stem for c in clips if c.stem not in finished)
     assert all(r["status"] == "done" for r in second)
     assert {v: (out / f"{v}.json").stat().st_mtime_ns for v in finished} == finished

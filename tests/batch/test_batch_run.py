@@ -26,8 +26,13 @@ def lines(out: Path) -> list[dict]:
 def test_ten_videos_done_and_three_broken_ones_failed(tmp_path, shared, broken, scheduler):
     videos = sorted((shared / "video").glob("*.mp4"))
     listing = tmp_path / "videos.txt"
-    listing.write_text("# the shared videos and three broken files\n" + "\n".join(map(str, videos))
-                       + "\n\n" + "\n".join(str(broken[n]) for n in ("truncated", "random", "noface")) + "\n")
+    listing.write_text(
+        "# the shared videos and three broken files\n"
+        + "\n".join(map(str, videos))
+        + "\n\n"
+        + "\n".join(str(broken[n]) for n in ("truncated", "random", "noface"))
+        + "\n"
+    )
     out = tmp_path / "out"
     result = run_batch(listing, out, scheduler=scheduler)
     assert (result.total, result.done, result.skipped, len(result.failed), result.timed_out) == (13, 10, 0, 3, [])
@@ -47,10 +52,12 @@ def test_ten_videos_done_and_three_broken_ones_failed(tmp_path, shared, broken, 
         assert r["source"] == {"bytes": v.stat().st_size, "mtime_ns": v.stat().st_mtime_ns}
     assert result.frames == sum(records[v.stem]["frames"] for v in videos)
     errors = {n: records[n]["error"] for n in ("truncated", "random", "noface")}
-    assert errors == {"truncated": f"cannot read video {broken['truncated']}: Invalid data found when processing input",
-                      "random": f"cannot read video {broken['random']}: Invalid data found when processing input",
-                      "noface": f"no face found in any of the 10 frames of {broken['noface']}; "
-                                "pass the contours with --init INIT.json"}
+    assert errors == {
+        "truncated": f"cannot read video {broken['truncated']}: Invalid data found when processing input",
+        "random": f"cannot read video {broken['random']}: Invalid data found when processing input",
+        "noface": f"no face found in any of the 10 frames of {broken['noface']}; "
+        "pass the contours with --init INIT.json",
+    }
     assert all(records[n]["status"] == "failed" and records[n]["frames"] is None for n in errors)
     assert sorted(p.name for p in out.iterdir()) == sorted([f"{v.stem}.json" for v in videos] + ["manifest.jsonl"])
 
@@ -65,8 +72,14 @@ def test_a_task_past_its_time_limit_is_stopped(tmp_path, clips, scheduler):
     (tmp_path / "in").mkdir()
     os.symlink(clips[0], tmp_path / "in" / "a.mp4")
     t0 = time.perf_counter()
-    result = run_batch(tmp_path / "in", tmp_path / "out", scheduler=scheduler, timeout_per_frame=0.01,
-                       start_seconds=0.5, task=slow_task)
+    result = run_batch(
+        tmp_path / "in",
+        tmp_path / "out",
+        scheduler=scheduler,
+        timeout_per_frame=0.01,
+        start_seconds=0.5,
+        task=slow_task,
+    )
     assert time.perf_counter() - t0 < 15
     [r] = lines(tmp_path / "out")
     assert [r["video"] for r in result.timed_out] == ["a"] and r["status"] == "timed out" and r["frames"] is None
@@ -118,14 +131,17 @@ def test_a_rerun_redoes_only_what_is_missing_or_broken(tmp_path, clips, schedule
     stamps = {p.name: p.stat().st_mtime_ns for p in out.glob("*.json")}
     # One result cut short (as by a full disk), one gone; a new video added.
     text = (out / "vr_2.json").read_text()
-    (out / "vr_2.json").write_text(text[:len(text) // 2])
+    (out / "vr_2.json").write_text(text[: len(text) // 2])
     (out / "st_aoc.json").unlink()
     os.symlink(clips[3], inp / clips[3].name)
     second = run_batch(inp, out, scheduler=scheduler)
     assert (second.done, second.skipped, second.failed) == (3, 1, [])
     assert (out / "lp_d0.json").stat().st_mtime_ns == stamps["lp_d0.json"]
-    assert [r["video"] for r in lines(out)][3:] != [] and sorted(r["video"] for r in lines(out)[3:]) == \
-        ["lp_d12", "st_aoc", "vr_2"]
+    assert [r["video"] for r in lines(out)][3:] != [] and sorted(r["video"] for r in lines(out)[3:]) == [
+        "lp_d12",
+        "st_aoc",
+        "vr_2",
+    ]
     assert all(r["status"] == "done" for r in Manifest(out).read().values())
     # A third run has nothing to do.
     third = run_batch(inp, out, scheduler=scheduler)

@@ -3,6 +3,7 @@ client gets (hello, header, actor, frames and packets), intra requests, bad clie
 without stopping the sender, the page's host checks, the recording, and one-line errors."""
 
 import http.client
+import itertools
 import json
 import re
 import signal
@@ -17,12 +18,11 @@ import pytest
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
+from cli.test_cli import run
 from facemime.call import Call
 from facemime.call.sender import FileSource, Sender
 from facemime.call.server import MAX_MESSAGE
 from facemime.codec.stream import MotionDecoder
-
-from cli.test_cli import run
 
 HEADER, ACTOR, INTRA, INTER = 1, 2, 3, 4
 PAGE = b"<!doctype html><title>stand-in</title>"
@@ -100,9 +100,16 @@ def test_the_page_and_script_are_served_and_nothing_else(live):
     assert get(live, "/index.html")[0] == 404 and get(live, "/../x")[0] == 404
 
 
-@pytest.mark.parametrize("headers", [{"Host": "evil.example"}, {"Host": "evil.example:{port}"},
-                                     {"Host": "127.0.0.1:1"}, {"Origin": "http://evil.example"},
-                                     {"Origin": "http://127.0.0.1:1"}])
+@pytest.mark.parametrize(
+    "headers",
+    [
+        {"Host": "evil.example"},
+        {"Host": "evil.example:{port}"},
+        {"Host": "127.0.0.1:1"},
+        {"Origin": "http://evil.example"},
+        {"Origin": "http://127.0.0.1:1"},
+    ],
+)
 def test_requests_not_addressed_to_this_machine_are_forbidden(live, headers):
     headers = {k: v.format(port=live.port) for k, v in headers.items()}
     assert get(live, "/", headers)[0] == 403
@@ -127,7 +134,7 @@ def test_a_client_gets_hello_header_actor_then_frames_and_packets_that_decode(li
     assert all(t["type"] == "frames" and len(t["arrived"]) == 2 for t in texts)
     assert firsts == list(range(firsts[0], firsts[0] + 24, 2))  # P = 2; no packet skipped
     arrived = [a for t in texts for a in t["arrived"]]
-    gaps = [b - a for a, b in zip(arrived, arrived[1:])]
+    gaps = [b - a for a, b in itertools.pairwise(arrived)]
     assert 30 < sum(gaps) / len(gaps) < 50  # the video's pace: 40 ms a frame
     assert abs(arrived[-1] - time.time() * 1000) < 1000  # ms since the epoch, this machine's clock
     decoder = MotionDecoder(from_start=False)
@@ -151,8 +158,16 @@ def test_an_intra_request_makes_the_next_packet_intra_once(live):
     assert live.sender.stats.intra_asked == asked + 2 and live.sender.stats.intra_honoured == honoured + 1
 
 
-@pytest.mark.parametrize(("message", "code"), [(b"\x01\x02", 1003), ("not json", 1003), ('{"type": "pause"}', 1003),
-                                               ('["intra"]', 1003), ("x" * (MAX_MESSAGE + 1), 1009)])
+@pytest.mark.parametrize(
+    ("message", "code"),
+    [
+        (b"\x01\x02", 1003),
+        ("not json", 1003),
+        ('{"type": "pause"}', 1003),
+        ('["intra"]', 1003),
+        ("x" * (MAX_MESSAGE + 1), 1009),
+    ],
+)
 def test_a_bad_message_closes_that_client_and_the_others_go_on(live, message, code):
     with client(live) as watcher, client(live) as bad:
         until_packets(bad, 1)
@@ -167,8 +182,10 @@ def test_a_bad_message_closes_that_client_and_the_others_go_on(live, message, co
 def raw_stream(port: int) -> socket.socket:
     """A stream connection by hand: the handshake, then the first bytes read."""
     s = socket.create_connection(("127.0.0.1", port), timeout=5)
-    s.sendall(b"GET /stream HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
-              b"Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n" % port)
+    s.sendall(
+        b"GET /stream HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+        b"Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n" % port
+    )
     assert s.recv(4096).startswith(b"HTTP/1.1 101")
     return s
 
@@ -200,8 +217,12 @@ def test_a_client_that_comes_back_gets_header_and_actor_again(live):
 
 
 def start_call(*args):
-    proc = subprocess.Popen([sys.executable, "-m", "facemime", "call", "--port", "0", "--no-browser", *map(str, args)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "facemime", "call", "--port", "0", "--no-browser", *map(str, args)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     url = proc.stdout.readline().strip()
     match = re.fullmatch(r"http://127\.0\.0\.1:(\d+)/", url)
     if match is None:
@@ -242,8 +263,10 @@ def test_a_call_streams_a_video_to_its_end_and_records_what_it_sent(video, tmp_p
     assert code == 1 and err.count("\n") == 1 and "--force" in err
 
 
-@pytest.mark.parametrize(("sig", "code", "line"), [(signal.SIGINT, 130, "facemime: interrupted"),
-                                                   (signal.SIGTERM, 143, "facemime: terminated")])
+@pytest.mark.parametrize(
+    ("sig", "code", "line"),
+    [(signal.SIGINT, 130, "facemime: interrupted"), (signal.SIGTERM, 143, "facemime: terminated")],
+)
 def test_a_call_stops_cleanly_on_a_signal(video, sig, code, line):
     proc, port = start_call(video, "--loop")
     try:
@@ -264,18 +287,25 @@ def test_a_call_stops_cleanly_on_a_signal(video, sig, code, line):
 
 
 def run_cli(*args):
-    proc = subprocess.run([sys.executable, "-m", "facemime", "call", "--port", "0", "--no-browser", *map(str, args)],
-                          capture_output=True, text=True, timeout=30)
+    proc = subprocess.run(
+        [sys.executable, "-m", "facemime", "call", "--port", "0", "--no-browser", *map(str, args)],
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
     return proc.returncode, proc.stdout, proc.stderr
 
 
-@pytest.mark.parametrize(("args", "message"), [
-    (["missing.mp4"], "video missing.mp4 does not exist"),
-    (["NOTVIDEO"], "cannot read video NOTVIDEO"),
-    (["{video}", "--actor", "BAD"], "BAD"),
-    (["{video}", "--actor", "missing.actor"], "actor file missing.actor does not exist"),
-    (["{video}", "--record", "out.mp4"], "must end in .fmstream"),
-])
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["missing.mp4"], "video missing.mp4 does not exist"),
+        (["NOTVIDEO"], "cannot read video NOTVIDEO"),
+        (["{video}", "--actor", "BAD"], "BAD"),
+        (["{video}", "--actor", "missing.actor"], "actor file missing.actor does not exist"),
+        (["{video}", "--record", "out.mp4"], "must end in .fmstream"),
+    ],
+)
 def test_bad_input_gives_one_line(video, tmp_path, capsys, monkeypatch, args, message):
     monkeypatch.chdir(tmp_path)
     (tmp_path / "NOTVIDEO").write_text("hello")

@@ -48,7 +48,7 @@ def test_demo_fits_animates_tracks_back_and_resynthesises(tmp_path, capsys):
     stills = cv2.imread(str(tmp_path / "d" / "stills.png"))
     assert stills.shape == (1024, 768, 3)
     for col in range(3):  # each panel of each still shows a face, not the empty backdrop
-        panel = stills[:256, 256 * col:256 * (col + 1)].astype(int)
+        panel = stills[:256, 256 * col : 256 * (col + 1)].astype(int)
         assert (np.abs(panel - panel[5, 5]).sum(axis=2) > 60).mean() > 0.1
     # A second run refuses to overwrite, in one line, and changes nothing.
     before = (tmp_path / "d" / "resynthesis.mp4").stat().st_mtime_ns

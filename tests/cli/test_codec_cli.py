@@ -7,11 +7,10 @@ import cv2
 import numpy as np
 import pytest
 
+from codec.reference_decoder import chunks
 from facemime.animate.synth import BACKGROUND
 from facemime.io.actor_file import save_actor
 from facemime.io.video import VideoReader
-
-from codec.reference_decoder import chunks
 
 from .test_cli import first_frames, run
 
@@ -44,7 +43,7 @@ def test_encode_then_decode_gives_the_synthesised_picture_at_the_videos_size(str
     assert len(frames) == FRAMES and frames[0].shape == (512, 512, 3)
     real = list(VideoReader(clip))[25]
     mse = np.mean((frames[25].astype(float) - real) ** 2)
-    assert 10 * np.log10(255 ** 2 / mse) > 24  # the face in its scene: the whole picture resembles the video's
+    assert 10 * np.log10(255**2 / mse) > 24  # the face in its scene: the whole picture resembles the video's
 
 
 def test_decode_mask_only_shows_the_face_alone_mid_picture(stream, tmp_path, capsys):
@@ -59,8 +58,9 @@ def test_decode_mask_only_shows_the_face_alone_mid_picture(stream, tmp_path, cap
 def test_encode_reports_the_motions_rate_and_the_actors_bytes(clip, tmp_path, capsys):
     code, _, err = run(capsys, "encode", str(clip), "--rate", "1", "--out", str(tmp_path / "s.fmstream"))
     assert code == 0, err
-    m = re.search(r"motion ([\d.]+) kbit/s .* header (\d+) bytes, the actor (\d+) bytes once, its scene (\d+) of them",
-                  err)
+    m = re.search(
+        r"motion ([\d.]+) kbit/s .* header (\d+) bytes, the actor (\d+) bytes once, its scene (\d+) of them", err
+    )
     assert m and float(m[1]) <= 1.0 and int(m[3]) > int(m[4]) > 5000
 
 
@@ -77,8 +77,9 @@ def test_a_stream_naming_its_actor_decodes_only_with_that_actor(clip, shared, tm
         code, out, err = run(capsys, "decode", str(tmp_path / "s.fmstream"), *args, "--out", str(tmp_path / "x.mp4"))
         assert code == 1 and out == "" and err.count("\n") == 1 and message in err, err
         assert not (tmp_path / "x.mp4").exists()
-    code, _, err = run(capsys, "decode", str(tmp_path / "s.fmstream"), "--actor", str(own),
-                       "--out", str(tmp_path / "x.mp4"))
+    code, _, err = run(
+        capsys, "decode", str(tmp_path / "s.fmstream"), "--actor", str(own), "--out", str(tmp_path / "x.mp4")
+    )
     assert code == 0, err
 
 
@@ -115,7 +116,9 @@ def test_bad_streams_and_outputs_give_one_line(stream, tmp_path, capsys):
 
 
 def test_quality_and_rate_are_one_or_the_other(clip, tmp_path, capsys):
-    code, out, err = run(capsys, "encode", str(clip), "--quality", "3", "--rate", "1", "--out", str(tmp_path / "s.fmstream"))
+    code, _out, err = run(
+        capsys, "encode", str(clip), "--quality", "3", "--rate", "1", "--out", str(tmp_path / "s.fmstream")
+    )
     assert code == 1 and "not both" in err and not (tmp_path / "s.fmstream").exists()
 
 

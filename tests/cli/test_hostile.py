@@ -57,21 +57,63 @@ def test_no_output_may_replace_an_input(files, tmp_path, capsys):
     before = {p: p.read_bytes() for p in (video, init, actor)}
     cases = [
         (["track", str(video), "--init", str(init), "--out", str(video), "--force"], "must end in .json"),
-        (["track", str(video), "--init", str(init), "--out", str(tmp_path / "t.json"), "--overlay", str(video),
-          "--force"], "would replace the input"),
-        (["track", str(video), "--init", str(init), "--out", str(tmp_path / "link.json"), "--force"],
-         "would replace the input"),
-        (["track", str(video), "--out", str(tmp_path / "t.mp4"), "--overlay", str(tmp_path / "t.mp4")],
-         "must end in .json"),
+        (
+            [
+                "track",
+                str(video),
+                "--init",
+                str(init),
+                "--out",
+                str(tmp_path / "t.json"),
+                "--overlay",
+                str(video),
+                "--force",
+            ],
+            "would replace the input",
+        ),
+        (
+            ["track", str(video), "--init", str(init), "--out", str(tmp_path / "link.json"), "--force"],
+            "would replace the input",
+        ),
+        (
+            ["track", str(video), "--out", str(tmp_path / "t.mp4"), "--overlay", str(tmp_path / "t.mp4")],
+            "must end in .json",
+        ),
         (["run", str(video), "--out", str(video), "--force"], "would replace the input"),
         (["run", str(video), "--out", str(tmp_path / "link.mp4"), "--force"], "would replace the input"),
-        (["run", str(video), "--actor", str(actor), "--out", str(tmp_path / "o.mp4"), "--track", str(actor),
-          "--force"], "must end in .json"),
-        (["run", str(video), "--actor", str(actor), "--out", str(tmp_path / "o.mp4"), "--track",
-          str(tmp_path / "o.json"), "--force"], ""),  # allowed: distinct files (the face is synthetic: an error)
+        (
+            [
+                "run",
+                str(video),
+                "--actor",
+                str(actor),
+                "--out",
+                str(tmp_path / "o.mp4"),
+                "--track",
+                str(actor),
+                "--force",
+            ],
+            "must end in .json",
+        ),
+        (
+            [
+                "run",
+                str(video),
+                "--actor",
+                str(actor),
+                "--out",
+                str(tmp_path / "o.mp4"),
+                "--track",
+                str(tmp_path / "o.json"),
+                "--force",
+            ],
+            "",
+        ),  # allowed: distinct files (the face is synthetic: an error)
         (["encode", str(video), "--out", str(tmp_path / "link.mp4"), "--force"], "must end in .fmstream"),
-        (["fit", str(video), "--out", str(tmp_path / "p.actor"), "--points", str(tmp_path / "p.actor"), "--force"],
-         "would replace the input"),
+        (
+            ["fit", str(video), "--out", str(tmp_path / "p.actor"), "--points", str(tmp_path / "p.actor"), "--force"],
+            "would replace the input",
+        ),
         (["model-preview", str(init), "--out", str(tmp_path / "link.json"), "--force"], "cannot write image"),
     ]
     for args, message in cases:
@@ -115,8 +157,12 @@ def bomb_actor(path, inflated=256 << 20):
     data = b"".join(deflate.compress(bytes(1 << 22)) for _ in range(inflated >> 22)) + deflate.flush()
     name = b"actor.json"
     local = struct.pack("<IHHHHHIIIHH", 0x04034B50, 20, 0, 8, 0, 0, 0, len(data), 1000, len(name), 0) + name
-    central = struct.pack("<IHHHHHHIIIHHHHHII", 0x02014B50, 20, 20, 0, 8, 0, 0, 0, len(data), 1000, len(name),
-                          0, 0, 0, 0, 0, 0) + name
+    central = (
+        struct.pack(
+            "<IHHHHHHIIIHHHHHII", 0x02014B50, 20, 20, 0, 8, 0, 0, 0, len(data), 1000, len(name), 0, 0, 0, 0, 0, 0
+        )
+        + name
+    )
     end = struct.pack("<IHHHHIIH", 0x06054B50, 0, 0, 1, 1, len(central), len(local) + len(data), 0)
     path.write_bytes(local + data + central + end)
 
@@ -124,8 +170,9 @@ def bomb_actor(path, inflated=256 << 20):
 def huge_png(path, side=30000):
     ihdr = struct.pack(">IIBBBBB", side, side, 8, 2, 0, 0, 0)
     chunk = b"IHDR" + ihdr
-    path.write_bytes(b"\x89PNG\r\n\x1a\n" + struct.pack(">I", 13) + chunk + struct.pack(">I", zlib.crc32(chunk))
-                     + b"\x00" * 100)
+    path.write_bytes(
+        b"\x89PNG\r\n\x1a\n" + struct.pack(">I", 13) + chunk + struct.pack(">I", zlib.crc32(chunk)) + b"\x00" * 100
+    )
 
 
 def test_deep_huge_and_damaged_inputs_give_one_line(files, tmp_path, capsys, monkeypatch):
@@ -137,13 +184,19 @@ def test_deep_huge_and_damaged_inputs_give_one_line(files, tmp_path, capsys, mon
     video, out = files / "face.mp4", tmp_path / "out"
     out.mkdir()
     cases = [
-        (["track", str(video), "--init", str(tmp_path / "deep.json"), "--out", str(out / "t.json")],
-         "nested too deeply"),
-        (["fit", str(files / "face.mp4"), "--points", str(tmp_path / "deep.json"), "--out", str(out / "a.actor")],
-         "nested too deeply"),
+        (
+            ["track", str(video), "--init", str(tmp_path / "deep.json"), "--out", str(out / "t.json")],
+            "nested too deeply",
+        ),
+        (
+            ["fit", str(files / "face.mp4"), "--points", str(tmp_path / "deep.json"), "--out", str(out / "a.actor")],
+            "nested too deeply",
+        ),
         (["model-preview", str(tmp_path / "deep.json"), "--out", str(out / "m.png")], ""),
-        (["run", str(video), "--actor", str(tmp_path / "deep.actor"), "--out", str(out / "o.mp4")],
-         "nested too deeply"),
+        (
+            ["run", str(video), "--actor", str(tmp_path / "deep.actor"), "--out", str(out / "o.mp4")],
+            "nested too deeply",
+        ),
         (["run", str(video), "--actor", str(tmp_path / "crc.actor"), "--out", str(out / "o.mp4")], "crc.actor"),
         (["run", str(video), "--actor", str(tmp_path / "bomb.actor"), "--out", str(out / "o.mp4")], "Bad CRC"),
         (["fit", str(tmp_path / "huge.png"), "--out", str(out / "h.actor")], "30000x30000 pixels, more than"),
@@ -154,8 +207,10 @@ def test_deep_huge_and_damaged_inputs_give_one_line(files, tmp_path, capsys, mon
         assert time.perf_counter() - t0 < 30, args  # refused, not worked through
         assert listing(out) == [], args
     monkeypatch.setenv("FACEMIME_MAX_JSON_BYTES", "100")
-    one_line_error(*run(capsys, "track", str(video), "--init", str(files / "init.json"), "--out", str(out / "t.json")),
-                   "more than the 100 allowed (set FACEMIME_MAX_JSON_BYTES")
+    one_line_error(
+        *run(capsys, "track", str(video), "--init", str(files / "init.json"), "--out", str(out / "t.json")),
+        "more than the 100 allowed (set FACEMIME_MAX_JSON_BYTES",
+    )
     assert listing(out) == []
 
 
@@ -163,10 +218,29 @@ def test_deep_huge_and_damaged_inputs_give_one_line(files, tmp_path, capsys, mon
 @given(st.data())
 def test_mutated_init_files_never_escape_as_a_traceback(files, tmp_path, capsys, data):
     doc = json.loads((files / "init.json").read_text())
-    path = data.draw(st.sampled_from([["frame"], ["contours"], ["contours", "mouth_outer_upper"],
-                                      ["contours", "mouth_outer_upper", 0], ["format"], []]))
-    value = data.draw(st.one_of(st.none(), st.booleans(), st.integers(-10**12, 10**12), st.floats(allow_nan=True),
-                                st.text(max_size=5), st.lists(st.floats(), max_size=3), st.just({})))
+    path = data.draw(
+        st.sampled_from(
+            [
+                ["frame"],
+                ["contours"],
+                ["contours", "mouth_outer_upper"],
+                ["contours", "mouth_outer_upper", 0],
+                ["format"],
+                [],
+            ]
+        )
+    )
+    value = data.draw(
+        st.one_of(
+            st.none(),
+            st.booleans(),
+            st.integers(-(10**12), 10**12),
+            st.floats(allow_nan=True),
+            st.text(max_size=5),
+            st.lists(st.floats(), max_size=3),
+            st.just({}),
+        )
+    )
     target = doc
     for key in path[:-1]:
         target = target[key]
@@ -193,7 +267,7 @@ def test_mutated_actor_files_never_escape_as_a_traceback(files, tmp_path, capsys
     bad = tmp_path / "bad.actor"
     bad.write_bytes(bytes(data))
     out = tmp_path / "o.mp4"
-    code, stdout, err = run(capsys, "run", str(files / "face.mp4"), "--actor", str(bad), "--out", str(out))
+    code, _stdout, err = run(capsys, "run", str(files / "face.mp4"), "--actor", str(bad), "--out", str(out))
     assert code == 1 and "Traceback" not in err and "unexpected" not in err and not out.exists(), err
 
 
@@ -243,8 +317,18 @@ def mutate(doc, data):
             paths.append(path + [key])
             stack.append((path + [key], child))
     path = data.draw(st.sampled_from(paths))
-    value = data.draw(st.one_of(st.none(), st.booleans(), st.integers(-10**12, 10**12), st.floats(allow_nan=True),
-                                st.text(max_size=5), st.lists(st.floats(), max_size=3), st.just({}), st.just([[]])))
+    value = data.draw(
+        st.one_of(
+            st.none(),
+            st.booleans(),
+            st.integers(-(10**12), 10**12),
+            st.floats(allow_nan=True),
+            st.text(max_size=5),
+            st.lists(st.floats(), max_size=3),
+            st.just({}),
+            st.just([[]]),
+        )
+    )
     if not path:
         return value
     target = doc
@@ -264,7 +348,7 @@ def test_mutated_points_and_head_models_never_escape_as_a_traceback(tmp_path, ca
     head.write_text(json.dumps(mutate(head_document(generic_head()), data)))
     out = tmp_path / "h.png"
     out.unlink(missing_ok=True)
-    code, stdout, err = run(capsys, "model-preview", str(head), "--out", str(out))
+    code, _stdout, err = run(capsys, "model-preview", str(head), "--out", str(out))
     assert code in (0, 1) and "Traceback" not in err and "unexpected" not in err, err
     assert code == 0 or not out.exists()
 
@@ -287,10 +371,12 @@ def bad_videos(tmp_path_factory, files):
 @pytest.mark.parametrize("name", ["missing.mp4", "empty.mp4", "random.mp4", "text.mp4", "header.mp4", "blank.mp4"])
 def test_bad_videos_give_one_line_to_every_command(bad_videos, tmp_path, capsys, name):
     video = str(bad_videos / name)
-    for args in (["track", video, "--out", str(tmp_path / "t.json"), "--overlay", str(tmp_path / "o.mp4")],
-                 ["run", video, "--out", str(tmp_path / "o.mp4")],
-                 ["encode", video, "--out", str(tmp_path / "s.fmstream")],
-                 ["fit", video, "--out", str(tmp_path / "a.actor")]):
+    for args in (
+        ["track", video, "--out", str(tmp_path / "t.json"), "--overlay", str(tmp_path / "o.mp4")],
+        ["run", video, "--out", str(tmp_path / "o.mp4")],
+        ["encode", video, "--out", str(tmp_path / "s.fmstream")],
+        ["fit", video, "--out", str(tmp_path / "a.actor")],
+    ):
         one_line_error(*run(capsys, *args))
         assert listing(tmp_path) == [], args
 
@@ -304,8 +390,11 @@ def test_a_full_disk_gives_one_line_and_leaves_nothing(shared, tmp_path, command
         resource.setrlimit(resource.RLIMIT_FSIZE, (150_000, 150_000))
 
     args = [sys.executable, "-m", "facemime", command, str(shared / "video" / "lp_d3.mp4")]
-    args += ["--out", str(tmp_path / "o.mp4")] if command == "run" else ["--out", str(tmp_path / "t.json"), "--overlay",
-                                                                          str(tmp_path / "o.mp4")]
+    args += (
+        ["--out", str(tmp_path / "o.mp4")]
+        if command == "run"
+        else ["--out", str(tmp_path / "t.json"), "--overlay", str(tmp_path / "o.mp4")]
+    )
     proc = subprocess.run(args, preexec_fn=small_files, capture_output=True, text=True, timeout=300)
     one_line_error(proc.returncode, proc.stdout, proc.stderr, "cannot write")
     outputs = ("o.mp4", "o.json") if command == "run" else ("t.json", "o.mp4")
@@ -318,6 +407,16 @@ def test_numbers_too_large_for_a_float_give_one_line(files, tmp_path, capsys):
     doc = json.loads((files / "init.json").read_text())
     text = json.dumps(doc).replace(str(doc["contours"]["mouth_outer_upper"][0][0]), huge, 1)
     (tmp_path / "init.json").write_text(text)
-    one_line_error(*run(capsys, "track", str(files / "face.mp4"), "--init", str(tmp_path / "init.json"),
-                        "--out", str(tmp_path / "t.json")), "mouth_outer_upper")
+    one_line_error(
+        *run(
+            capsys,
+            "track",
+            str(files / "face.mp4"),
+            "--init",
+            str(tmp_path / "init.json"),
+            "--out",
+            str(tmp_path / "t.json"),
+        ),
+        "mouth_outer_upper",
+    )
     assert listing(tmp_path) == ["init.json"]

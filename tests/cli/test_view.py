@@ -98,8 +98,9 @@ def test_a_track_without_motion_is_refused(tmp_path):
         Viewer(tmp_path / "t.json")
 
 
-@pytest.mark.parametrize(("args", "message"), [(["missing.mp4"], "missing.mp4 does not exist"),
-                                               (["BAD"], "not valid JSON")])
+@pytest.mark.parametrize(
+    ("args", "message"), [(["missing.mp4"], "missing.mp4 does not exist"), (["BAD"], "not valid JSON")]
+)
 def test_view_bad_input_gives_one_line(tmp_path, capsys, monkeypatch, args, message):
     monkeypatch.chdir(tmp_path)
     (tmp_path / "bad.json").write_text("{")
@@ -108,6 +109,7 @@ def test_view_bad_input_gives_one_line(tmp_path, capsys, monkeypatch, args, mess
 
 
 # Hostile input and hard stops (issue 54).
+
 
 @pytest.fixture
 def serve(recorded):
@@ -167,12 +169,24 @@ def test_a_port_outside_0_to_65535_is_one_clear_error(recorded, capsys):
     assert code == 1 and err.startswith("facemime: error: port must be") and err.count("\n") == 1, err
 
 
-@pytest.mark.parametrize(("block", "field", "value"), [
-    ("video", None, [1, 2]), ("video", "width", "wide"), ("video", "width", 0), ("video", "height", -4),
-    ("video", "width", 100000), ("video", "width", 512.5), ("video", "fps", 0), ("video", "fps", "fast"),
-    ("video", "fps", 1e300), ("model", "iod", "abc"), ("model", "iod", -1), ("model", "iod", True),
-    ("model", "feature_sizes", ["a"]),
-])
+@pytest.mark.parametrize(
+    ("block", "field", "value"),
+    [
+        ("video", None, [1, 2]),
+        ("video", "width", "wide"),
+        ("video", "width", 0),
+        ("video", "height", -4),
+        ("video", "width", 100000),
+        ("video", "width", 512.5),
+        ("video", "fps", 0),
+        ("video", "fps", "fast"),
+        ("video", "fps", 1e300),
+        ("model", "iod", "abc"),
+        ("model", "iod", -1),
+        ("model", "iod", True),
+        ("model", "feature_sizes", ["a"]),
+    ],
+)
 def test_a_track_with_wrong_fields_gives_one_line(recorded, tmp_path, capsys, monkeypatch, block, field, value):
     def serving(*args, **kwargs):
         raise AssertionError("the track was taken")  # refused at start, not served
@@ -190,12 +204,22 @@ def test_a_track_with_wrong_fields_gives_one_line(recorded, tmp_path, capsys, mo
     assert err.count("\n") == 1 and "Traceback" not in err
 
 
-@pytest.mark.parametrize(("headers", "status"), [
-    ({}, 200), ({"Host": "localhost"}, 200), ({"Host": "LOCALHOST:9"}, 200), ({"Host": "[::1]:8765"}, 200),
-    ({"Origin": "http://127.0.0.1:8765"}, 200), ({"Host": "evil.example"}, 403),
-    ({"Host": "evil.example:8765"}, 403), ({"Host": "127.0.0.1.evil.example"}, 403),
-    ({"Origin": "http://evil.example"}, 403), ({"Origin": "null"}, 403), ({"X-Pad": "a" * 9000}, 431),
-])
+@pytest.mark.parametrize(
+    ("headers", "status"),
+    [
+        ({}, 200),
+        ({"Host": "localhost"}, 200),
+        ({"Host": "LOCALHOST:9"}, 200),
+        ({"Host": "[::1]:8765"}, 200),
+        ({"Origin": "http://127.0.0.1:8765"}, 200),
+        ({"Host": "evil.example"}, 403),
+        ({"Host": "evil.example:8765"}, 403),
+        ({"Host": "127.0.0.1.evil.example"}, 403),
+        ({"Origin": "http://evil.example"}, 403),
+        ({"Origin": "null"}, 403),
+        ({"X-Pad": "a" * 9000}, 431),
+    ],
+)
 def test_requests_not_addressed_to_this_machine_are_forbidden(serve, headers, status):
     port = serve()
     assert get(port, "/", headers)[0] == status
@@ -297,8 +321,12 @@ def test_stopping_the_server_ends_its_streams_cleanly(serve, capsys):
 
 
 def test_ctrl_c_stops_a_streaming_view_cleanly(recorded):
-    proc = subprocess.Popen([sys.executable, "-m", "facemime", "view", "--no-browser", "--port", "0", str(recorded[1])],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "facemime", "view", "--no-browser", "--port", "0", str(recorded[1])],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         port = int(proc.stdout.readline().strip().rstrip("/").rsplit(":", 1)[1])
         streams = [stream(port) for _ in range(2)]

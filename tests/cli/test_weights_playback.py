@@ -20,18 +20,29 @@ from .test_cli import first_frames, run
 
 SIZE = (320, 240)
 #: The performance: still, the jaw opening, open, a smile, a blink, and a frame without a face.
-WEIGHTS = [{}, {"jawOpen": 0.5}, {"jawOpen": 1.0}, {"mouthSmileLeft": 1.0, "mouthSmileRight": 1.0},
-           {"eyeBlinkLeft": 1.0, "eyeBlinkRight": 1.0}, {}]
+WEIGHTS = [
+    {},
+    {"jawOpen": 0.5},
+    {"jawOpen": 1.0},
+    {"mouthSmileLeft": 1.0, "mouthSmileRight": 1.0},
+    {"eyeBlinkLeft": 1.0, "eyeBlinkRight": 1.0},
+    {},
+]
 
 
 def write_performance(path):
     """The performance as a hand-written track file: a pose framing the generic head, weights."""
     pose = generic_actor(SIZE).pose
-    frames = [{"index": i, "pose": {k: getattr(pose, k) for k in ("yaw", "pitch", "roll", "scale", "tx", "ty")},
-               "weights": w} for i, w in enumerate(WEIGHTS)]
+    frames = [
+        {"index": i, "pose": {k: getattr(pose, k) for k in ("yaw", "pitch", "roll", "scale", "tx", "ty")}, "weights": w}
+        for i, w in enumerate(WEIGHTS)
+    ]
     frames[-1].update(face=False, lost=["mouth_inner"])
-    path.write_text(json.dumps({"format": "facemime.track/1", "video": {"width": SIZE[0], "height": SIZE[1], "fps": 10},
-                                "frames": frames}))
+    path.write_text(
+        json.dumps(
+            {"format": "facemime.track/1", "video": {"width": SIZE[0], "height": SIZE[1], "fps": 10}, "frames": frames}
+        )
+    )
     return path
 
 
@@ -117,10 +128,11 @@ def test_bad_tracks_and_options_that_need_a_video_give_one_line(tmp_path, capsys
         (["encode", str(cut), "--out", str(tmp_path / "x.fmstream")], "is not valid JSON"),
         (["run", str(unknown), "--out", str(tmp_path / "x.mp4")], "unknown expression weight 'jawOpened'"),
         (["encode", str(track), "--appearance", "5", "--out", str(tmp_path / "x.fmstream")], "is a track file"),
-        (["run", str(track), "--track", str(tmp_path / "x.json"), "--out", str(tmp_path / "x.mp4")],
-         "is a track file"),
-        (["run", str(track), "--weights", str(tmp_path / "x.csv"), "--out", str(tmp_path / "x.mp4")],
-         "is a track file"),
+        (["run", str(track), "--track", str(tmp_path / "x.json"), "--out", str(tmp_path / "x.mp4")], "is a track file"),
+        (
+            ["run", str(track), "--weights", str(tmp_path / "x.csv"), "--out", str(tmp_path / "x.mp4")],
+            "is a track file",
+        ),
     ]
     for args, message in cases:
         code, out, err = run(capsys, *args)

@@ -29,8 +29,20 @@ STEPS_V2 = [0.5, 0.5, 0.5, 0.004, 0.5, 0.5, 3.0, 3.0, 1 / 16, 1 / 16, 0.02, 0.02
 def encoder() -> _core.StreamEncoder:
     """The golden stream's encoder: 25 fps, 320x240, 5 frames per packet, an intra packet every 4."""
     basis = (np.arange(4 * 6).reshape(4, 6) * 1111 - 12000).astype(np.int16)
-    return _core.StreamEncoder((25, 1), (320, 240), b"golden!!", 5, 4, STEPS, [0, 0, 0, 173, 320, 240, 0, 0, 0, 0],
-                               [5, 5, 5, 3, 7, 7, 6, 6, 6, 6], basis, bytes(range(32)), False, 0.3)
+    return _core.StreamEncoder(
+        (25, 1),
+        (320, 240),
+        b"golden!!",
+        5,
+        4,
+        STEPS,
+        [0, 0, 0, 173, 320, 240, 0, 0, 0, 0],
+        [5, 5, 5, 3, 7, 7, 6, 6, 6, 6],
+        basis,
+        bytes(range(32)),
+        False,
+        0.3,
+    )
 
 
 def frames() -> list[tuple[bool, int, np.ndarray]]:
@@ -48,8 +60,21 @@ def encoder_v2() -> _core.StreamEncoder:
     basis = (np.arange(2 * 6).reshape(2, 6) * 2345 - 13000).astype(np.int16)
     references = [0, 0, 0, 173, 160, 120] + [0] * 8
     classes = [5, 5, 5, 3, 7, 7, 6, 6] + [4, 4, 3, 3, 3, 3]
-    return _core.StreamEncoder((30, 1), (160, 120), b"golden02", 4, 3, STEPS_V2, references, classes, basis,
-                               bytes(range(32, 64)), False, 0.3, EXTRAS_V2)
+    return _core.StreamEncoder(
+        (30, 1),
+        (160, 120),
+        b"golden02",
+        4,
+        3,
+        STEPS_V2,
+        references,
+        classes,
+        basis,
+        bytes(range(32, 64)),
+        False,
+        0.3,
+        EXTRAS_V2,
+    )
 
 
 def frames_v2() -> list[tuple[bool, int, np.ndarray]]:
@@ -82,8 +107,10 @@ def write(version: int) -> None:
     dec = _core.StreamDecoder(True)
     index, face, lost, values, *_ = dec.push(data)
     stream.write_bytes(data)
-    rows = [json.dumps({"index": int(i), "face": bool(f), "lost": int(b), "values": v.tolist()})
-            for i, f, b, v in zip(index, face, lost, values)]
+    rows = [
+        json.dumps({"index": int(i), "face": bool(f), "lost": int(b), "values": v.tolist()})
+        for i, f, b, v in zip(index, face, lost, values)
+    ]
     extras = f'"extras": {json.dumps(dec.header()["extras"])},\n' if version > 1 else ""
     expected.write_text("{" + extras + '"frames": [\n' + ",\n".join(rows) + "\n]}\n")
     print(f"{stream}: {len(data)} bytes")

@@ -46,15 +46,23 @@ def header(p: bytes) -> dict:
     at += 9 * n
     extras = []
     if p[4] == 2:
-        extras = list(p[at + 1:at + 1 + p[at]])
+        extras = list(p[at + 1 : at + 1 + p[at]])
         at += 1 + p[at]
         assert len(extras) <= n - 6 and 0 not in extras and len(set(extras)) == len(extras)
     (rows,) = struct.unpack_from("<H", p, at)
     at += 2 + 2 * (n - 6 - len(extras)) * rows + 32
     assert at + 1 == len(p)
-    return {"fps": (num, den), "size": (w, h), "P": frames, "K": keyframes, "steps": [x[0] for x in params],
-            "references": [x[1] for x in params], "classes": [x[2] for x in params], "extras": extras,
-            "carried": p[at]}
+    return {
+        "fps": (num, den),
+        "size": (w, h),
+        "P": frames,
+        "K": keyframes,
+        "steps": [x[0] for x in params],
+        "references": [x[1] for x in params],
+        "classes": [x[2] for x in params],
+        "extras": extras,
+        "carried": p[at],
+    }
 
 
 def table(freq: list[int]) -> list[int]:
@@ -142,8 +150,11 @@ def decode(data: bytes, appearance: list | None = None) -> list[dict]:
         if kind not in (3, 4):
             continue
         if kind == 3:
-            state = {"values": [Context(starting(c)) for c in h["classes"]],
-                     "flags": Context([496 if s == 1 else 16 for s in range(32)]), "pred": None}
+            state = {
+                "values": [Context(starting(c)) for c in h["classes"]],
+                "flags": Context([496 if s == 1 else 16 for s in range(32)]),
+                "pred": None,
+            }
         coder = Range(payload)
         for j in range(count):
             flags = coder.symbol(state["flags"].cdf)
@@ -162,7 +173,7 @@ def decode(data: bytes, appearance: list | None = None) -> list[dict]:
                 entry["values"] = [float(x) * float(step) for x, step in zip(q, h["steps"])]
                 if h["extras"]:
                     look = [0.0] * 6
-                    for kind, value in zip(h["extras"], entry["values"][len(q) - len(h["extras"]):]):
+                    for kind, value in zip(h["extras"], entry["values"][len(q) - len(h["extras"]) :]):
                         if 1 <= kind <= 6:
                             look[kind - 1] = value
                     entry["look"] = look

@@ -47,8 +47,9 @@ def test_the_payload_round_trips_and_garbage_is_refused():
     assert parse(b"\x01\x00\x00\x00\x02\x00\x03\x00not a webp") is None
     assert parse(b"short") is None
     late = Update(2, 0, 0, image[:8, :8]).payload()  # for frame 2, read after 9 frames were out
-    receiver = Appearance(np.zeros((32, 32, 3), np.uint8), [b"short", Update(5, 0, 0, image[:8, :8]).payload(), late],
-                          [0, 0, 9])
+    receiver = Appearance(
+        np.zeros((32, 32, 3), np.uint8), [b"short", Update(5, 0, 0, image[:8, :8]).payload(), late], [0, 0, 9]
+    )
     assert receiver.refused == 1 and not receiver.due(4) and receiver.due(5) and receiver.applied == 1
     assert not receiver.due(8) and receiver.due(9) and receiver.applied == 2
 
@@ -67,7 +68,7 @@ def tinted():
 
 
 def test_a_changed_cheek_is_sent_and_nothing_else(tinted):
-    actor, changed, frame = tinted
+    actor, _changed, frame = tinted
     sender = AppearanceSender(actor.model, actor.texture, budget=200.0, fps=25.0)
     for i in range(1, CHECK):  # the bucket fills; the face is looked at every CHECK frames only
         assert sender.update(i, frame, actor.model.vertices, actor.pose) is None
@@ -79,7 +80,7 @@ def test_a_changed_cheek_is_sent_and_nothing_else(tinted):
     h, w = actor.texture.shape[:2]
     for e in EYES:
         x, y = (actor.model.uv[actor.model.groups[e]] * [w, h]).mean(axis=0).astype(int)
-        assert np.array_equal(sender.texture[y - 3:y + 4, x - 3:x + 4], actor.texture[y - 3:y + 4, x - 3:x + 4])
+        assert np.array_equal(sender.texture[y - 3 : y + 4, x - 3 : x + 4], actor.texture[y - 3 : y + 4, x - 3 : x + 4])
     assert sender.update(2 * CHECK, frame, actor.model.vertices, actor.pose) is None  # nothing left to send
 
 
@@ -98,8 +99,9 @@ def test_a_face_whose_cheek_reddens_is_sent_again_through_the_stream(tmp_path):
     """End to end: a video of the astronaut whose cheek is redder than in her actor file is
     encoded for a receiver holding that file, with appearance updates; the decoded video's
     cheek reddens, and without updates it does not."""
-    import cv2
     from importlib import resources
+
+    import cv2
 
     from facemime.animate.synth import key_frame, scene_mesh, synthesize
     from facemime.codec.files import decode_stream, encode_video
@@ -134,13 +136,16 @@ def test_a_face_whose_cheek_reddens_is_sent_again_through_the_stream(tmp_path):
 
     def redness(video):
         frames = list(VideoReader(video))
-        return [float((f[cy - 3:cy + 4, cx - 3:cx + 4].astype(float) @ [1.0, -0.5, -0.5]).mean())
-                for f in (frames[1], frames[-1])]
+        return [
+            float((f[cy - 3 : cy + 4, cx - 3 : cx + 4].astype(float) @ [1.0, -0.5, -0.5]).mean())
+            for f in (frames[1], frames[-1])
+        ]
 
     source = redness(tmp_path / "v.mp4")
     for budget, name in ((16.0, "with"), (0.0, "without")):
-        result = encode_video(tmp_path / "v.mp4", tmp_path / f"{name}.fmstream", tmp_path / "a.actor",
-                              appearance=budget)
+        result = encode_video(
+            tmp_path / "v.mp4", tmp_path / f"{name}.fmstream", tmp_path / "a.actor", appearance=budget
+        )
         assert (result.appearance_updates > 0) == (budget > 0)
         assert result.appearance_kbit_s <= budget + 1e-9
         decoded = decode_stream(tmp_path / f"{name}.fmstream", tmp_path / f"{name}.mp4", tmp_path / "a.actor")

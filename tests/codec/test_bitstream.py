@@ -61,9 +61,16 @@ def test_random_bytes_are_never_decoded(data):
 
 
 @settings(max_examples=300, deadline=None)
-@given(st.lists(st.tuples(st.integers(0, 10**6), st.integers(0, 255), st.sampled_from("flip drop insert cut")),
-                min_size=1, max_size=10),
-       st.integers(1, 50), st.booleans(), st.sampled_from([1, 2]))
+@given(
+    st.lists(
+        st.tuples(st.integers(0, 10**6), st.integers(0, 255), st.sampled_from("flip drop insert cut")),
+        min_size=1,
+        max_size=10,
+    ),
+    st.integers(1, 50),
+    st.booleans(),
+    st.sampled_from([1, 2]),
+)
 def test_mutated_streams_decode_only_true_frames(edits, piece, from_start, version):
     stream, expected = (golden.STREAM, golden.EXPECTED) if version == 1 else (golden.STREAM_V2, golden.EXPECTED_V2)
     truth = {f["index"]: f["values"] for f in json.loads(expected.read_text())["frames"] if f["face"]}
@@ -84,7 +91,7 @@ def test_mutated_streams_decode_only_true_frames(edits, piece, from_start, versi
         else:
             del data[i:]
     dec = _core.StreamDecoder(from_start)
-    outs = [dec.push(bytes(data[k:k + piece])) for k in range(0, len(data), piece)] + [dec.finish()]
+    outs = [dec.push(bytes(data[k : k + piece])) for k in range(0, len(data), piece)] + [dec.finish()]
     for index, face, _, values, concealed, appearance in outs:
         for i, f, v in zip(index, face, values):
             if f:
@@ -117,7 +124,7 @@ def test_the_version_2_golden_stream_decodes_to_its_checked_in_parameters_and_lo
     for (has_face, _, v), out in zip(golden.frames_v2(), values):
         if has_face:
             assert np.all(np.abs(v - out) <= 0.8 * np.array(golden.STEPS_V2) + 1e-6)
-    closure = values[:, 6 + 2:6 + 4]
+    closure = values[:, 6 + 2 : 6 + 4]
     assert closure[9].tolist() == [1.0, 1.0] and closure[8].tolist() == [0.0, 0.0]  # the blink, in one frame
     assert closure[21, 0] < -0.3 and closure[21, 1] == 0.0  # the right eye opened wide
 
@@ -142,19 +149,32 @@ def test_the_specification_and_the_rust_decoder_agree_on_version_2_streams(kinds
     rng = np.random.default_rng(sum(kinds))
     x, m, frames = len(kinds), 3, 400
     steps = [0.5, 0.5, 0.5, 0.004, 0.5, 0.5] + [2.0] * m + list(rng.uniform(0.01, 0.1, x))
-    enc = _core.StreamEncoder((24, 1), (640, 360), b"spec-rs!", 7, 5, steps, [0, 0, 0, 200, 320, 180] + [3] * (m + x),
-                              list(rng.integers(0, 16, 6 + m + x)), rng.integers(-30000, 30000, (m, 10), np.int16),
-                              bytes(32), True, 0.3, list(kinds))
+    enc = _core.StreamEncoder(
+        (24, 1),
+        (640, 360),
+        b"spec-rs!",
+        7,
+        5,
+        steps,
+        [0, 0, 0, 200, 320, 180] + [3] * (m + x),
+        list(rng.integers(0, 16, 6 + m + x)),
+        rng.integers(-30000, 30000, (m, 10), np.int16),
+        bytes(32),
+        True,
+        0.3,
+        list(kinds),
+    )
     walk = np.cumsum(rng.normal(0, 1.5, (frames, 6 + m + x)) * steps, axis=0) + np.array(steps) * 3
-    walk[::37, 6 + m:] += 1.0  # blinks: jumps of 10-100 steps
+    walk[::37, 6 + m :] += 1.0  # blinks: jumps of 10-100 steps
     data = [enc.header_chunk()]
     for t in range(frames):
         data.append(enc.push(t % 50 < 47, t % 3, walk[t])[1] or b"")
     data.append(enc.finish() or b"")
     _, (index, face, lost, values, _) = decode(b"".join(data))
     frames_ = reference(b"".join(data))
-    assert [(f["index"], f["face"], f["lost"]) for f in frames_] == list(zip(index.tolist(), face.tolist(),
-                                                                             lost.tolist()))
+    assert [(f["index"], f["face"], f["lost"]) for f in frames_] == list(
+        zip(index.tolist(), face.tolist(), lost.tolist())
+    )
     assert [f["values"] for f in frames_ if f["face"]] == values[face].tolist()
     known = [(i, k) for i, k in enumerate(kinds) if k <= 6]
     for f, v in zip([f for f in frames_ if f["face"]], values[face]):
@@ -186,24 +206,27 @@ def golden_v2_header() -> tuple[bytearray, int]:
     """The version-2 golden stream's header payload, and where its X byte is."""
     data = golden.STREAM_V2.read_bytes()
     length = (data[3] & 0x7F) | (data[4] << 7)  # a two-byte LEB128 length
-    payload = bytearray(data[5:5 + length])
-    assert header_chunk(bytes(payload)) == data[:5 + length + 4]
+    payload = bytearray(data[5 : 5 + length])
+    assert header_chunk(bytes(payload)) == data[: 5 + length + 4]
     return payload, 29 + 9 * payload[28]
 
 
-@pytest.mark.parametrize("edit, reason", [
-    ("many", "9 extra parameters do not fit in 14 parameters per frame (at most 8 after the pose)"),
-    ("twice", "extra parameter kind 3 appears twice"),
-    ("zero", "extra parameter 4 has kind 0; kinds are 1-255"),
-    ("version 3", "stream format version 3; this decoder reads versions 1 and 2"),
-    ("version 0", "stream format version 0; this decoder reads versions 1 and 2"),
-])
+@pytest.mark.parametrize(
+    "edit, reason",
+    [
+        ("many", "9 extra parameters do not fit in 14 parameters per frame (at most 8 after the pose)"),
+        ("twice", "extra parameter kind 3 appears twice"),
+        ("zero", "extra parameter 4 has kind 0; kinds are 1-255"),
+        ("version 3", "stream format version 3; this decoder reads versions 1 and 2"),
+        ("version 0", "stream format version 0; this decoder reads versions 1 and 2"),
+    ],
+)
 def test_bad_version_2_headers_are_refused_with_their_reason(edit, reason):
     payload, x = golden_v2_header()
-    assert payload[4] == 2 and payload[x:x + 7] == bytes([6, *range(1, 7)])
+    assert payload[4] == 2 and payload[x : x + 7] == bytes([6, *range(1, 7)])
     if edit == "many":  # nine extras where only eight parameters follow the pose
         payload[x] = 9
-        payload[x + 7:x + 7] = bytes([7, 8, 9])
+        payload[x + 7 : x + 7] = bytes([7, 8, 9])
     elif edit == "twice":
         payload[x + 2] = 3
     elif edit == "zero":
@@ -211,7 +234,7 @@ def test_bad_version_2_headers_are_refused_with_their_reason(edit, reason):
     else:
         payload[4] = int(edit[-1])
     dec = _core.StreamDecoder(True)
-    dec.push(header_chunk(bytes(payload)) + golden.STREAM_V2.read_bytes()[len(header_chunk(golden_v2_header()[0])):])
+    dec.push(header_chunk(bytes(payload)) + golden.STREAM_V2.read_bytes()[len(header_chunk(golden_v2_header()[0])) :])
     assert dec.header() is None and dec.header_error() == reason
     receiver = MotionDecoder()
     receiver.push(header_chunk(bytes(payload)))
@@ -230,18 +253,20 @@ def test_a_version_2_header_read_as_version_1_is_refused_not_misread():
 def test_the_encoder_refuses_bad_extras():
     basis = np.zeros((2, 6), np.int16)
     args = ((30, 1), (160, 120), b"golden02", 4, 3, golden.STEPS_V2, [0] * 14, [6] * 14, basis, bytes(32), False, 0.3)
-    with pytest.raises(ValueError, match="^extra parameter kind 2 appears twice$"):
+    with pytest.raises(ValueError, match=r"^extra parameter kind 2 appears twice$"):
         _core.StreamEncoder(*args, [1, 2, 3, 4, 5, 2])
-    with pytest.raises(ValueError, match="^extra parameter 0 has kind 0; kinds are 1-255$"):
+    with pytest.raises(ValueError, match=r"^extra parameter 0 has kind 0; kinds are 1-255$"):
         _core.StreamEncoder(*args, [0, 2, 3, 4, 5, 6])
-    with pytest.raises(ValueError, match="^the basis holds 12 entries, not 3 x 6$"):
+    with pytest.raises(ValueError, match=r"^the basis holds 12 entries, not 3 x 6$"):
         _core.StreamEncoder(*args, [1, 2, 3, 4, 5])
 
 
 def split_chunks(data: bytes) -> list[bytes]:
     """The bytes of each chunk of an undamaged stream."""
-    out = [any_chunk(kind, payload, count if kind in (3, 4) else 0, seq)
-           for kind, count, seq, payload in reference_chunks(data)]
+    out = [
+        any_chunk(kind, payload, count if kind in (3, 4) else 0, seq)
+        for kind, count, seq, payload in reference_chunks(data)
+    ]
     assert b"".join(out) == data
     return out
 
@@ -299,7 +324,7 @@ def test_appearance_chunks_between_packets_change_no_frame_and_come_out_in_order
     # fed a byte at a time: each update comes out in the call that completes its chunk
     dec, seen, got = _core.StreamDecoder(True), 0, []
     for i in range(len(mixed)):
-        index, _, _, _, concealed, app = dec.push(mixed[i:i + 1])
+        index, _, _, _, concealed, app = dec.push(mixed[i : i + 1])
         got += [(seen + int(at), bytes(p)) for at, p in app]
         seen += len(index) + int(concealed[:, 1].sum())
     assert got == updates and seen == golden.FRAMES_V2
@@ -310,7 +335,7 @@ def test_appearance_chunks_come_out_in_a_version_1_stream_too():
     chunks = split_chunks(data)
     p = appearance_payload(5, 0, 0, b"RIFF....WEBP")
     mixed = b"".join(chunks[:2] + [_core.appearance_chunk(p)] + chunks[2:])
-    dec, frames, got = decode_all(mixed)
+    _dec, frames, got = decode_all(mixed)
     assert same_arrays(frames, decode_all(data)[1]) and got == [(5, p)]
 
 
@@ -340,9 +365,9 @@ def test_an_appearance_payload_too_short_for_its_frame_and_place_is_undecodable(
     found = []
     reference(b"".join(chunks[:1] + [short] + chunks[1:]), found)
     assert found == []
-    with pytest.raises(ValueError, match="^an appearance payload must hold at least 8 bytes \\(frame, x, y\\), got 7$"):
+    with pytest.raises(ValueError, match=r"^an appearance payload must hold at least 8 bytes \(frame, x, y\), got 7$"):
         _core.appearance_chunk(b"1234567")
-    with pytest.raises(ValueError, match="^an appearance payload must hold at most 1048576 bytes, got 1048577$"):
+    with pytest.raises(ValueError, match=r"^an appearance payload must hold at most 1048576 bytes, got 1048577$"):
         _core.appearance_chunk(bytes(8 + (1 << 20) - 7))
     assert len(_core.appearance_chunk(bytes(1 << 20))) == 3 + 3 + (1 << 20) + 4
 

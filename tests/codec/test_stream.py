@@ -63,7 +63,7 @@ def test_a_live_receiver_fed_small_pieces_sees_the_same_frames(clip):
     dec = MotionDecoder(from_start=False)
     frames = []
     for k in range(0, len(stream), 37):
-        frames += dec.push(stream[k:k + 37])
+        frames += dec.push(stream[k : k + 37])
     frames += dec.finish()
     assert len(frames) == len(recon) and all(same(f, recon[f.index]) for f in frames)
 
@@ -79,7 +79,7 @@ def test_lost_packets_are_concealed_and_the_next_intra_packet_resynchronises(cli
     assert dec.stats["lost_packets"] == 3 and len(concealed) == dec.stats["concealed"] >= 15
     for f in frames:
         if f.concealed:  # the last good frame, held
-            good = [g for g in frames[:f.index] if not g.concealed]
+            good = [g for g in frames[: f.index] if not g.concealed]
             assert f.pose == good[-1].pose if good else True
         else:
             assert same(f, recon[f.index])
@@ -136,8 +136,20 @@ def test_a_stream_for_another_head_model_is_refused(clip):
     from facemime.io.actor_file import actor_id
 
     basis = Basis.learn(np.array([m.offsets for m in clip.motion]), 4)
-    enc = _core.StreamEncoder((25, 1), clip.size, b"othermdl", 5, 5, Settings().steps(4), [0] * 10, [6] * 10,
-                              basis.raw, actor_id(clip.actor), False, 0.3)
+    enc = _core.StreamEncoder(
+        (25, 1),
+        clip.size,
+        b"othermdl",
+        5,
+        5,
+        Settings().steps(4),
+        [0] * 10,
+        [6] * 10,
+        basis.raw,
+        actor_id(clip.actor),
+        False,
+        0.3,
+    )
     with pytest.raises(StreamError, match="another head model"):
         MotionDecoder(clip.actor).push(enc.header_chunk())
 
@@ -149,7 +161,7 @@ def looks(n: int, seed: int = 0) -> list[Look]:
     rng = np.random.default_rng(seed)
     closure = np.zeros(n)
     for start in range(20, n, 75):
-        closure[start:start + 4] = [1.0, 0.8, 0.4, 0.1][:len(closure[start:start + 4])]
+        closure[start : start + 4] = [1.0, 0.8, 0.4, 0.1][: len(closure[start : start + 4])]
     jumps = np.repeat(rng.uniform(-0.15, 0.15, (n // 20 + 1, 2)), 20, axis=0)[:n]
     iris = jumps + rng.normal(0, 0.005, (n, 2))
     out = []
@@ -172,8 +184,15 @@ def with_looks(clip, given):
 def test_looks_round_trip_exactly_and_within_half_a_step(clip):
     settings = Settings(hysteresis=0.0)
     given = looks(len(clip.motion))
-    enc = MotionEncoder(clip.actor, clip.fps, clip.size, Basis.learn(np.array([m.offsets for m in clip.motion]), 16),
-                        settings, True, look=True)
+    enc = MotionEncoder(
+        clip.actor,
+        clip.fps,
+        clip.size,
+        Basis.learn(np.array([m.offsets for m in clip.motion]), 16),
+        settings,
+        True,
+        look=True,
+    )
     data, recon = [enc.start()], []
     for m, look in zip(clip.motion, given):
         recon.append(enc.push(m.face, m.lost, m.pose, m.offsets, look))
@@ -194,8 +213,15 @@ def test_looks_round_trip_exactly_and_within_half_a_step(clip):
 
 def test_a_lost_packet_repeats_the_last_good_look(clip):
     given = looks(len(clip.motion), 1)
-    enc = MotionEncoder(clip.actor, clip.fps, clip.size, Basis.learn(np.array([m.offsets for m in clip.motion]), 8),
-                        Settings(packet=0.2), False, look=True)
+    enc = MotionEncoder(
+        clip.actor,
+        clip.fps,
+        clip.size,
+        Basis.learn(np.array([m.offsets for m in clip.motion]), 8),
+        Settings(packet=0.2),
+        False,
+        look=True,
+    )
     packets = [enc.push(m.face, m.lost, m.pose, m.offsets, look).data for m, look in zip(clip.motion, given)]
     packets = [p for p in packets + [enc.finish()] if p]
     dec = MotionDecoder(clip.actor)
@@ -249,8 +275,21 @@ def test_encode_clip_sends_looks_only_when_one_is_not_neutral(clip):
 def test_kinds_the_decoder_does_not_know_are_decoded_and_ignored(clip):
     basis = Basis.learn(np.array([m.offsets for m in clip.motion]), 2)
     steps = Settings().steps(2) + [1 / 64, 0.5, 1 / 16, 0.5]
-    enc = _core.StreamEncoder((25, 1), clip.size, topology_id(clip.actor.model), 5, 5, steps, [0] * 12, [6] * 12,
-                              basis.raw, actor_id(clip.actor), False, 0.3, [5, 200, 2, 7])
+    enc = _core.StreamEncoder(
+        (25, 1),
+        clip.size,
+        topology_id(clip.actor.model),
+        5,
+        5,
+        steps,
+        [0] * 12,
+        [6] * 12,
+        basis.raw,
+        actor_id(clip.actor),
+        False,
+        0.3,
+        [5, 200, 2, 7],
+    )
     m = clip.motion[0]
     values = np.concatenate([pose_vector(m.pose), basis.coefficients(m.offsets), [0.25, 40.0, 0.5, 3.0]])
     data = enc.header_chunk() + (enc.push(True, 0, values)[1] or b"") + (enc.finish() or b"")
@@ -262,7 +301,7 @@ def test_kinds_the_decoder_does_not_know_are_decoded_and_ignored(clip):
 
 
 def test_the_decoder_collects_appearance_payloads_in_order_and_where_they_fall(clip):
-    data, recon = encoded(clip)
+    data, _recon = encoded(clip)
     plain = MotionDecoder()
     expected = plain.push(b"".join(data)) + plain.finish()
     # an update before every third packet, for that packet's first frame (payloads not parsed
@@ -281,9 +320,10 @@ def test_the_decoder_collects_appearance_payloads_in_order_and_where_they_fall(c
     stream = b"".join(mixed)
     assert len(payloads) >= 3
     dec = MotionDecoder()
-    got = [f for k in range(0, len(stream), 37) for f in dec.push(stream[k:k + 37])] + dec.finish()
-    assert [(f.index, f.face, f.lost, f.pose, f.concealed) for f in got] == \
-        [(f.index, f.face, f.lost, f.pose, f.concealed) for f in expected]
+    got = [f for k in range(0, len(stream), 37) for f in dec.push(stream[k : k + 37])] + dec.finish()
+    assert [(f.index, f.face, f.lost, f.pose, f.concealed) for f in got] == [
+        (f.index, f.face, f.lost, f.pose, f.concealed) for f in expected
+    ]
     assert all(np.array_equal(f.offsets, e.offsets) for f, e in zip(got, expected))
     assert dec.appearance == payloads and dec.appearance_after == after
     assert dec.stats["appearance"] == len(payloads) and dec.stats["undecodable"] == 0

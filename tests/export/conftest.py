@@ -31,20 +31,37 @@ def write_track(path: Path, frames: int = 12, fps: float = 25.0, size=(320, 240)
     base = Pose.framing(head.vertices, size, 0.6)
     out = []
     for n in range(frames):
-        pose = {"yaw": 20 * np.sin(n / 4), "pitch": 10 * np.sin(n / 3), "roll": 8 * np.cos(n / 5),
-                "scale": base.scale * (1 + 0.15 * np.sin(n / 6)), "tx": base.tx + 12 * np.sin(n / 3.5),
-                "ty": base.ty + 8 * np.cos(n / 2.5)}
+        pose = {
+            "yaw": 20 * np.sin(n / 4),
+            "pitch": 10 * np.sin(n / 3),
+            "roll": 8 * np.cos(n / 5),
+            "scale": base.scale * (1 + 0.15 * np.sin(n / 6)),
+            "tx": base.tx + 12 * np.sin(n / 3.5),
+            "ty": base.ty + 8 * np.cos(n / 2.5),
+        }
         offsets = np.zeros((len(d.knots), 2))
         offsets[:, 1] = -0.8 * np.sin(n / 2) ** 2 * (d.knots % 3 == 0)
-        f = {"index": n, "contours": {}, "pose": {k: round(float(v), 4) for k, v in pose.items()},
-             "offsets": np.round(offsets, 3).tolist(), "look": {"eye_left_closure": round(0.5 * np.sin(n) ** 2, 4)}}
+        f = {
+            "index": n,
+            "contours": {},
+            "pose": {k: round(float(v), 4) for k, v in pose.items()},
+            "offsets": np.round(offsets, 3).tolist(),
+            "look": {"eye_left_closure": round(0.5 * np.sin(n) ** 2, 4)},
+        }
         if weights is not None:
             f["weights"] = {k: float(v[n]) for k, v in weights.items()}
         out.append(f)
-    doc = {"format": "facemime.track/1", "frames": out,
-           "video": {"width": size[0], "height": size[1], "fps": fps, "frames": frames},
-           "model": {"unit": "mm", "knots": d.knots.tolist(), "feature_sizes": d.feature_sizes().round(3).tolist(),
-                     "iod": round(model_iod(head), 3)}}
+    doc = {
+        "format": "facemime.track/1",
+        "frames": out,
+        "video": {"width": size[0], "height": size[1], "fps": fps, "frames": frames},
+        "model": {
+            "unit": "mm",
+            "knots": d.knots.tolist(),
+            "feature_sizes": d.feature_sizes().round(3).tolist(),
+            "iod": round(model_iod(head), 3),
+        },
+    }
     path.write_text(json.dumps(doc))
     return path
 

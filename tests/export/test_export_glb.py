@@ -9,14 +9,13 @@ import time
 import numpy as np
 import pytest
 
+from cli.test_cli import run
 from facemime.animate.expressions import Expressions
 from facemime.export import export_track, load_performance
 from facemime.export.animation import node_keys
 from facemime.fit.actor import generic_actor
 from facemime.io.actor_file import load_actor
 from facemime.render.projection import rotation_matrix
-
-from cli.test_cli import run
 
 from .conftest import write_track
 
@@ -40,9 +39,13 @@ def accessor(gltf, blob, index):
 
 def quaternion_matrix(q):
     x, y, z, w = q
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 def check_round_trip(glb, track, actor):
@@ -102,8 +105,9 @@ def test_stored_weights_are_exported_as_they_are(tmp_path):
     export_track(track, tmp_path / "w.glb")
     gltf = pygltflib.GLTF2().load_binary(str(tmp_path / "w.glb"))
     names = gltf.meshes[0].extras["targetNames"]
-    sampler = next(gltf.animations[0].samplers[c.sampler] for c in gltf.animations[0].channels
-                   if c.target.path == "weights")
+    sampler = next(
+        gltf.animations[0].samplers[c.sampler] for c in gltf.animations[0].channels if c.target.path == "weights"
+    )
     w = accessor(gltf, gltf.binary_blob(), sampler.output).reshape(6, len(names))
     assert np.allclose(w[:, names.index("jawOpen")], jaw) and np.allclose(w[:, names.index("mouthSmileLeft")], 1 - jaw)
     assert np.count_nonzero(w) == np.count_nonzero(jaw) + np.count_nonzero(1 - jaw)
@@ -117,11 +121,13 @@ def test_bad_input_is_refused_in_one_line(generic_export, tmp_path, capsys):
     (tmp_path / "not_json.json").write_text('{"format": ')
     (tmp_path / "no_motion.json").write_text(json.dumps({"format": "facemime.track/1", "frames": [{"index": 0}]}))
     other = {"unit": "mm", "knots": [0, 1, 2], "feature_sizes": [1, 1, 1]}  # motion of a 3-knot head
-    (tmp_path / "other_head.json").write_text(json.dumps({**doc, "model": other, "frames": [
-        {**f, "offsets": f["offsets"][:3]} for f in doc["frames"]]}))
+    (tmp_path / "other_head.json").write_text(
+        json.dumps({**doc, "model": other, "frames": [{**f, "offsets": f["offsets"][:3]} for f in doc["frames"]]})
+    )
     (tmp_path / "bad_fps.json").write_text(json.dumps({**doc, "video": {"width": 320, "height": 240, "fps": 0}}))
-    (tmp_path / "bad_weight.json").write_text(json.dumps({**doc, "frames": [
-        {**f, "weights": {"jawOpen": 2.0}} for f in doc["frames"]]}))
+    (tmp_path / "bad_weight.json").write_text(
+        json.dumps({**doc, "frames": [{**f, "weights": {"jawOpen": 2.0}} for f in doc["frames"]]})
+    )
     (tmp_path / "bad.actor").write_bytes(b"PK\3\4 not an actor")
     cases = [
         ((str(track), "--out", str(out)), "already exists; use --force"),
@@ -131,8 +137,10 @@ def test_bad_input_is_refused_in_one_line(generic_export, tmp_path, capsys):
         ((str(tmp_path / "other_head.json"), "--out", str(tmp_path / "a.glb")), "another head model"),
         ((str(tmp_path / "bad_fps.json"), "--out", str(tmp_path / "a.glb")), "'fps' must be"),
         ((str(tmp_path / "bad_weight.json"), "--out", str(tmp_path / "a.glb")), "must be a number in [0, 1]"),
-        ((str(track), "--actor", str(tmp_path / "bad.actor"), "--out", str(tmp_path / "a.glb")),
-         "not a facemime actor"),
+        (
+            (str(track), "--actor", str(tmp_path / "bad.actor"), "--out", str(tmp_path / "a.glb")),
+            "not a facemime actor",
+        ),
         ((str(track), "--out", str(tmp_path / "a.gltf")), "must end in .glb"),
     ]
     for args, message in cases:
@@ -147,8 +155,12 @@ def test_a_1000_frame_track_exports_in_under_2_s(tmp_path):
     """With the weights stored per frame, as ``facemime run`` writes them (solving them is the
     solver's own target: under 1 s)."""
     t = np.linspace(0.0, 40.0, 1000)
-    weights = {"jawOpen": 0.5 + 0.5 * np.sin(t), "mouthSmileLeft": 0.5 - 0.5 * np.sin(t / 3),
-               "browInnerUp": 0.5 + 0.5 * np.cos(t / 2), "eyeBlinkLeft": (np.sin(t * 2) > 0.9) * 1.0}
+    weights = {
+        "jawOpen": 0.5 + 0.5 * np.sin(t),
+        "mouthSmileLeft": 0.5 - 0.5 * np.sin(t / 3),
+        "browInnerUp": 0.5 + 0.5 * np.cos(t / 2),
+        "eyeBlinkLeft": (np.sin(t * 2) > 0.9) * 1.0,
+    }
     track = write_track(tmp_path / "long.json", frames=1000, weights=weights)
     export_track(track, tmp_path / "warm.glb", generic_actor((320, 240)))  # imports and caches warmed
     t0 = time.perf_counter()

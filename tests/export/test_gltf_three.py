@@ -28,7 +28,6 @@ from facemime.io.contours_json import read_motion
 from facemime.render.projection import Pose, project
 from facemime.render.texture_map import coverage
 
-
 #: Least PSNR (dB) of three.js's picture against facemime's over the face: the measured values
 #: (module docstring) less a margin of about 4 dB for other Chromium and three.js versions.
 THRESHOLD = 48.0
@@ -45,8 +44,9 @@ def three(browser, three_page):
     page.add_script_tag(content=three_page)
 
     def render(data: bytes, seconds: float):
-        out = page.evaluate("([b, t, bg]) => renderGlb(b, t, bg)",
-                            [base64.b64encode(data).decode(), float(seconds), list(BACKGROUND)])
+        out = page.evaluate(
+            "([b, t, bg]) => renderGlb(b, t, bg)", [base64.b64encode(data).decode(), float(seconds), list(BACKGROUND)]
+        )
         png = np.frombuffer(base64.b64decode(out["png"].split(",", 1)[1]), np.uint8)
         return cv2.cvtColor(cv2.imdecode(png, cv2.IMREAD_COLOR), cv2.COLOR_BGR2RGB), out
 
@@ -66,15 +66,22 @@ def facemime_frame(track, perf, n):
     g = perf.actor.model.groups
     face = (coverage(points, perf.actor.model.triangles, perf.size) > 0).astype(np.uint8)
     mouth = np.zeros_like(face)
-    cv2.fillPoly(mouth, [np.round(np.concatenate([points[g["mouth_inner_upper"]],
-                                                  points[g["mouth_inner_lower"]][::-1]])).astype(np.int32)], 1)
+    cv2.fillPoly(
+        mouth,
+        [
+            np.round(np.concatenate([points[g["mouth_inner_upper"]], points[g["mouth_inner_lower"]][::-1]])).astype(
+                np.int32
+            )
+        ],
+        1,
+    )
     kernel = np.ones((5, 5), np.uint8)
     return picture, (cv2.erode(face, kernel) > 0) & ~(cv2.dilate(mouth, kernel) > 0)
 
 
 def psnr(a, b, region):
     d = a.astype(np.float64)[region] - b[region]
-    return 10 * np.log10(255.0 ** 2 / max(float(np.mean(d ** 2)), 1e-12))
+    return 10 * np.log10(255.0**2 / max(float(np.mean(d**2)), 1e-12))
 
 
 def check_frames(three, track, perf, data, frames):
@@ -99,8 +106,9 @@ def test_the_generic_head_plays_in_three_js_as_facemime_draws_it(three, generic_
     other, region = facemime_frame(track, perf, 9)
     print(f"frame 4 against frame 9: {psnr(picture, other, region):.1f} dB")
     assert psnr(picture, other, region) < 30.0
-    flipped = replace(perf, actor=replace(perf.actor, model=replace(perf.actor.model, uv=perf.actor.model.uv
-                                                                    * [1, -1] + [0, 1])))
+    flipped = replace(
+        perf, actor=replace(perf.actor, model=replace(perf.actor.model, uv=perf.actor.model.uv * [1, -1] + [0, 1]))
+    )
     picture, _ = three(glb_bytes(flipped), perf.times[4])  # a v flip would show
     reference, region = facemime_frame(track, perf, 4)
     print(f"texture flipped upside down: {psnr(picture, reference, region):.1f} dB")

@@ -3,9 +3,8 @@ finds no error and no warning in exported files, and does find them in a broken 
 check can fail)."""
 
 import json
-import subprocess
-
 import struct
+import subprocess
 
 from facemime.export.gltf import BIN_CHUNK, GLB_MAGIC, JSON_CHUNK, read_glb
 

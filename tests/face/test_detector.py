@@ -59,8 +59,8 @@ def test_windows_cover_the_image_whole_then_in_squares(width, height):
     assert side == max(width, height) and x <= 0 and y <= 0  # the whole image, letterboxed
     covered = np.zeros((height, width), bool)
     for x, y, side in found[1:]:
-        assert 0 <= x and 0 <= y and x + side <= width and y + side <= height
-        covered[y:y + side, x:x + side] = True
+        assert x >= 0 and y >= 0 and x + side <= width and y + side <= height
+        covered[y : y + side, x : x + side] = True
     assert len(found) == 1 or covered.all()
 
 

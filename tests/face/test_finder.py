@@ -12,7 +12,7 @@ from facemime.io.photo import read_photo
 
 @pytest.mark.parametrize("name", ["lp_s22", "lp_s25", "lp_s39"])  # a monkey, a dog, a cat
 def test_an_animal_is_no_human_face(shared, name):
-    with pytest.raises(NoFaceError, match="^no face found$"):
+    with pytest.raises(NoFaceError, match=r"^no face found$"):
         find_face(read_photo(shared / "photos" / f"{name}.jpg"))
 
 
@@ -36,7 +36,7 @@ def test_the_largest_of_two_faces_is_taken_and_both_are_counted(shared):
 def test_the_shipped_models_load_and_an_unknown_one_is_refused():
     for name in MODELS:
         assert not load_network(name).empty()
-    with pytest.raises(FacemimeError, match="unknown face model 'x.tflite'"):
+    with pytest.raises(FacemimeError, match=r"unknown face model 'x.tflite'"):
         load_network("x.tflite")
 
 

@@ -16,9 +16,18 @@ from facemime.metrics import curve_error
 
 def group_nmes(points, reference, iod):
     """NME per reference-point group (benchmarks/fit_points.py): eye corner distance, curve distance."""
-    return {g: np.mean([np.linalg.norm(points[n][0] - reference[n][0]) if g == "eye_corners"
-                        else curve_error(points[n], reference[n]) for n in names]) / iod
-            for g, names in GROUPS.items()}
+    return {
+        g: np.mean(
+            [
+                np.linalg.norm(points[n][0] - reference[n][0])
+                if g == "eye_corners"
+                else curve_error(points[n], reference[n])
+                for n in names
+            ]
+        )
+        / iod
+        for g, names in GROUPS.items()
+    }
 
 
 @pytest.mark.parametrize("angle", [0.0, 0.4, -1.0])

@@ -15,8 +15,12 @@ from facemime.io.outputs import OutputExistsError
 def test_round_trip_is_exact(tmp_path, actor):
     path = save_actor(tmp_path / "a.actor", actor)
     back = load_actor(path)
-    for a, b in ((back.model.vertices, actor.model.vertices), (back.model.uv, actor.model.uv),
-                 (back.model.triangles, actor.model.triangles), (back.texture, actor.texture)):
+    for a, b in (
+        (back.model.vertices, actor.model.vertices),
+        (back.model.uv, actor.model.uv),
+        (back.model.triangles, actor.model.triangles),
+        (back.texture, actor.texture),
+    ):
         np.testing.assert_array_equal(a, b)
         assert a.dtype == b.dtype
     assert back.pose == actor.pose and back.source == actor.source
@@ -56,23 +60,42 @@ def edit_json(edit):
         doc = json.loads(data)
         edit(doc)
         return name, json.dumps(doc)
+
     return change
 
 
-@pytest.mark.parametrize(("make", "message"), [
-    (lambda p, d: write(d, p.read_bytes()[: len(p.read_bytes()) // 2]), "not a facemime actor file, or truncated"),
-    (lambda p, d: write(d, b"hello"), "not a facemime actor file"),
-    (lambda p, d: write(d, pickle.dumps({"x": 1})), "not a facemime actor file"),
-    (lambda p, d: rewrite(p, d, lambda n, b: None if n == "texture.png" else (n, b)), "no texture.png inside"),
-    (lambda p, d: rewrite(p, d, edit_json(lambda doc: doc.update(format="facemime.actor/9"))), "a newer facemime wrote it"),
-    (lambda p, d: rewrite(p, d, edit_json(lambda doc: doc.update(format="something else"))), "expected format 'facemime.actor/1'"),
-    (lambda p, d: rewrite(p, d, edit_json(lambda doc: doc["model"]["uv"].pop())), r"uv must have shape \(120, 2\)"),
-    (lambda p, d: rewrite(p, d, edit_json(lambda doc: doc["model"]["triangles"][0].__setitem__(0, 999))), "uses vertex 999"),
-    (lambda p, d: rewrite(p, d, edit_json(lambda doc: doc["texture"].update(width=3))), "but actor.json says"),
-    (lambda p, d: rewrite(p, d, edit_json(lambda doc: doc["pose"].update(scale=-1))), "malformed actor"),
-    (lambda p, d: rewrite(p, d, lambda n, b: (n, b"not a png") if n == "texture.png" else (n, b)), "texture.png is not a PNG"),
-    (lambda p, d: rewrite(p, d, lambda n, b: (n, b"{]") if n == "actor.json" else (n, b)), "actor.json is not valid JSON"),
-])
+@pytest.mark.parametrize(
+    ("make", "message"),
+    [
+        (lambda p, d: write(d, p.read_bytes()[: len(p.read_bytes()) // 2]), "not a facemime actor file, or truncated"),
+        (lambda p, d: write(d, b"hello"), "not a facemime actor file"),
+        (lambda p, d: write(d, pickle.dumps({"x": 1})), "not a facemime actor file"),
+        (lambda p, d: rewrite(p, d, lambda n, b: None if n == "texture.png" else (n, b)), "no texture.png inside"),
+        (
+            lambda p, d: rewrite(p, d, edit_json(lambda doc: doc.update(format="facemime.actor/9"))),
+            "a newer facemime wrote it",
+        ),
+        (
+            lambda p, d: rewrite(p, d, edit_json(lambda doc: doc.update(format="something else"))),
+            "expected format 'facemime.actor/1'",
+        ),
+        (lambda p, d: rewrite(p, d, edit_json(lambda doc: doc["model"]["uv"].pop())), r"uv must have shape \(120, 2\)"),
+        (
+            lambda p, d: rewrite(p, d, edit_json(lambda doc: doc["model"]["triangles"][0].__setitem__(0, 999))),
+            "uses vertex 999",
+        ),
+        (lambda p, d: rewrite(p, d, edit_json(lambda doc: doc["texture"].update(width=3))), "but actor.json says"),
+        (lambda p, d: rewrite(p, d, edit_json(lambda doc: doc["pose"].update(scale=-1))), "malformed actor"),
+        (
+            lambda p, d: rewrite(p, d, lambda n, b: (n, b"not a png") if n == "texture.png" else (n, b)),
+            "texture.png is not a PNG",
+        ),
+        (
+            lambda p, d: rewrite(p, d, lambda n, b: (n, b"{]") if n == "actor.json" else (n, b)),
+            "actor.json is not valid JSON",
+        ),
+    ],
+)
 def test_bad_files_are_refused_with_a_message(tmp_path, actor, make, message):
     good = save_actor(tmp_path / "good.actor", actor)
     bad = make(good, tmp_path / "bad.actor")
@@ -85,12 +108,12 @@ def test_oversized_members_are_refused_before_reading(tmp_path, monkeypatch, act
 
     path = save_actor(tmp_path / "a.actor", actor)
     monkeypatch.setattr(actor_file, "MAX_TEXTURE_BYTES", 1000)
-    with pytest.raises(ActorFileError, match="texture.png is .* bytes, more than the 1000 allowed"):
+    with pytest.raises(ActorFileError, match=r"texture.png is .* bytes, more than the 1000 allowed"):
         load_actor(path)
 
 
 def test_missing_file(tmp_path):
-    with pytest.raises(InputFileError, match="actor file .*nope.actor does not exist"):
+    with pytest.raises(InputFileError, match=r"actor file .*nope.actor does not exist"):
         load_actor(tmp_path / "nope.actor")
 
 
@@ -130,12 +153,15 @@ def test_a_file_without_a_scene_loads_and_shows_the_face_alone(tmp_path, actor):
     assert np.abs(frames["old"][face].astype(int) - frames["scene"][face]).mean() < 2
 
 
-@pytest.mark.parametrize(("change", "message"), [
-    (lambda n, b: None if n == "scene.png" else (n, b), "disagree on whether it has a scene"),
-    (edit_json(lambda doc: doc.pop("scene")), "disagree on whether it has a scene"),
-    (edit_json(lambda doc: doc["scene"].update(height=500)), "scene is 512x512, but actor.json says"),
-    (lambda n, b: (n, b"not a png") if n == "scene.png" else (n, b), "scene.png is not a PNG"),
-])
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (lambda n, b: None if n == "scene.png" else (n, b), "disagree on whether it has a scene"),
+        (edit_json(lambda doc: doc.pop("scene")), "disagree on whether it has a scene"),
+        (edit_json(lambda doc: doc["scene"].update(height=500)), "scene is 512x512, but actor.json says"),
+        (lambda n, b: (n, b"not a png") if n == "scene.png" else (n, b), "scene.png is not a PNG"),
+    ],
+)
 def test_a_file_whose_scene_and_actor_json_disagree_is_refused(tmp_path, actor, change, message):
     bad = rewrite(save_actor(tmp_path / "good.actor", actor), tmp_path / "bad.actor", change)
     with pytest.raises(ActorFileError, match=message) as e:
@@ -143,12 +169,15 @@ def test_a_file_whose_scene_and_actor_json_disagree_is_refused(tmp_path, actor, 
     assert "\n" not in str(e.value) and str(bad) in str(e.value)
 
 
-@pytest.mark.parametrize("source, message", [
-    ({"width": 10**6, "height": 10**6}, "more than 100000000 pixels"),
-    ({"width": 512, "height": 900}, "not its source picture"),
-    ({"width": 256, "height": 256}, "not its source picture"),
-    ({"width": "512", "height": 512}, "needs its source picture's width and height"),
-])
+@pytest.mark.parametrize(
+    "source, message",
+    [
+        ({"width": 10**6, "height": 10**6}, "more than 100000000 pixels"),
+        ({"width": 512, "height": 900}, "not its source picture"),
+        ({"width": 256, "height": 256}, "not its source picture"),
+        ({"width": "512", "height": 512}, "needs its source picture's width and height"),
+    ],
+)
 def test_a_scene_whose_source_picture_is_huge_or_of_another_shape_is_refused(actor, tmp_path, source, message):
     """The scene is drawn at its source picture's size: a forged size would make it allocate
     without bound, or stretch it out of shape."""

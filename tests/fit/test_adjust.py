@@ -18,8 +18,17 @@ def grid() -> np.ndarray:
 
 def adjust(points, chains, targets, psi, iterations=8, tolerance=0.1):
     return _core.elastic_adjust(
-        points, np.concatenate(chains).astype(np.uint32), np.array([len(c) for c in chains], np.uint32),
-        np.concatenate(targets), np.array([len(t) for t in targets], np.uint32), psi, 0.5, 2.0, iterations, tolerance)
+        points,
+        np.concatenate(chains).astype(np.uint32),
+        np.array([len(c) for c in chains], np.uint32),
+        np.concatenate(targets),
+        np.array([len(t) for t in targets], np.uint32),
+        psi,
+        0.5,
+        2.0,
+        iterations,
+        tolerance,
+    )
 
 
 def test_a_model_contour_moves_onto_its_target_in_a_few_iterations():
@@ -43,15 +52,20 @@ def test_small_rigidity_leaves_far_vertices_still():
 
 def test_large_rigidity_moves_everything_together():
     p = grid()
-    out, _ = adjust(p, [[0], [143]], [np.array([[3.0, 2.0]]), np.array([[113.0, 112.0]])], psi=1e5, iterations=1, tolerance=0.0)
+    out, _ = adjust(
+        p, [[0], [143]], [np.array([[3.0, 2.0]]), np.array([[113.0, 112.0]])], psi=1e5, iterations=1, tolerance=0.0
+    )
     np.testing.assert_allclose(out - p, np.tile([3.0, 2.0], (len(p), 1)), atol=1e-3)
 
 
-@pytest.mark.parametrize(("chains", "targets", "psi", "message"), [
-    ([[200]], [np.zeros((1, 2))], 10.0, "uses vertex 200, but there are 144 vertices"),
-    ([[1]], [np.zeros((1, 2))], 0.0, "psi must be a positive number"),
-    ([[1]], [np.array([[np.nan, 0.0]])], 10.0, "target of contour 0 holds NaN"),
-])
+@pytest.mark.parametrize(
+    ("chains", "targets", "psi", "message"),
+    [
+        ([[200]], [np.zeros((1, 2))], 10.0, "uses vertex 200, but there are 144 vertices"),
+        ([[1]], [np.zeros((1, 2))], 0.0, "psi must be a positive number"),
+        ([[1]], [np.array([[np.nan, 0.0]])], 10.0, "target of contour 0 holds NaN"),
+    ],
+)
 def test_bad_input_is_refused(chains, targets, psi, message):
     with pytest.raises(InvalidInputError, match=message):
         adjust(grid(), chains, targets, psi)
@@ -59,7 +73,10 @@ def test_bad_input_is_refused(chains, targets, psi, message):
 
 def test_frontal_pose_recovers_a_known_placement():
     model = generic_head()
-    truth = frontal_pose(model.vertices[:3], project(model.vertices[:3], frontal_pose(model.vertices[:2], np.array([[10.0, 20], [90, 35]])))[0])
+    truth = frontal_pose(
+        model.vertices[:3],
+        project(model.vertices[:3], frontal_pose(model.vertices[:2], np.array([[10.0, 20], [90, 35]])))[0],
+    )
     pts = project(model.vertices, truth)[0]
     again = frontal_pose(model.vertices, pts)
     assert again.roll == pytest.approx(truth.roll) and again.scale == pytest.approx(truth.scale)
@@ -67,7 +84,7 @@ def test_frontal_pose_recovers_a_known_placement():
 
 
 def test_fitting_real_points_puts_the_model_contours_on_them(lp_d0):
-    frame, points, iod = lp_d0
+    _frame, points, iod = lp_d0
     model = generic_head()
     fit = fit_model(model, check_points(points, 512, 512))
     assert fit.residuals[-1] < 0.01 * iod and len(fit.residuals) - 1 <= 6
@@ -80,13 +97,16 @@ def test_fitting_real_points_puts_the_model_contours_on_them(lp_d0):
     assert 80 < np.linalg.norm(g[:2]) < 100
 
 
-@pytest.mark.parametrize(("change", "message"), [
-    (lambda p: p.pop("eye_left_outer"), "missing eye_left_outer"),
-    (lambda p: p.__setitem__("ear", [1, 2]), "unknown point ear"),
-    (lambda p: p.__setitem__("nose_tip", [[1, 2], [3, 4]]), "nose_tip is a single point"),
-    (lambda p: p.__setitem__("chin", [900, 10]), "chin has points outside the 512x512 image"),
-    (lambda p: p.__setitem__("mouth_outer_upper", "abc"), "mouth_outer_upper must be"),
-])
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (lambda p: p.pop("eye_left_outer"), "missing eye_left_outer"),
+        (lambda p: p.__setitem__("ear", [1, 2]), "unknown point ear"),
+        (lambda p: p.__setitem__("nose_tip", [[1, 2], [3, 4]]), "nose_tip is a single point"),
+        (lambda p: p.__setitem__("chin", [900, 10]), "chin has points outside the 512x512 image"),
+        (lambda p: p.__setitem__("mouth_outer_upper", "abc"), "mouth_outer_upper must be"),
+    ],
+)
 def test_bad_points_are_refused(lp_d0, change, message):
     points = {k: v.tolist() for k, v in lp_d0[1].items()}
     change(points)

@@ -12,8 +12,12 @@ from facemime.metrics import curve_error
 from facemime.render.head_view import render_head
 from facemime.render.projection import Pose, project
 
-CORNERS = {"eye_right_outer": ("eye_right", 0), "eye_right_inner": ("eye_right", 4),
-           "eye_left_inner": ("eye_left", 0), "eye_left_outer": ("eye_left", 4)}
+CORNERS = {
+    "eye_right_outer": ("eye_right", 0),
+    "eye_right_inner": ("eye_right", 4),
+    "eye_left_inner": ("eye_left", 0),
+    "eye_left_outer": ("eye_left", 4),
+}
 
 
 @pytest.mark.parametrize(("roll", "zoom"), [(0.0, 1.0), (6.0, 0.8), (-8.0, 1.2)])
@@ -39,8 +43,10 @@ def test_points_on_real_first_frames_are_within_target(shared, points_of, video)
     ref, iod = points_of(z["landmarks"][0]), float(z["iod"][0])
     found = auto_points(frame).points
     for group, names in GROUPS.items():
-        errors = [np.linalg.norm(found[n][0] - ref[n][0]) if group == "eye_corners" else curve_error(found[n], ref[n])
-                  for n in names]
+        errors = [
+            np.linalg.norm(found[n][0] - ref[n][0]) if group == "eye_corners" else curve_error(found[n], ref[n])
+            for n in names
+        ]
         assert np.mean(errors) / iod < 0.05, (group, np.mean(errors) / iod)
 
 

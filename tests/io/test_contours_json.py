@@ -5,18 +5,29 @@ import json
 import numpy as np
 import pytest
 
-from facemime.errors import InputFileError
 from facemime.animate.look import Look
-from facemime.io.contours_json import (ContourFileError, init_document, read_init, read_motion, read_track,
-                                       track_document, write_json)
+from facemime.errors import InputFileError
+from facemime.io.contours_json import (
+    ContourFileError,
+    init_document,
+    read_init,
+    read_motion,
+    read_track,
+    track_document,
+    write_json,
+)
 from facemime.track.synthetic import band_face
 
 
 def test_track_json_round_trips(tmp_path):
     _, contours = band_face(shift=(0.123456, -7.5))
-    frames = [{"index": i, "contours": contours, "confidence": {"mouth_outer": 0.5}, "lost": ["brow_left"] if i else []}
-              for i in range(3)]
-    path = write_json(tmp_path / "t.json", track_document({"width": 256, "height": 256, "fps": 25.0, "frames": 3}, frames))
+    frames = [
+        {"index": i, "contours": contours, "confidence": {"mouth_outer": 0.5}, "lost": ["brow_left"] if i else []}
+        for i in range(3)
+    ]
+    path = write_json(
+        tmp_path / "t.json", track_document({"width": 256, "height": 256, "fps": 25.0, "frames": 3}, frames)
+    )
     video, back = read_track(path)
     assert video == {"width": 256, "height": 256, "fps": 25.0, "frames": 3}
     assert sorted(back) == [0, 1, 2]
@@ -68,12 +79,19 @@ def test_missing_init_file(tmp_path):
 
 
 def _motion_file(tmp_path, look):
-    frame = {"index": 0, "pose": {"yaw": 0, "pitch": 0, "roll": 0, "scale": 2.0, "tx": 100, "ty": 90},
-             "offsets": [[0.0, 0.0]] * 3}
+    frame = {
+        "index": 0,
+        "pose": {"yaw": 0, "pitch": 0, "roll": 0, "scale": 2.0, "tx": 100, "ty": 90},
+        "offsets": [[0.0, 0.0]] * 3,
+    }
     if look is not None:
         frame["look"] = look
-    doc = {"format": "facemime.track/1", "video": {}, "frames": [frame],
-           "model": {"unit": "mm", "knots": [1, 2, 3], "feature_sizes": [1, 1, 1], "iod": 90}}
+    doc = {
+        "format": "facemime.track/1",
+        "video": {},
+        "frames": [frame],
+        "model": {"unit": "mm", "knots": [1, 2, 3], "feature_sizes": [1, 1, 1], "iod": 90},
+    }
     path = tmp_path / "m.json"
     path.write_text(json.dumps(doc))
     return path
@@ -87,10 +105,15 @@ def test_the_look_is_read_back_and_a_file_without_it_plays_neutral(tmp_path):
     assert partial.vector().tolist() == [0.0, 0.5, 0.0, 0.0, 0.0, 0.0]
 
 
-@pytest.mark.parametrize("look, message", [({"eye_right_closure": "shut"}, "malformed 'look'"),
-                                           ([0.5, 0.5], "malformed 'look'"),
-                                           ({"iris_left_u": 1e9}, "beyond"),
-                                           ({"iris_left_v": float("nan")}, "beyond")])
+@pytest.mark.parametrize(
+    "look, message",
+    [
+        ({"eye_right_closure": "shut"}, "malformed 'look'"),
+        ([0.5, 0.5], "malformed 'look'"),
+        ({"iris_left_u": 1e9}, "beyond"),
+        ({"iris_left_v": float("nan")}, "beyond"),
+    ],
+)
 def test_a_bad_look_is_refused_in_one_line(tmp_path, look, message):
     with pytest.raises(ContourFileError, match=message):
         read_motion(_motion_file(tmp_path, look))

@@ -67,10 +67,12 @@ def test_an_encoding_error_is_one_line_and_leaves_nothing(tmp_path, monkeypatch)
         raise OSError(28, "No space left on device")
 
     monkeypatch.setattr(av.VideoFrame, "from_ndarray", disk_full)
-    with pytest.raises(OutputFileError, match=r"cannot write video .*clip\.mp4: No space left on device"):
-        with VideoWriter(tmp_path / "clip.mp4", fps=25) as w:
-            for _ in range(3 * VideoWriter.QUEUED):  # more than the queue holds: no writer waits forever
-                w.write(np.zeros((16, 16, 3), np.uint8))
+    with (
+        pytest.raises(OutputFileError, match=r"cannot write video .*clip\.mp4: No space left on device"),
+        VideoWriter(tmp_path / "clip.mp4", fps=25) as w,
+    ):
+        for _ in range(3 * VideoWriter.QUEUED):  # more than the queue holds: no writer waits forever
+            w.write(np.zeros((16, 16, 3), np.uint8))
     assert list(tmp_path.iterdir()) == []
 
 
@@ -85,7 +87,7 @@ def test_bad_video_arguments(tmp_path):
 
 def test_existing_outputs_are_not_overwritten_without_force(tmp_path):
     (tmp_path / "a.png").write_bytes(b"mine")
-    with pytest.raises(OutputExistsError, match="a.png already exists; use --force"):
+    with pytest.raises(OutputExistsError, match=r"a.png already exists; use --force"):
         check_outputs([tmp_path / "a.png", tmp_path / "b.png"], force=False)
     check_outputs([tmp_path / "a.png"], force=True)
     assert (tmp_path / "a.png").read_bytes() == b"mine"

@@ -8,8 +8,16 @@ from facemime.errors import InputFileError, ModelFormatError
 from facemime.model import CONTOUR_GROUPS, REQUIRED_GROUPS, generic_head, load_head
 from facemime.model.head import HEAD_FORMAT
 
-SNAKE_KNOTS = {"mouth_outer_upper": 11, "mouth_outer_lower": 11, "mouth_inner_upper": 11, "mouth_inner_lower": 11,
-               "brow_left_upper": 5, "brow_left_lower": 5, "brow_right_upper": 5, "brow_right_lower": 5}
+SNAKE_KNOTS = {
+    "mouth_outer_upper": 11,
+    "mouth_outer_lower": 11,
+    "mouth_inner_upper": 11,
+    "mouth_inner_lower": 11,
+    "brow_left_upper": 5,
+    "brow_left_lower": 5,
+    "brow_right_upper": 5,
+    "brow_right_lower": 5,
+}
 
 
 @pytest.fixture(scope="module")
@@ -47,7 +55,11 @@ def test_contour_groups_match_the_snake_contours(head):
         up, lo = head.groups[f"mouth_{kind}_upper"], head.groups[f"mouth_{kind}_lower"]
         assert up[0] == lo[0] and up[-1] == lo[-1], "upper and lower lips share the corners"
     # Subject's left brow on the image's right (+x).
-    assert head.vertices[head.groups["brow_left_upper"], 0].min() > 0 > head.vertices[head.groups["brow_right_upper"], 0].max()
+    assert (
+        head.vertices[head.groups["brow_left_upper"], 0].min()
+        > 0
+        > head.vertices[head.groups["brow_right_upper"], 0].max()
+    )
 
 
 def test_deformation_units_move_the_right_way(head):

@@ -54,8 +54,10 @@ def test_wfm_count_is_checked_before_the_lines_are_parsed(tmp_path, monkeypatch)
 def test_wfm_just_over_the_triangle_limit_is_refused(tmp_path, monkeypatch):
     path = grid_wfm(tmp_path / "grid.wfm", 4)
     monkeypatch.setenv("FACEMIME_MAX_TRIANGLES", "17")
-    with pytest.raises(ModelFormatError, match="FACE LIST, line 20: the model has 18 triangles, more than the limit of "
-                                               "17; set FACEMIME_MAX_TRIANGLES"):
+    with pytest.raises(
+        ModelFormatError,
+        match="FACE LIST, line 20: the model has 18 triangles, more than the limit of 17; set FACEMIME_MAX_TRIANGLES",
+    ):
         load_wfm(path)
 
 
@@ -68,13 +70,17 @@ def test_model_files_over_the_byte_limit_are_refused_unread(tmp_path, monkeypatc
         monkeypatch.setenv("FACEMIME_MAX_MODEL_BYTES", str(size))
         load(path)
         monkeypatch.setenv("FACEMIME_MAX_MODEL_BYTES", str(size - 1))
-        with pytest.raises(ModelFormatError, match=f"has {size} bytes, more than the limit of {size - 1} bytes; "
-                                                   "set FACEMIME_MAX_MODEL_BYTES"):
+        with pytest.raises(
+            ModelFormatError,
+            match=f"has {size} bytes, more than the limit of {size - 1} bytes; set FACEMIME_MAX_MODEL_BYTES",
+        ):
             load(path)
 
 
-@pytest.mark.parametrize(("variable", "what", "count"), [("FACEMIME_MAX_VERTICES", "vertices", 120),
-                                                         ("FACEMIME_MAX_TRIANGLES", "triangles", None)])
+@pytest.mark.parametrize(
+    ("variable", "what", "count"),
+    [("FACEMIME_MAX_VERTICES", "vertices", 120), ("FACEMIME_MAX_TRIANGLES", "triangles", None)],
+)
 def test_head_documents_over_a_limit_are_refused(tmp_path, monkeypatch, variable, what, count):
     doc = head_document(generic_head())
     count = count or len(doc["triangles"])
@@ -117,7 +123,7 @@ def test_table_parsing_keeps_the_line_by_line_checks(tmp_path):
     with pytest.raises(ModelFormatError, match="VERTEX LIST, line 3: expected 3 numbers, got '0 0 0 1'"):
         load_wfm(path)
     path.write_text("# VERTEX LIST:\n3\n0 0 0\n1 0 0\n0 1 0\n# FACE LIST:\n1\n0 1 2.0\n")
-    with pytest.raises(ModelFormatError, match="FACE LIST, line 8: expected 3 integers, got '0 1 2.0'"):
+    with pytest.raises(ModelFormatError, match=r"FACE LIST, line 8: expected 3 integers, got '0 1 2.0'"):
         load_wfm(path)
 
 
@@ -125,10 +131,13 @@ def test_many_deformation_units_on_many_vertices_are_refused(tmp_path, monkeypat
     doc = head_document(generic_head())
     doc["deformation_units"] = {f"u{k}": {"description": "", "displacements": []} for k in range(50)}
     monkeypatch.setenv("FACEMIME_MAX_UNIT_VALUES", str(50 * len(doc["vertices"]) - 1))
-    with pytest.raises(ModelFormatError, match="deformation unit values .* more than the limit"):
+    with pytest.raises(ModelFormatError, match=r"deformation unit values .* more than the limit"):
         head_from_document(doc, "many units")
-    grid = grid_wfm(tmp_path / "grid.wfm", 4).read_text().replace(
-        "# END OF FILE:", "# ANIMATION UNITS LIST:\n3\n# a\n0\n# b\n0\n# c\n0\n# END OF FILE:")
+    grid = (
+        grid_wfm(tmp_path / "grid.wfm", 4)
+        .read_text()
+        .replace("# END OF FILE:", "# ANIMATION UNITS LIST:\n3\n# a\n0\n# b\n0\n# c\n0\n# END OF FILE:")
+    )
     (tmp_path / "units.wfm").write_text(grid)
     monkeypatch.setenv("FACEMIME_MAX_UNIT_VALUES", "47")
     with pytest.raises(ModelFormatError, match="48 deformation unit values"):

@@ -40,8 +40,11 @@ def test_deforming_candide_with_units_and_shape(candide_path):
         ("# VERTEX LIST:\n3\n0 0 0\n1 0 0\n0 1 0\n# FACE LIST:\n1\n0 1 7\n", "uses vertex 7, but there are 3 vertices"),
         ("# VERTEX LIST:\n3\n0 0 0\n1 0 x\n0 1 0\n# FACE LIST:\n1\n0 1 2\n", "line 4: expected 3 numbers, got '1 0 x'"),
         ("# VERTEX LIST:\n3\n0 0 0\n1 0 0\n2 0 0\n# FACE LIST:\n1\n0 1 2\n", "degenerate"),
-        ("# VERTEX LIST:\n3\n0 0 0\n1 0 0\n0 1 0\n# FACE LIST:\n1\n0 1 2\n# ANIMATION UNITS LIST:\n1\n# up\n1\n9 0 1 0\n",
-         "unit 'up' names vertex 9"),
+        (
+            "# VERTEX LIST:\n3\n0 0 0\n1 0 0\n0 1 0\n# FACE LIST:\n1\n0 1 2\n"
+            "# ANIMATION UNITS LIST:\n1\n# up\n1\n9 0 1 0\n",
+            "unit 'up' names vertex 9",
+        ),
     ],
 )
 def test_malformed_wfm_is_refused_with_file_and_line(tmp_path, text, message):

@@ -35,9 +35,14 @@ def mesh_of(name):
 
 def plane(x, y):
     """A smooth textured plane, RGB float in 38..218, known at any (x, y): the key frame's truth."""
-    return np.stack([128 + 50 * np.sin(x / 9.0) + 40 * np.cos(y / 11.0),
-                     128 + 60 * np.sin((x + y) / 13.0),
-                     128 + 45 * np.cos(x / 7.0 - y / 10.0)], axis=-1)
+    return np.stack(
+        [
+            128 + 50 * np.sin(x / 9.0) + 40 * np.cos(y / 11.0),
+            128 + 60 * np.sin((x + y) / 13.0),
+            128 + 45 * np.cos(x / 7.0 - y / 10.0),
+        ],
+        axis=-1,
+    )
 
 
 #: The plane's steepest slope, grey levels per pixel (its third channel's).
@@ -85,22 +90,22 @@ def check_topology(mesh):
     for y in (-0.5, h - 0.5):
         assert (p[border, 1] == y).sum() == BORDER_STEPS
     # rings: inside the picture, kept EDGE_MARGIN of its shorter side away from its edges
-    rings = p[len(mesh.anchors):-n]
+    rings = p[len(mesh.anchors) : -n]
     margin = EDGE_MARGIN * min(w, h)
     assert ((rings > -0.5 + margin) & (rings < [w - 0.5 - margin, h - 0.5 - margin])).all()
-    assert set(mesh.follow[len(mesh.anchors):-n]) <= {share for _, share in RINGS}
-    assert (mesh.follow[:len(mesh.anchors)] == 1).all()
+    assert set(mesh.follow[len(mesh.anchors) : -n]) <= {share for _, share in RINGS}
+    assert (mesh.follow[: len(mesh.anchors)] == 1).all()
 
 
 @pytest.mark.parametrize("name", list(PLACEMENTS))
 def test_the_mesh_covers_the_picture_once_wound_like_the_face(name):
     mesh, outline = mesh_of(name)
     check_topology(mesh)
-    np.testing.assert_array_equal(mesh.rest[:len(outline)], outline)
+    np.testing.assert_array_equal(mesh.rest[: len(outline)], outline)
     np.testing.assert_array_equal(mesh.anchors, np.arange(100, 118))
     # every ring vertex that fits is there: all around a face in the middle, fewer near an edge
     rings = len(mesh.rest) - len(outline) - 4 * (BORDER_STEPS - 1)
-    first = (mesh.follow[len(outline):] == 1).sum()
+    first = (mesh.follow[len(outline) :] == 1).sum()
     if name in WHOLE:
         assert first == len(outline) and rings == len(RINGS) * len(outline)
     else:
@@ -154,7 +159,7 @@ def test_a_shifted_face_moves_its_surround_and_leaves_the_border(name):
     outline = ellipse(centre, axes)
     mesh = SceneMesh.build(size, np.arange(len(outline)), outline)
     outermost = np.zeros(len(mesh.rest), bool)
-    outermost[len(RINGS) * len(outline):(len(RINGS) + 1) * len(outline)] = True
+    outermost[len(RINGS) * len(outline) : (len(RINGS) + 1) * len(outline)] = True
     assert (mesh.follow[outermost] == RINGS[-1][1]).all()
     key = key_frame(size)
     out = np.full_like(key, 255)
@@ -211,8 +216,9 @@ def test_bad_input_is_refused():
         mesh.draw(np.zeros((240, 320, 3), np.uint8), np.zeros((240, 300, 3), np.uint8), outline)
 
 
-@pytest.mark.parametrize("centre, axes", [((100, 230), (40, 60)), ((-10, 100), (40, 60)), ((100, 120), (150, 190)),
-                                          ((100, 120), (0, 0))])
+@pytest.mark.parametrize(
+    "centre, axes", [((100, 230), (40, 60)), ((-10, 100), (40, 60)), ((100, 120), (150, 190)), ((100, 120), (0, 0))]
+)
 def test_a_face_cut_by_the_picture_edge_or_degenerate_still_makes_a_whole_picture(centre, axes):
     """A face whose outline reaches past the picture (a chin below its bottom edge, a face half
     out, a face larger than the picture) or collapses to a point still gives a mesh that covers

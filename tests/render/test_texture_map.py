@@ -18,8 +18,16 @@ def exact_bilinear(tex, s):
     x0, y0 = np.floor(s[:, 0]).astype(int), np.floor(s[:, 1]).astype(int)
     fx, fy = (s[:, 0] - x0)[:, None], (s[:, 1] - y0)[:, None]
     h, w = tex.shape[:2]
-    at = lambda x, y: tex[np.clip(y, 0, h - 1), np.clip(x, 0, w - 1)].astype(float)
-    return (1 - fx) * (1 - fy) * at(x0, y0) + fx * (1 - fy) * at(x0 + 1, y0) + (1 - fx) * fy * at(x0, y0 + 1) + fx * fy * at(x0 + 1, y0 + 1)
+
+    def at(x, y):
+        return tex[np.clip(y, 0, h - 1), np.clip(x, 0, w - 1)].astype(float)
+
+    return (
+        (1 - fx) * (1 - fy) * at(x0, y0)
+        + fx * (1 - fy) * at(x0 + 1, y0)
+        + (1 - fx) * fy * at(x0, y0 + 1)
+        + fx * fy * at(x0 + 1, y0 + 1)
+    )
 
 
 def grid_mesh(nx, ny, x0, y0, dx, dy):
@@ -120,15 +128,24 @@ def test_nose_hides_cheek_in_profile():
 
 def test_gray_texture_gives_gray_image_and_background_image_is_kept():
     bg = np.full((20, 20), 7, np.uint8)
-    img = render_mesh(np.full((3, 3), 99, np.uint8), [[0, 0], [1, 0], [0, 1]], [[1.0, 1], [1, 15], [15, 1]],
-                      np.zeros(3), [[0, 1, 2]], (20, 20), background=bg)
+    img = render_mesh(
+        np.full((3, 3), 99, np.uint8),
+        [[0, 0], [1, 0], [0, 1]],
+        [[1.0, 1], [1, 15], [15, 1]],
+        np.zeros(3),
+        [[0, 1, 2]],
+        (20, 20),
+        background=bg,
+    )
     assert img.shape == (20, 20) and img[3, 3] == 99 and img[18, 18] == 7
     assert (bg == 7).all()
 
 
 def test_triangles_outside_the_image_are_clipped():
     pts = np.array([[-1e6, -1e6], [-1e6, 1e6], [1e6, 0.0], [500.0, 500], [500, 600], [600, 500]])
-    img = render_mesh(np.full((2, 2), 50, np.uint8), np.zeros((6, 2)), pts, np.zeros(6), [[0, 1, 2], [3, 4, 5]], (16, 12))
+    img = render_mesh(
+        np.full((2, 2), 50, np.uint8), np.zeros((6, 2)), pts, np.zeros(6), [[0, 1, 2], [3, 4, 5]], (16, 12)
+    )
     assert (img == 50).all()
 
 
@@ -142,22 +159,28 @@ def test_zero_area_triangles_are_skipped():
 @pytest.mark.parametrize(
     ("change", "message"),
     [
-        (dict(points=np.array([[np.nan, 0], [1, 0], [0, 1]])), "points must be finite"),
-        (dict(points=np.zeros((3, 3))), r"points must have shape \(N, 2\)"),
-        (dict(triangles=[[0, 1, 5]]), "index 5 is out of range for 3 vertices"),
-        (dict(triangles=[[0, 1, -1]]), "index -1 is out of range"),
-        (dict(triangles=[[0.0, 1.0, 2.0]]), "integer indices"),
-        (dict(depth=np.zeros(2)), r"depth must have shape \(3,\)"),
-        (dict(texture=np.zeros((4, 4, 3), np.float32)), "texture must be a uint8 numpy array"),
-        (dict(size=(100_000, 100_000)), "too large"),
-        (dict(size=(0, 10)), "must be positive"),
-        (dict(filter="cubic"), "filter must be one of 'nearest', 'bilinear'"),
-        (dict(background=(1, 2)), "one value per texture channel"),
+        ({"points": np.array([[np.nan, 0], [1, 0], [0, 1]])}, "points must be finite"),
+        ({"points": np.zeros((3, 3))}, r"points must have shape \(N, 2\)"),
+        ({"triangles": [[0, 1, 5]]}, "index 5 is out of range for 3 vertices"),
+        ({"triangles": [[0, 1, -1]]}, "index -1 is out of range"),
+        ({"triangles": [[0.0, 1.0, 2.0]]}, "integer indices"),
+        ({"depth": np.zeros(2)}, r"depth must have shape \(3,\)"),
+        ({"texture": np.zeros((4, 4, 3), np.float32)}, "texture must be a uint8 numpy array"),
+        ({"size": (100_000, 100_000)}, "too large"),
+        ({"size": (0, 10)}, "must be positive"),
+        ({"filter": "cubic"}, "filter must be one of 'nearest', 'bilinear'"),
+        ({"background": (1, 2)}, "one value per texture channel"),
     ],
 )
 def test_bad_input_is_refused_with_a_message(change, message):
-    args = dict(texture=np.zeros((4, 4, 3), np.uint8), tex_coords=np.zeros((3, 2)), points=np.array([[0.0, 0], [1, 0], [0, 1]]),
-                depth=np.zeros(3), triangles=[[0, 1, 2]], size=(8, 8))
+    args = {
+        "texture": np.zeros((4, 4, 3), np.uint8),
+        "tex_coords": np.zeros((3, 2)),
+        "points": np.array([[0.0, 0], [1, 0], [0, 1]]),
+        "depth": np.zeros(3),
+        "triangles": [[0, 1, 2]],
+        "size": (8, 8),
+    }
     args.update(change)
     with pytest.raises(InvalidInputError, match=message):
         render_mesh(**args)
@@ -171,7 +194,9 @@ def test_empty_mesh_is_refused():
 def test_render_into_a_non_contiguous_or_readonly_image_is_refused():
     out = np.zeros((8, 8, 3), np.uint8)[:, ::2]
     with pytest.raises(InvalidInputError, match="C-contiguous"):
-        render_mesh_into(out, np.zeros((2, 2, 3), np.uint8), np.zeros((3, 2)), np.zeros((3, 2)), np.zeros(3), [[0, 1, 2]])
+        render_mesh_into(
+            out, np.zeros((2, 2, 3), np.uint8), np.zeros((3, 2)), np.zeros((3, 2)), np.zeros(3), [[0, 1, 2]]
+        )
 
 
 @pytest.mark.parametrize("shape, colour", [((5, 7, 3), (38, 40, 46)), ((5, 7, 4), (1, 2, 3, 255)), ((5, 7), 9)])

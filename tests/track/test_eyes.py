@@ -4,27 +4,27 @@ known looks, and blinks on a real video."""
 import numpy as np
 import pytest
 
+from facemime.animate.analysis import Analysis
 from facemime.animate.deform import Deformer
 from facemime.animate.look import Look
 from facemime.animate.synth import Puppet
 from facemime.fit.actor import generic_actor
 from facemime.fit.placement import model_iod
 from facemime.io.video import VideoReader
-from facemime.animate.analysis import Analysis
 from facemime.track.eyes import DENSITY, SPAN_U, SPAN_V, EyeFrame, EyeTracker, find_iris
 
 
 def drawn_eye(iris_uv: tuple[float, float]) -> np.ndarray:
     """An eye patch as :meth:`EyeFrame.patch` gives it: skin, a white almond opening between
     lids at v = ±0.18, a dark iris disc of radius 0.21 centred at ``iris_uv``."""
-    cols = int(round((SPAN_U[1] - SPAN_U[0]) * DENSITY)) + 1
-    rows = int(round((SPAN_V[1] - SPAN_V[0]) * DENSITY)) + 1
+    cols = round((SPAN_U[1] - SPAN_U[0]) * DENSITY) + 1
+    rows = round((SPAN_V[1] - SPAN_V[0]) * DENSITY) + 1
     u = SPAN_U[0] + np.arange(cols) / DENSITY
     v = SPAN_V[0] + np.arange(rows)[:, None] / DENSITY
     patch = np.full((rows, cols), 150.0, np.float32)
     opening = np.abs(v) <= 0.18 * (1 - (u / 0.5) ** 2)
     patch[opening] = 225.0
-    iris = ((u - iris_uv[0]) ** 2 + (v - iris_uv[1]) ** 2 <= 0.21 ** 2) & opening
+    iris = ((u - iris_uv[0]) ** 2 + (v - iris_uv[1]) ** 2 <= 0.21**2) & opening
     patch[iris] = 60.0
     return patch
 
@@ -37,8 +37,9 @@ def test_the_iris_is_found_on_a_drawn_eye(iris):
 
 
 def test_eye_frames_map_both_ways():
-    frame = EyeFrame.of(np.array([[100, 50], [110, 45], [120, 44], [130, 45], [140, 50], [130, 55], [120, 56],
-                                  [110, 55]], float))
+    frame = EyeFrame.of(
+        np.array([[100, 50], [110, 45], [120, 44], [130, 45], [140, 50], [130, 55], [120, 56], [110, 55]], float)
+    )
     assert frame.width == pytest.approx(40.0)
     assert np.allclose(frame.to_image([0.0, 0.0]), [120, 50])
     assert np.allclose(frame.to_image([0.5, 0.25]), [140, 60])  # v points down the screen

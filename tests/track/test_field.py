@@ -72,7 +72,7 @@ def test_a_field_read_inside_its_bands_is_that_of_a_box_grown_far_beyond_them(fr
 
 
 def test_a_reused_buffer_gets_the_same_field_whatever_it_held(frames):
-    prev, frame = frames
+    _prev, frame = frames
     box, bands = (150, 200, 400, 480), [(0, 210, 512, 260), (220, 400, 330, 470)]
     want = build_field(frame, None, box, 1.5, bands)
     buffer = np.full((280, 250, 6), np.nan, np.float32)

@@ -17,8 +17,13 @@ def frame_pair(shared):
     with VideoReader(shared / "video" / "lp_d3.mp4") as reader:
         gray = cv2.cvtColor(next(iter(reader)), cv2.COLOR_RGB2GRAY)
     shift = np.array([3.4, -2.7])
-    moved = cv2.warpAffine(gray, np.float64([[1, 0, shift[0]], [0, 1, shift[1]]]), gray.shape[::-1],
-                           flags=cv2.INTER_CUBIC, borderMode=cv2.BORDER_REFLECT_101)
+    moved = cv2.warpAffine(
+        gray,
+        np.float64([[1, 0, shift[0]], [0, 1, shift[1]]]),
+        gray.shape[::-1],
+        flags=cv2.INTER_CUBIC,
+        borderMode=cv2.BORDER_REFLECT_101,
+    )
     corners = cv2.goodFeaturesToTrack(gray, 80, 0.01, 8).reshape(-1, 2).astype(float)
     inner = np.all((corners > 40) & (corners < np.array(gray.shape[::-1]) - 40), axis=1)
     return gray, moved, shift, corners[inner]
@@ -48,8 +53,9 @@ def test_agrees_with_opencv_on_real_frames(shared):
     a, b = frames[0], frames[3]
     pts = cv2.goodFeaturesToTrack(a, 100, 0.01, 6).reshape(-1, 2)
     crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, ITERATIONS, EPSILON)
-    theirs, st, _ = cv2.calcOpticalFlowPyrLK(a, b, pts.reshape(-1, 1, 2), None, winSize=(WINDOW, WINDOW),
-                                             maxLevel=LEVELS, criteria=crit)
+    theirs, st, _ = cv2.calcOpticalFlowPyrLK(
+        a, b, pts.reshape(-1, 1, 2), None, winSize=(WINDOW, WINDOW), maxLevel=LEVELS, criteria=crit
+    )
     flow = FrameFlow()
     flow.push(a, whole(a))
     flow.push(b, whole(b))
@@ -61,7 +67,7 @@ def test_agrees_with_opencv_on_real_frames(shared):
 
 
 def test_points_outside_the_crop_or_not_finite_are_refused(frame_pair):
-    gray, moved, _, pts = frame_pair
+    gray, moved, _, _pts = frame_pair
     h, w = gray.shape
     flow = FrameFlow()
     flow.push(gray, (0, 0, w // 2, h))

@@ -80,7 +80,7 @@ def test_lips_left_behind_by_the_flow_as_the_mouth_opens_on_teeth_are_moved_to_t
     # from the colour edge, which on a closed mouth is the line where the lips met
     assert _error(knots[34:43], truth["mouth_inner_lower"]) < 6.0
     for k, name in ((1, "mouth_outer_lower"), (2, "mouth_inner_upper")):  # left on their edges
-        np.testing.assert_array_equal(knots[11 * k:11 * (k + 1)], truth[name])
+        np.testing.assert_array_equal(knots[11 * k : 11 * (k + 1)], truth[name])
 
 
 def test_the_inner_lips_follow_a_real_mouth_opening_wide_on_teeth(shared):
@@ -101,7 +101,9 @@ def test_the_inner_lips_follow_a_real_mouth_opening_wide_on_teeth(shared):
     errors = []
     for i, frame in enumerate(frames[1:], 1):
         contours = tracker.update(frame).contours
-        errors.append(group_nme(contours, reference_contours(z["landmarks"][i]), GROUPS["mouth_inner"], float(z["iod"][i])))
+        errors.append(
+            group_nme(contours, reference_contours(z["landmarks"][i]), GROUPS["mouth_inner"], float(z["iod"][i]))
+        )
     assert np.mean(errors) < 0.045 and np.mean(np.array(errors) > 0.10) < 0.05
 
 

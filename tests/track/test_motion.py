@@ -28,8 +28,9 @@ def test_robust_similarity_recovers_the_motion_despite_gross_outliers():
     rng = np.random.default_rng(3)
     src = rng.uniform(100, 300, (40, 2))
     angle, scale = np.radians(4.0), 1.05
-    truth = np.array([[scale * np.cos(angle), -scale * np.sin(angle), 7.5],
-                      [scale * np.sin(angle), scale * np.cos(angle), -3.0]])
+    truth = np.array(
+        [[scale * np.cos(angle), -scale * np.sin(angle), 7.5], [scale * np.sin(angle), scale * np.cos(angle), -3.0]]
+    )
     dst = apply(truth, src) + rng.normal(0.0, 0.1, src.shape)
     bad = rng.choice(40, 12, replace=False)  # 30 % of the points jump 5-40 px
     dst[bad] += rng.uniform(5, 40, (12, 2)) * rng.choice([-1, 1], (12, 2))
@@ -86,7 +87,9 @@ def test_points_keep_their_identity_while_followed_and_new_ones_get_new_ones(sha
     found_again = 0
     for t in range(1, len(frames)):
         before = set(head.ids.tolist())
-        _, _, moved = head.update(frames[t], head.brow_points(from_face_mesh(lm[t - 1])), extra=lm[t - 1][NOSE_BRIDGE, :2])
+        _, _, moved = head.update(
+            frames[t], head.brow_points(from_face_mesh(lm[t - 1])), extra=lm[t - 1][NOSE_BRIDGE, :2]
+        )
         followed = head.followed[1].tolist()
         assert set(followed) <= before
         assert moved.shape == (len(NOSE_BRIDGE), 2)
@@ -120,13 +123,19 @@ def test_the_corners_found_in_the_rigid_zones_are_opencvs(shared):
     head = HeadMotion(frames[0], from_face_mesh(lm[0]))
     for t in range(1, len(frames)):
         head.update(frames[t], head.brow_points(from_face_mesh(lm[t - 1])))
-        zones = head._head.zones  # noqa: SLF001 - the zones the detector searches
-        x0, y0, x1, y1 = head._zones_box(zones, frames[t].shape, DETECT_MARGIN)  # noqa: SLF001
+        zones = head._head.zones
+        x0, y0, x1, y1 = head._zones_box(zones, frames[t].shape, DETECT_MARGIN)
         mask = np.zeros((y1 - y0, x1 - x0), np.uint8)
         for poly in zones:
             cv2.fillConvexPoly(mask, np.round(poly - [x0, y0]).astype(np.int32), 255)
-        theirs = cv2.goodFeaturesToTrack(frames[t][y0:y1, x0:x1], head._max_points, QUALITY,  # noqa: SLF001
-                                         head._min_distance, mask=mask, blockSize=CORNER_BLOCK)  # noqa: SLF001
-        ours = head._detect(zones)  # noqa: SLF001
+        theirs = cv2.goodFeaturesToTrack(
+            frames[t][y0:y1, x0:x1],
+            head._max_points,
+            QUALITY,
+            head._min_distance,
+            mask=mask,
+            blockSize=CORNER_BLOCK,
+        )
+        ours = head._detect(zones)
         assert ours.dtype == np.float32 and len(ours) > 20
         np.testing.assert_array_equal(ours, theirs.reshape(-1, 2) + [x0, y0])

@@ -68,12 +68,21 @@ def test_follows_a_mouth_pushed_sideways_in_a_real_video(shared):
     worst = {0.5: [], 0.0: []}
     for seed in range(5):
         rng = np.random.default_rng(seed)
-        start = {n: c + (rng.normal(0.0, 0.2, c.shape) if seed else 0.0)
-                 for n, c in reference_contours(z["landmarks"][545]).items()}
+        start = {
+            n: c + (rng.normal(0.0, 0.2, c.shape) if seed else 0.0)
+            for n, c in reference_contours(z["landmarks"][545]).items()
+        }
         for patch, out in worst.items():
             tracker = Tracker(frames[0], start, TrackerParams(mouth_patch=patch))
-            errors = [group_nme(tracker.update(frame).contours, reference_contours(z["landmarks"][i]),
-                                GROUPS["mouth_outer"], float(z["iod"][i])) for i, frame in enumerate(frames[1:], 546)]
+            errors = [
+                group_nme(
+                    tracker.update(frame).contours,
+                    reference_contours(z["landmarks"][i]),
+                    GROUPS["mouth_outer"],
+                    float(z["iod"][i]),
+                )
+                for i, frame in enumerate(frames[1:], 546)
+            ]
             out.append(max(errors))
     assert np.mean(worst[0.5]) < np.mean(worst[0.0]) - 0.015 and min(worst[0.0]) > 0.095, worst
 

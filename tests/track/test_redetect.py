@@ -109,7 +109,9 @@ def test_an_automatic_start_reports_the_mean_of_the_landmark_passes(shared):
     means = {}
     for calibrate in (True, False):
         tracker = FaceTracker(frames[0], redetection=Redetection(calibrate=calibrate))
-        errors = [group_nme(tracker.update(f).contours, refs[i], GROUPS["brows"], iods[i])
-                  for i, f in enumerate(frames[1:], 1)]
+        errors = [
+            group_nme(tracker.update(f).contours, refs[i], GROUPS["brows"], iods[i])
+            for i, f in enumerate(frames[1:], 1)
+        ]
         means[calibrate] = np.mean(errors[60:])  # after two checks
     assert means[True] < 0.031 and means[True] < means[False] - 0.006, means

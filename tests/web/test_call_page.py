@@ -14,9 +14,23 @@ from facemime.codec.stream import MotionDecoder
 
 def test_two_pages_receive_a_live_call_one_of_them_losing_packets(browser, shared, tmp_path):
     record = tmp_path / "call.fmstream"
-    proc = subprocess.Popen([sys.executable, "-m", "facemime", "call", str(shared / "video" / "mt_yongen.mp4"),
-                             "--port", "0", "--no-browser", "--record", str(record)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "facemime",
+            "call",
+            str(shared / "video" / "mt_yongen.mp4"),
+            "--port",
+            "0",
+            "--no-browser",
+            "--record",
+            str(record),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         url = proc.stdout.readline().strip()
         assert url.startswith("http://127.0.0.1:"), proc.stderr.read()
@@ -27,8 +41,14 @@ def test_two_pages_receive_a_live_call_one_of_them_losing_packets(browser, share
         assert proc.returncode == 0, err
         for page in (whole, lossy):
             page.wait_for_function("() => document.getElementById('message').textContent.includes('ended')")
-        got = {name: (page.evaluate("() => window.facemime.frames"), page.evaluate("() => window.facemime.stats()"),
-                      page.inner_text("#hud")) for name, page in (("whole", whole), ("lossy", lossy))}
+        got = {
+            name: (
+                page.evaluate("() => window.facemime.frames"),
+                page.evaluate("() => window.facemime.stats()"),
+                page.inner_text("#hud"),
+            )
+            for name, page in (("whole", whole), ("lossy", lossy))
+        }
     finally:
         if proc.poll() is None:
             proc.kill()
@@ -38,8 +58,11 @@ def test_two_pages_receive_a_live_call_one_of_them_losing_packets(browser, share
 
     def same(shown: dict, f) -> bool:
         v = np.array(shown["values"])
-        return ((shown["index"], shown["face"]) == (f.index, f.face) and pose_from_vector(v[:6]) == f.pose
-                and np.array_equal(decoder.info.basis.offsets(v[6:6 + m]), f.offsets))
+        return (
+            (shown["index"], shown["face"]) == (f.index, f.face)
+            and pose_from_vector(v[:6]) == f.pose
+            and np.array_equal(decoder.info.basis.offsets(v[6 : 6 + m]), f.offsets)
+        )
 
     frames, stats, hud = got["whole"]
     brief = {k: stats.get(k) for k in ("drawn", "dropped", "lost_packets", "concealed", "intraRequests", "setupMs")}

@@ -32,7 +32,7 @@ def stream(shared, tmp_path_factory):
 def psnr(a: np.ndarray, b: np.ndarray) -> float:
     """PSNR, dB, of two RGB uint8 pictures over all their channels."""
     mse = np.mean((a.astype(np.float64) - b) ** 2)
-    return 10 * np.log10(255 ** 2 / mse) if mse > 0 else float("inf")
+    return 10 * np.log10(255**2 / mse) if mse > 0 else float("inf")
 
 
 def load(page, receiver: Path, data: bytes) -> list[dict]:
@@ -54,7 +54,7 @@ def python_picture(decoder: MotionDecoder, frames: list, index: int) -> np.ndarr
     w, h = decoder.info.size
     image = np.empty((h, w, 3), np.uint8)
     updates = Appearance(actor.texture, decoder.appearance, decoder.appearance_after)
-    for f in frames[:index + 1]:
+    for f in frames[: index + 1]:
         if updates.due(f.index):
             puppet.retexture(updates.texture)
     f = frames[index]
@@ -71,8 +71,8 @@ def test_the_page_decodes_every_parameter_of_a_real_stream_exactly(page, receive
         assert (got["index"], got["face"], got["concealed"]) == (f.index, f.face, f.concealed)
         v = np.array(got["values"])
         assert pose_from_vector(v[:6]) == f.pose, f.index
-        assert np.array_equal(decoder.info.basis.offsets(v[6:6 + m]), f.offsets), f.index
-        assert np.array_equal(look_from_extras(decoder.info.extras, v[6 + m:]).vector(), f.look.vector()), f.index
+        assert np.array_equal(decoder.info.basis.offsets(v[6 : 6 + m]), f.offsets), f.index
+        assert np.array_equal(look_from_extras(decoder.info.extras, v[6 + m :]).vector(), f.look.vector()), f.index
 
 
 def test_the_pages_picture_matches_the_python_decoders(page, receiver_page, stream):
@@ -96,10 +96,13 @@ def test_a_file_chosen_on_the_page_plays_and_a_bad_one_is_refused_in_a_line(page
     bad.write_bytes(b"not a stream at all" * 50)
     page.goto(receiver_page.as_uri())
     page.set_input_files("#file", str(bad))
-    page.wait_for_function("() => !document.getElementById('message').hidden "
-                           "&& document.getElementById('message').textContent.startsWith('cannot play')")
+    page.wait_for_function(
+        "() => !document.getElementById('message').hidden "
+        "&& document.getElementById('message').textContent.startsWith('cannot play')"
+    )
     assert "junk.fmstream: this is not a facemime stream" in page.inner_text("#message")
     page.set_input_files("#file", str(good))
-    page.wait_for_function(f"() => window.facemime.frames.length === {len(frames)} && "
-                           "window.facemime.stats().drawn > 10")
+    page.wait_for_function(
+        f"() => window.facemime.frames.length === {len(frames)} && window.facemime.stats().drawn > 10"
+    )
     assert page.is_hidden("#message")

@@ -74,11 +74,19 @@ def walk(rng, frames: int, look: bool):
     names = list(FEATURES)
     out = []
     for i in range(frames):
-        pose = Pose(yaw=yaw[i], pitch=4 * np.cos(t[i] / 9), roll=t[i] / 40, scale=2.0 * np.exp(t[i] / 3000),
-                    tx=tx[i], ty=240 - t[i] / 4)
+        pose = Pose(
+            yaw=yaw[i],
+            pitch=4 * np.cos(t[i] / 9),
+            roll=t[i] / 40,
+            scale=2.0 * np.exp(t[i] / 3000),
+            tx=tx[i],
+            ty=240 - t[i] / 4,
+        )
         closure = 1.0 if i % 47 == 20 else 0.2 * np.sin(t[i] / 6)
-        lk = Look(np.array([closure, closure - (0.4 if 60 <= i % 100 < 64 else 0.0)]),
-                  np.array([[0.1 * np.sin(t[i] / 5), 0.03], [0.1 * np.sin(t[i] / 5), -0.02 * np.cos(t[i] / 4)]]))
+        lk = Look(
+            np.array([closure, closure - (0.4 if 60 <= i % 100 < 64 else 0.0)]),
+            np.array([[0.1 * np.sin(t[i] / 5), 0.03], [0.1 * np.sin(t[i] / 5), -0.02 * np.cos(t[i] / 4)]]),
+        )
         lost = [names[(i // 13) % 4]] if i % 13 == 5 else []
         out.append((i % 50 not in (17, 18, 19), lost, pose, np.tensordot(amps[i], modes, 1), lk if look else None))
     return out
@@ -91,8 +99,7 @@ def stream(actor, seed: int, frames: int, look: bool, carry: bool, settings: Set
     motion = walk(rng, frames, look)
     basis = Basis.learn(np.array([m[3] for m in motion]), settings.basis_size)
     n = 6 + len(basis.raw) + (6 if look else 0)
-    enc = MotionEncoder(actor, FPS, (640, 480), basis, settings, carry, classes=list(rng.integers(0, 16, n)),
-                        look=look)
+    enc = MotionEncoder(actor, FPS, (640, 480), basis, settings, carry, classes=list(rng.integers(0, 16, n)), look=look)
     chunks = [enc.header] + ([_core.actor_chunk(enc.actor_data)] if carry else [])
     for i, (face, lost, pose, offsets, lk) in enumerate(motion):
         if i in intra_at:
@@ -142,11 +149,11 @@ def mutate(data: bytes, rng, edits: int, start: int) -> bytes:
         if how == "flip":
             b[i] ^= int(rng.integers(1, 256))
         elif how == "drop":
-            del b[i:i + int(rng.integers(1, 40))]
+            del b[i : i + int(rng.integers(1, 40))]
         elif how == "insert":
             b[i:i] = bytes(rng.integers(0, 256, int(rng.integers(1, 30))).astype(np.uint8))
         else:
-            del b[max(i, len(b) - 200):]
+            del b[max(i, len(b) - 200) :]
     return bytes(b)
 
 
@@ -157,7 +164,7 @@ def python_decode(data: bytes, piece: int, from_start: bool, actor):
     frames = []
     step = piece or max(len(data), 1)
     for at in range(0, len(data), step):
-        frames += dec.push(data[at:at + step])
+        frames += dec.push(data[at : at + step])
     frames += dec.finish()
     return dec, rec, frames
 
@@ -202,14 +209,15 @@ def compare(cli, actor, data: bytes, piece: int = 0, from_start: bool = True, on
     got = [(f["index"], f["face"], f["lost"], f["values"], f["concealed"]) for f in lines if f["kind"] == "frame"]
     want = expected_values(rec.calls)
     # the replica of MotionDecoder's ordering and concealment is MotionDecoder's
-    assert [(f.index, f.face, lost_bits(f.lost), f.concealed) for f in frames] == [(w[0], w[1], w[2], w[4])
-                                                                                    for w in want]
+    assert [(f.index, f.face, lost_bits(f.lost), f.concealed) for f in frames] == [
+        (w[0], w[1], w[2], w[4]) for w in want
+    ]
     assert all(pose_from_vector(np.array(w[3][:6])) == f.pose for f, w in zip(frames, want))
     if one_header and dec.info is not None:
         m = len(dec.info.basis.raw)
         for f, w in zip(frames, want):
-            assert np.array_equal(dec.info.basis.offsets(np.array(w[3][6:6 + m])), f.offsets)
-            look = look_from_extras(dec.info.extras, np.array(w[3][6 + m:])) if dec.info.extras else Look()
+            assert np.array_equal(dec.info.basis.offsets(np.array(w[3][6 : 6 + m])), f.offsets)
+            look = look_from_extras(dec.info.extras, np.array(w[3][6 + m :])) if dec.info.extras else Look()
             assert np.array_equal(look.vector(), f.look.vector())
     # and the web decoder's frames are those, every value bit for bit
     assert len(got) == len(want)
@@ -233,7 +241,7 @@ def streams(actor):
     assert v1[0][9] == 1 and v2[0][9] == 2 and v2b[0][9] == 2  # the header's version byte
     assert kind(v1[1]) == 2 and kind(v2[1]) == 3
     assert v2[0][3] & 0x80 and not v2[0][4] & 0x80  # a two-byte length: the payload starts at 5
-    k = int.from_bytes(v2[0][5 + 26:5 + 28], "little")  # the header's K
+    k = int.from_bytes(v2[0][5 + 26 : 5 + 28], "little")  # the header's K
     off_grid = [int.from_bytes(c[1:3], "little") for c in v2 if kind(c) == 3 and int.from_bytes(c[1:3], "little") % k]
     assert len(off_grid) >= 2  # intra packets the sender was asked for
     return {"v1": v1, "v2": v2, "v2b": v2b}
@@ -257,13 +265,13 @@ def test_appearance_chunks_come_out_in_the_same_places(cli, actor, streams, name
     chunks = with_appearance(streams[name])
     assert compare(cli, actor, b"".join(chunks), piece)["appearance"] > 10
     # one damaged, one too short, one before the header: not passed on, counted
-    damaged = [c for c in chunks]
+    damaged = list(chunks)
     at = next(i for i, c in enumerate(chunks) if kind(c) == 5)
     damaged[at] = flip(damaged[at], np.random.default_rng(0), 1, 9)
     damaged.insert(at + 3, bytes([5 << 5, 0, 0, 7]) + bytes(7))  # a bad CRC anyway
     short = b"\xa0\x00\x00\x07" + bytes(7)
     short += zlib.crc32(short).to_bytes(4, "little")
-    stats = compare(cli, actor, appearance(0, 1) + b"".join(damaged[:at + 5] + [short] + damaged[at + 5:]), piece)
+    stats = compare(cli, actor, appearance(0, 1) + b"".join(damaged[: at + 5] + [short] + damaged[at + 5 :]), piece)
     assert stats["undecodable"] == 2 and stats["damaged_runs"] >= 2
 
 
@@ -276,7 +284,7 @@ def test_lost_packets(cli, actor, streams, name, piece):
     stats = compare(cli, actor, b"".join(c for i, c in enumerate(chunks) if i not in drop), piece or 1000)
     assert stats["lost_packets"] == len(drop) - 1 and stats["concealed"] > 0
     # the first packets lost: the reference pose until the first intra packet
-    stats = compare(cli, actor, b"".join(chunks[:first] + chunks[first + 3:]), piece)
+    stats = compare(cli, actor, b"".join(chunks[:first] + chunks[first + 3 :]), piece)
     assert stats["concealed"] > 0
 
 
@@ -284,7 +292,7 @@ def test_lost_packets(cli, actor, streams, name, piece):
 @pytest.mark.parametrize("name", ["v1", "v2"])
 def test_flipped_bytes(cli, actor, streams, name, seed):
     chunks = streams[name]
-    start = len(b"".join(chunks[:2 if name == "v1" else 1]))
+    start = len(b"".join(chunks[: 2 if name == "v1" else 1]))
     data = flip(b"".join(chunks), np.random.default_rng(seed), 1 + 3 * seed, start)
     stats = compare(cli, actor, data, [0, 1, 5, 64, 333, 4096][seed])
     assert stats["damaged_runs"] > 0
@@ -315,11 +323,11 @@ def test_duplicated_and_reordered_packets(cli, actor, streams, name, piece):
 @pytest.mark.parametrize("piece", [0, 1, 29])
 def test_joining_a_live_stream(cli, actor, streams, name, piece):
     chunks = streams[name]
-    head = chunks[:2 if name == "v1" else 1]
+    head = chunks[: 2 if name == "v1" else 1]
     for start in (len(head) + 5, len(head) + 8, len(head) + 13):
         # a packet or two before the header (the receiver cannot decode them), then the
         # header repeated, as a live sender does, and the stream from there on
-        data = b"".join(chunks[start - 2:start] + head + chunks[start:])
+        data = b"".join(chunks[start - 2 : start] + head + chunks[start:])
         stats = compare(cli, actor, data, piece, from_start=False)
         assert stats["undecodable"] == 2 and stats["frames"] > 0
 
@@ -379,6 +387,6 @@ def test_random_damage(cli, actor, streams, seed):
     rng = np.random.default_rng(100 + seed)
     name = ["v1", "v2"][seed % 2]
     chunks = with_appearance(streams[name], 4) if seed % 3 == 0 else streams[name]
-    start = len(b"".join(chunks[:2 if name == "v1" else 1]))
+    start = len(b"".join(chunks[: 2 if name == "v1" else 1]))
     data = mutate(b"".join(chunks), rng, int(rng.integers(1, 25)), start)
     compare(cli, actor, data, int(rng.choice([0, 1, 3, 17, 256])), from_start=bool(seed % 4 != 1))

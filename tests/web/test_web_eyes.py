@@ -88,7 +88,7 @@ ACTORS = {"generic": lambda: generic_actor((512, 512)), "astronaut": _astronaut,
 
 def _psnr(a: np.ndarray, b: np.ndarray) -> float:
     mse = float(((a.astype(np.float64) - b) ** 2).mean())
-    return float("inf") if mse == 0 else 10 * np.log10(255.0 ** 2 / mse)
+    return float("inf") if mse == 0 else 10 * np.log10(255.0**2 / mse)
 
 
 @pytest.mark.parametrize("name", list(ACTORS))
@@ -98,8 +98,14 @@ def test_the_web_painter_paints_the_irises_as_python_does(name, cli, tmp_path):
     h, w = texture.shape[:2]
     rgba = np.dstack([texture, np.full((h, w), 255, np.uint8)])
     (tmp_path / "texture.rgba").write_bytes(rgba.tobytes())
-    job = {"texture": "texture.rgba", "width": w, "height": h, "uv": actor.model.uv.ravel().tolist(),
-           "groups": {k: [int(i) for i in v] for k, v in actor.model.groups.items()}, "looks": LOOKS}
+    job = {
+        "texture": "texture.rgba",
+        "width": w,
+        "height": h,
+        "uv": actor.model.uv.ravel().tolist(),
+        "groups": {k: [int(i) for i in v] for k, v in actor.model.groups.items()},
+        "looks": LOOKS,
+    }
     (tmp_path / "job.json").write_text(json.dumps(job))
     run = subprocess.run([*cli, str(tmp_path / "job.json")], capture_output=True, text=True, check=True)
     same = json.loads(run.stdout)["same"]  # whether texture() returned null: as the last one

@@ -34,7 +34,6 @@ from facemime.track.eyes import EyeTracker
 from facemime.track.redetect import FaceTracker
 from facemime.track.tracker import TrackerParams
 
-
 #: Frames at least between two fits of the actor that anchor a pose carried by the head's step.
 #: On lp_d6 and lp_d12 (PSNR of the re-synthesised face, mean of the two): a fit on every such
 #: frame 20.67 dB (10 frames/s for lp_d12's run on one core), at most one in 15 or 30 frames the
@@ -101,8 +100,9 @@ class Analysis:
         self.eyes = EyeTracker(self.actor.model, frame, self.actor.pose)
         self.eye_state = self.eyes.key  # the eyes as last measured (image positions, for checks)
         self._follow_pose(self.actor.pose)
-        self.last = FrameMotion(contours, {f: 1.0 for f in FEATURES}, [], True, self.actor.pose,
-                                np.zeros((len(self.deformer.knots), 2)))
+        self.last = FrameMotion(
+            contours, dict.fromkeys(FEATURES, 1.0), [], True, self.actor.pose, np.zeros((len(self.deformer.knots), 2))
+        )
         self.frames_without_face = 0
 
     def _follow_pose(self, pose: Pose) -> None:
@@ -152,12 +152,20 @@ class Analysis:
             looking = time.perf_counter() - t2
             self.timings.look += looking
             elsewhere += looking
-            self.last = FrameMotion(result.contours, result.confidence, result.lost, True, self.pose.pose, offsets,
-                                    result.redetected, look)
+            self.last = FrameMotion(
+                result.contours, result.confidence, result.lost, True, self.pose.pose, offsets, result.redetected, look
+            )
         else:
             self.frames_without_face += 1
-            self.last = FrameMotion(self.last.contours, {f: 0.0 for f in FEATURES}, list(FEATURES), False,
-                                    self.last.pose, self.last.offsets, look=self.last.look)
+            self.last = FrameMotion(
+                self.last.contours,
+                dict.fromkeys(FEATURES, 0.0),
+                list(FEATURES),
+                False,
+                self.last.pose,
+                self.last.offsets,
+                look=self.last.look,
+            )
         self.timings.track += t1 - t0
         self.timings.pose += time.perf_counter() - t1 - elsewhere
         return self.last
@@ -166,7 +174,9 @@ class Analysis:
     def model_block(self) -> dict:
         """The track file's ``model`` entry: unit, knot vertices, their feature sizes and the
         distance between the outer eye corners (model units)."""
-        return {"unit": self.actor.model.unit, "knots": self.deformer.knots.tolist(),
-                "feature_sizes": np.round(self.deformer.feature_sizes(), 3).tolist(),
-                "iod": round(model_iod(self.actor.model), 3)}
-
+        return {
+            "unit": self.actor.model.unit,
+            "knots": self.deformer.knots.tolist(),
+            "feature_sizes": np.round(self.deformer.feature_sizes(), 3).tolist(),
+            "iod": round(model_iod(self.actor.model), 3),
+        }

@@ -42,8 +42,9 @@ def head_plane(points: np.ndarray, depth: np.ndarray, pose: Pose) -> np.ndarray:
     # (u - tx - s·r02·z, v - ty + s·r12·z) = s·[[r00, r01], [-r10, -r11]] (x, y), inverted.
     det = pose.scale * (r[1, 0] * r[0, 1] - r[0, 0] * r[1, 1])
     inverse = np.array([[-r[1, 1], -r[0, 1]], [r[1, 0], r[0, 0]]]) / det
-    rhs = np.column_stack([points[:, 0] - pose.tx - pose.scale * r[0, 2] * depth,
-                           points[:, 1] - pose.ty + pose.scale * r[1, 2] * depth])
+    rhs = np.column_stack(
+        [points[:, 0] - pose.tx - pose.scale * r[0, 2] * depth, points[:, 1] - pose.ty + pose.scale * r[1, 2] * depth]
+    )
     return rhs @ inverse.T
 
 
@@ -85,8 +86,10 @@ class Deformer:
         iod = model_iod(model)
         eye_y = v[np.concatenate([g["eye_left"], g["eye_right"]]), 1].mean()
         mouth_y = v[g["mouth_outer_upper"][[0, -1]], 1].mean()
-        sets = {name: np.array([self._slot[int(i)] for i in np.unique(np.concatenate([g[n] for n in names]))])
-                for name, names in (("upper", UPPER), ("lower", LOWER), ("brows", BROWS))}
+        sets = {
+            name: np.array([self._slot[int(i)] for i in np.unique(np.concatenate([g[n] for n in names]))])
+            for name, names in (("upper", UPPER), ("lower", LOWER), ("brows", BROWS))
+        }
         anchors = [g[n] for n in ("eye_left", "eye_right", "nose") if n in g]
         if "face_outline" in g:
             anchors.append(g["face_outline"][v[g["face_outline"], 1] > mouth_y])
@@ -163,7 +166,8 @@ class Deformer:
         sizes = np.zeros(len(self.knots))
         for name in CONTOUR_GROUPS:
             idx = g[name]
-            size = mouth_width(self.model, v) if name.startswith("mouth") else np.hypot(*(v[idx[-1], :2] - v[idx[0], :2]))
+            size = (
+                mouth_width(self.model, v) if name.startswith("mouth") else np.hypot(*(v[idx[-1], :2] - v[idx[0], :2]))
+            )
             sizes[[self._slot[int(i)] for i in idx]] = size
         return sizes
-

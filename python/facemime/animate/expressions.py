@@ -42,12 +42,31 @@ from facemime.track.eyes import EYES
 
 #: The controls, in the order of every weight vector.
 NAMES: tuple[str, ...] = (
-    "jawOpen", "mouthClose", "mouthFunnel", "mouthPucker", "mouthLeft", "mouthRight",
-    "mouthSmileLeft", "mouthSmileRight", "mouthFrownLeft", "mouthFrownRight",
-    "mouthStretchLeft", "mouthStretchRight", "mouthUpperUpLeft", "mouthUpperUpRight",
-    "mouthLowerDownLeft", "mouthLowerDownRight", "mouthRollUpper", "mouthRollLower",
-    "browInnerUp", "browOuterUpLeft", "browOuterUpRight", "browDownLeft", "browDownRight",
-    "eyeBlinkLeft", "eyeBlinkRight",
+    "jawOpen",
+    "mouthClose",
+    "mouthFunnel",
+    "mouthPucker",
+    "mouthLeft",
+    "mouthRight",
+    "mouthSmileLeft",
+    "mouthSmileRight",
+    "mouthFrownLeft",
+    "mouthFrownRight",
+    "mouthStretchLeft",
+    "mouthStretchRight",
+    "mouthUpperUpLeft",
+    "mouthUpperUpRight",
+    "mouthLowerDownLeft",
+    "mouthLowerDownRight",
+    "mouthRollUpper",
+    "mouthRollLower",
+    "browInnerUp",
+    "browOuterUpLeft",
+    "browOuterUpRight",
+    "browDownLeft",
+    "browDownRight",
+    "eyeBlinkLeft",
+    "eyeBlinkRight",
 )
 BLINKS = ("eyeBlinkRight", "eyeBlinkLeft")  # in the order of Look.closure (right eye first)
 
@@ -59,12 +78,30 @@ BLINKS = ("eyeBlinkRight", "eyeBlinkLeft")  # in the order of Look.closure (righ
 #: values are real: lp_d12 and lp_d6 open the mouth wide, and head turns measured a little off
 #: move the mouth sideways in the head's frame.
 MAGNITUDES: dict[str, float] = {
-    "jawOpen": 0.70, "mouthClose": 0.04, "mouthFunnel": 0.27, "mouthPucker": 0.22, "mouthLeft": 0.36,
-    "mouthRight": 0.36, "mouthSmileLeft": 0.29, "mouthSmileRight": 0.29, "mouthFrownLeft": 0.70,
-    "mouthFrownRight": 0.70, "mouthStretchLeft": 0.51, "mouthStretchRight": 0.51, "mouthUpperUpLeft": 0.23,
-    "mouthUpperUpRight": 0.23, "mouthLowerDownLeft": 0.79, "mouthLowerDownRight": 0.79, "mouthRollUpper": 0.35,
-    "mouthRollLower": 0.25, "browInnerUp": 0.39, "browOuterUpLeft": 0.43,
-    "browOuterUpRight": 0.43, "browDownLeft": 0.33, "browDownRight": 0.33, "eyeBlinkLeft": 1.0,
+    "jawOpen": 0.70,
+    "mouthClose": 0.04,
+    "mouthFunnel": 0.27,
+    "mouthPucker": 0.22,
+    "mouthLeft": 0.36,
+    "mouthRight": 0.36,
+    "mouthSmileLeft": 0.29,
+    "mouthSmileRight": 0.29,
+    "mouthFrownLeft": 0.70,
+    "mouthFrownRight": 0.70,
+    "mouthStretchLeft": 0.51,
+    "mouthStretchRight": 0.51,
+    "mouthUpperUpLeft": 0.23,
+    "mouthUpperUpRight": 0.23,
+    "mouthLowerDownLeft": 0.79,
+    "mouthLowerDownRight": 0.79,
+    "mouthRollUpper": 0.35,
+    "mouthRollLower": 0.25,
+    "browInnerUp": 0.39,
+    "browOuterUpLeft": 0.43,
+    "browOuterUpRight": 0.43,
+    "browDownLeft": 0.33,
+    "browDownRight": 0.33,
+    "eyeBlinkLeft": 1.0,
     "eyeBlinkRight": 1.0,
 }
 DESCRIPTIONS: dict[str, str] = {
@@ -72,7 +109,7 @@ DESCRIPTIONS: dict[str, str] = {
     "mouthClose": "the inner lips move towards each other (their middles, (1 - s²)²), the outer lips stay",
     "mouthFunnel": "the lips part round: inner lips apart, outer lips half that, the corners drawn in",
     "mouthPucker": "the mouth narrows towards its middle (each knot in proportion to its distance from it), "
-                   "the outer lips part by 0.2 (1 - s²)²",
+    "the outer lips part by 0.2 (1 - s²)²",
     "mouthLeft": "the whole mouth moves to the subject's left",
     "mouthRight": "the whole mouth moves to the subject's right",
     "mouthSmileLeft": "the subject's left corner up and out (2:1), the lips beside it follow",
@@ -117,11 +154,15 @@ def unit_patterns(model: HeadModel, deformer: Deformer | None = None) -> np.ndar
     g, v = model.groups, model.vertices
     slot = {int(k): i for i, k in enumerate(d.knots)}
     k = len(d.knots)
-    s = np.zeros(k)           # position along the lips, -1 (subject's right corner) .. 1
+    s = np.zeros(k)  # position along the lips, -1 (subject's right corner) .. 1
     role = {n: np.zeros(k, bool) for n in ("ou", "ol", "iu", "il", "mouth", "brow_l", "brow_r")}
-    t = np.zeros(k)           # position along a brow, 0 inner .. 1 outer
-    for name, key in (("mouth_outer_upper", "ou"), ("mouth_outer_lower", "ol"),
-                      ("mouth_inner_upper", "iu"), ("mouth_inner_lower", "il")):
+    t = np.zeros(k)  # position along a brow, 0 inner .. 1 outer
+    for name, key in (
+        ("mouth_outer_upper", "ou"),
+        ("mouth_outer_lower", "ol"),
+        ("mouth_inner_upper", "iu"),
+        ("mouth_inner_lower", "il"),
+    ):
         idx = [slot[int(i)] for i in g[name]]
         pos = np.linspace(-1.0, 1.0, len(idx))
         if v[g[name][-1], 0] < v[g[name][0], 0]:
@@ -139,11 +180,11 @@ def unit_patterns(model: HeadModel, deformer: Deformer | None = None) -> np.ndar
             role["brow_l" if "_left_" in name else "brow_r"][idx] = True
     corner = role["mouth"] & (np.abs(s) > 0.999)
     upper, lower = role["ou"] | role["iu"], role["ol"] | role["il"]
-    bump = 1.0 - s ** 2
+    bump = 1.0 - s**2
     out = {n: np.zeros((k, 2)) for n in NAMES}
     out["jawOpen"][lower, 1] = -(0.3 + 0.7 * bump[lower])
     out["jawOpen"][corner, 1] = -0.3
-    out["mouthClose"][role["iu"], 1] = -bump[role["iu"]] ** 2  # narrower than the lip raises: not their sum
+    out["mouthClose"][role["iu"], 1] = -(bump[role["iu"]] ** 2)  # narrower than the lip raises: not their sum
     out["mouthClose"][role["il"], 1] = bump[role["il"]] ** 2
     for key, dy in (("iu", 1.0), ("il", -1.0), ("ou", 0.5), ("ol", -0.5)):
         out["mouthFunnel"][role[key], 1] = dy * bump[role[key]]
@@ -201,7 +242,7 @@ class Expressions:
     deformer: Deformer = field(repr=False)
 
     @classmethod
-    def of(cls, model: HeadModel) -> "Expressions":
+    def of(cls, model: HeadModel) -> Expressions:
         """The controls of ``model`` (the generic head or an actor's, which has its groups)."""
         d = Deformer(model)
         patterns = unit_patterns(model, d) * d.feature_sizes()[None, :, None]
@@ -234,7 +275,7 @@ class Expressions:
         (the morph; the lips are not sealed as :class:`~facemime.animate.synth.Puppet` does)."""
         return self.deformer.model.vertices + np.tensordot(np.asarray(weights, np.float64), self.fields, axes=1)
 
-    def solver(self, smooth: float = SMOOTH) -> "FrameSolver":
+    def solver(self, smooth: float = SMOOTH) -> FrameSolver:
         """A solver that takes one frame at a time, as :meth:`solve` does all at once."""
         return FrameSolver(self, smooth)
 
@@ -273,8 +314,9 @@ class FrameSolver:
 
     def __init__(self, expressions: Expressions, smooth: float = SMOOTH):
         self.expressions = expressions
-        self._rows = expressions._knot_rows
-        self._a, gram, lam = expressions._system(smooth)
+        # The same module's helper class: it shares Expressions' internals on purpose.
+        self._rows = expressions._knot_rows  # noqa: SLF001
+        self._a, gram, lam = expressions._system(smooth)  # noqa: SLF001
         self._qp = BoxLeastSquares(gram, lam)
 
     def step(self, offsets: np.ndarray, closure: np.ndarray | None = None) -> np.ndarray:

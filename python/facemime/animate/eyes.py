@@ -57,7 +57,7 @@ class _Eye:
         centre = frame.to_image(self.iris_uv) - [x0, y0]
         self.radius = 0.21 * w * IRIS_REACH
         shape = region.shape[:2]
-        yy, xx = np.mgrid[0:shape[0], 0:shape[1]].astype(np.float32)
+        yy, xx = np.mgrid[0 : shape[0], 0 : shape[1]].astype(np.float32)
         self.disc = np.clip(self.radius + 0.5 - np.hypot(xx - centre[0], yy - centre[1]), 0.0, 1.0)
         opening = np.zeros(shape, np.uint8)
         cv2.fillPoly(opening, [np.round((ring_px - [x0, y0]) * 16).astype(np.int32)], 255, cv2.LINE_AA, 4)
@@ -78,8 +78,12 @@ class _Eye:
         # lids, smoothed, and blended in over a few texels so that no outline shows
         source = region.copy()
         source[~inside] = np.round(sclera).astype(np.uint8)
-        fill = cv2.inpaint(source, cv2.dilate(hole.astype(np.uint8) * 255, np.ones((3, 3), np.uint8)),
-                           max(2.0, self.radius / 3), cv2.INPAINT_TELEA).astype(np.float32)
+        fill = cv2.inpaint(
+            source,
+            cv2.dilate(hole.astype(np.uint8) * 255, np.ones((3, 3), np.uint8)),
+            max(2.0, self.radius / 3),
+            cv2.INPAINT_TELEA,
+        ).astype(np.float32)
         fill = cv2.GaussianBlur(fill, (0, 0), max(1.0, self.radius / 4))
         blend = cv2.GaussianBlur(hole.astype(np.float32), (0, 0), max(1.0, self.radius / 8)) * self.opening
         blend = np.maximum(blend, hole)[:, :, None]

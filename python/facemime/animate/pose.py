@@ -47,8 +47,9 @@ def lift(points: np.ndarray, vertices: np.ndarray, triangles: np.ndarray, pose: 
     rel = pts[:, None, :]
 
     def edge(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-        return ((q[None, :, 0] - p[None, :, 0]) * (rel[..., 1] - p[None, :, 1])
-                - (q[None, :, 1] - p[None, :, 1]) * (rel[..., 0] - p[None, :, 0]))
+        return (q[None, :, 0] - p[None, :, 0]) * (rel[..., 1] - p[None, :, 1]) - (q[None, :, 1] - p[None, :, 1]) * (
+            rel[..., 0] - p[None, :, 0]
+        )
 
     wa, wb, wc = edge(b, c) / area, edge(c, a) / area, edge(a, b) / area
     inside = (wa >= -1e-9) & (wb >= -1e-9) & (wc >= -1e-9)
@@ -71,11 +72,14 @@ def _params(pose: Pose) -> np.ndarray:
 
 
 def _pose(p: np.ndarray) -> Pose:
-    return Pose(yaw=float(p[0]), pitch=float(p[1]), roll=float(p[2]), scale=float(np.exp(p[3])), tx=float(p[4]), ty=float(p[5]))
+    return Pose(
+        yaw=float(p[0]), pitch=float(p[1]), roll=float(p[2]), scale=float(np.exp(p[3])), tx=float(p[4]), ty=float(p[5])
+    )
 
 
-def fit_pose(model_points: np.ndarray, image_points: np.ndarray, start: Pose,
-             towards: tuple[float, float] = (0.0, 0.0)) -> Pose:
+def fit_pose(
+    model_points: np.ndarray, image_points: np.ndarray, start: Pose, towards: tuple[float, float] = (0.0, 0.0)
+) -> Pose:
     """The pose that maps (M, 3) ``model_points`` onto (M, 2) ``image_points`` (px): Gauss-Newton
     with Huber weights (:data:`HUBER`) from ``start`` (``facemime._core.fit_pose``, analytic
     Jacobian); yaw and pitch are held towards ``start``'s (weight :data:`ANGLE_PRIOR`) and
@@ -96,8 +100,13 @@ def moved(pose: Pose, step: np.ndarray) -> Pose:
     m = np.asarray(step, np.float64)
     turn = np.degrees(np.arctan2(m[1, 0] - m[0, 1], m[0, 0] + m[1, 1]))
     origin = m[:, :2] @ (pose.tx, pose.ty) + m[:, 2]
-    return replace(pose, roll=pose.roll - float(turn), scale=pose.scale * float(np.sqrt(abs(np.linalg.det(m[:, :2])))),
-                   tx=float(origin[0]), ty=float(origin[1]))
+    return replace(
+        pose,
+        roll=pose.roll - float(turn),
+        scale=pose.scale * float(np.sqrt(abs(np.linalg.det(m[:, :2])))),
+        tx=float(origin[0]),
+        ty=float(origin[1]),
+    )
 
 
 class PoseTracker:
@@ -142,8 +151,9 @@ class PoseTracker:
         ok = int(known.sum()) >= MIN_POINTS
         if ok:
             xyz = np.array([self._known[i] for i in ids[known].tolist()])
-            self.pose = fit_pose(xyz, np.asarray(points, np.float64)[known], self.pose,
-                                 towards=(self._frontal.yaw, self._frontal.pitch))
+            self.pose = fit_pose(
+                xyz, np.asarray(points, np.float64)[known], self.pose, towards=(self._frontal.yaw, self._frontal.pitch)
+            )
         else:
             self.pose = moved(self.pose, motion.step)
         current = set(motion.ids.tolist())

@@ -47,14 +47,26 @@ def track_settings(where: str, video: Any, model: dict) -> tuple[tuple[int, int]
     side = (lambda v: isinstance(v, int) and 0 < v <= MAX_SIDE, f"a whole number from 1 to {MAX_SIDE}")
     size = (number(video, "width", 512, *side), number(video, "height", 512, *side))
     if size[0] * size[1] > limit("FACEMIME_MAX_IMAGE_PIXELS"):
-        raise ContourFileError(f"{where}: a {size[0]}x{size[1]} frame is over the limit of "
-                               f"{limit('FACEMIME_MAX_IMAGE_PIXELS')} pixels (FACEMIME_MAX_IMAGE_PIXELS)")
-    fps = float(number(video, "fps", 25.0, lambda v: FPS_RANGE[0] <= v <= FPS_RANGE[1],
-                       f"a number from {FPS_RANGE[0]:g} to {FPS_RANGE[1]:g}"))
+        raise ContourFileError(
+            f"{where}: a {size[0]}x{size[1]} frame is over the limit of "
+            f"{limit('FACEMIME_MAX_IMAGE_PIXELS')} pixels (FACEMIME_MAX_IMAGE_PIXELS)"
+        )
+    fps = float(
+        number(
+            video,
+            "fps",
+            25.0,
+            lambda v: FPS_RANGE[0] <= v <= FPS_RANGE[1],
+            f"a number from {FPS_RANGE[0]:g} to {FPS_RANGE[1]:g}",
+        )
+    )
     iod = number(model, "iod", None, lambda v: 0 < v < float("inf"), "a positive number")
     sizes = model["feature_sizes"]
-    if (len(sizes) != len(model["knots"]) or any(isinstance(s, bool) or not isinstance(s, (int, float)) for s in sizes)
-            or not all(0 < s < float("inf") for s in sizes)):
+    if (
+        len(sizes) != len(model["knots"])
+        or any(isinstance(s, bool) or not isinstance(s, (int, float)) for s in sizes)
+        or not all(0 < s < float("inf") for s in sizes)
+    ):
         raise ContourFileError(f"{where}: 'feature_sizes' must be {len(model['knots'])} positive numbers, one per knot")
     return size, fps, np.asarray(sizes, np.float64), None if iod is None else float(iod)
 
@@ -81,8 +93,9 @@ class Replay:
         knot and the pose's scale by the eye distances, as :class:`Puppet` does when it plays."""
         ratio = (Deformer(self.actor.model).feature_sizes() / self.sizes)[:, None]
         scale = self.iod / model_iod(self.actor.model)
-        return [replace(m, offsets=m.offsets * ratio, pose=replace(m.pose, scale=m.pose.scale * scale))
-                for m in self.motion]
+        return [
+            replace(m, offsets=m.offsets * ratio, pose=replace(m.pose, scale=m.pose.scale * scale)) for m in self.motion
+        ]
 
 
 def load_replay(path: str | Path, actor: Actor | None = None) -> Replay:
@@ -93,8 +106,10 @@ def load_replay(path: str | Path, actor: Actor | None = None) -> Replay:
     driven = actor or generic_actor()
     knots = len(Deformer(driven.model).knots)
     if len(sizes) != knots:
-        raise InvalidInputError(f"the motion of {path} has {len(sizes)} knots but actor {driven.model.name!r} "
-                                f"has {knots}")
-    motion = [FrameMotion({}, {}, list(f["lost"]), f["face"], Pose(**f["pose"]), f["offsets"], look=f["look"])
-              for f in frames]
+        raise InvalidInputError(
+            f"the motion of {path} has {len(sizes)} knots but actor {driven.model.name!r} has {knots}"
+        )
+    motion = [
+        FrameMotion({}, {}, list(f["lost"]), f["face"], Pose(**f["pose"]), f["offsets"], look=f["look"]) for f in frames
+    ]
     return Replay(driven, size, fps, motion, sizes, model_iod(driven.model) if iod is None else iod)

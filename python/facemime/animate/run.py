@@ -94,9 +94,16 @@ class SideBySide:
     ``synth``, the departure measure included; ``compose``). ``analysis`` is None until the
     first frame. ``mask_only``: show the face alone on a plain backdrop, not in its scene."""
 
-    def __init__(self, frames: Iterable[np.ndarray], name: str, target: Actor | None = None,
-                 user: UserMotion = UserMotion(), params: TrackerParams | None = None,
-                 records: list[dict] | TrackWriter | None = None, mask_only: bool = False):
+    def __init__(
+        self,
+        frames: Iterable[np.ndarray],
+        name: str,
+        target: Actor | None = None,
+        user: UserMotion = UserMotion(),
+        params: TrackerParams | None = None,
+        records: list[dict] | TrackWriter | None = None,
+        mask_only: bool = False,
+    ):
         self._frames, self._name, self._target, self._user, self._params = frames, name, target, user, params
         self._mask_only = mask_only
         self.records = [] if records is None else records
@@ -124,8 +131,9 @@ class SideBySide:
                     raise NoFaceError(f"{e}; the video must start with a frontal face") from None
                 actor = self.analysis.actor
                 driven = actor if self._target is None else self._target
-                puppet = Puppet(driven, self.analysis.deformer.feature_sizes(), model_iod(actor.model), actor.pose,
-                                self._mask_only)
+                puppet = Puppet(
+                    driven, self.analysis.deformer.feature_sizes(), model_iod(actor.model), actor.pose, self._mask_only
+                )
                 # the surround is compared only where the synthesis is of this very picture
                 compare = puppet.scene is not None and self._target is None
                 outline = actor.model.groups["face_outline"]
@@ -139,9 +147,17 @@ class SideBySide:
             if puppet.scene is None:
                 fill(synth, BACKGROUND)
             puppet.render(motion.pose, motion.offsets, (w, h), self._user, out=synth, look=motion.look)
-            record = {"index": self.frames, "contours": motion.contours, "confidence": motion.confidence,
-                      "lost": motion.lost, "redetected": motion.redetected, "face": motion.face,
-                      "pose": pose_dict(motion.pose), "offsets": motion.offsets, "look": motion.look.as_dict()}
+            record = {
+                "index": self.frames,
+                "contours": motion.contours,
+                "confidence": motion.confidence,
+                "lost": motion.lost,
+                "redetected": motion.redetected,
+                "face": motion.face,
+                "pose": pose_dict(motion.pose),
+                "offsets": motion.offsets,
+                "look": motion.look.as_dict(),
+            }
             self.weights.append(solver.step(motion.offsets, motion.look.closure))
             record["weights"] = solver.named(self.weights[-1])
             if compare and motion.face:
@@ -173,8 +189,14 @@ class SideBySide:
         spent encoding)."""
         if self.analysis is None:
             raise InputFileError(f"video {self._name} has no frames")
-        return RunResult(self.frames, self.analysis.frames_without_face, files, list(self.analysis.warnings),
-                         {**self.seconds, "encode": encode_seconds}, [list(r) for r in self.departs])
+        return RunResult(
+            self.frames,
+            self.analysis.frames_without_face,
+            files,
+            list(self.analysis.warnings),
+            {**self.seconds, "encode": encode_seconds},
+            [list(r) for r in self.departs],
+        )
 
 
 def weights_csv(weights: list[np.ndarray], fps: float) -> str:
@@ -207,10 +229,17 @@ def write_frames(writer: VideoWriter, frames: Iterable[np.ndarray]) -> float:
     return encode
 
 
-def run_video(video: str | Path, out: str | Path, actor: str | Path | Actor | None = None,
-              track: str | Path | None = None, user: UserMotion = UserMotion(), force: bool = False,
-              params: TrackerParams | None = None, mask_only: bool = False,
-              weights: str | Path | None = None) -> RunResult:
+def run_video(
+    video: str | Path,
+    out: str | Path,
+    actor: str | Path | Actor | None = None,
+    track: str | Path | None = None,
+    user: UserMotion = UserMotion(),
+    force: bool = False,
+    params: TrackerParams | None = None,
+    mask_only: bool = False,
+    weights: str | Path | None = None,
+) -> RunResult:
     """Analyse ``video`` and write ``out`` (.mp4 or .webm, side by side) and ``track`` (default:
     ``out`` with the suffix ``.json``), and with ``weights`` the expression weights as a .csv
     file (:func:`weights_csv`). ``actor``: an ``.actor`` file or an :class:`Actor` to
@@ -227,24 +256,38 @@ def run_video(video: str | Path, out: str | Path, actor: str | Path | Actor | No
     actor_path = actor if isinstance(actor, (str, Path)) else None
     with Outputs([out, track] + ([csv] if csv else []), force, inputs=[video, actor_path]) as outputs:
         target = load_actor(actor_path) if actor_path is not None else actor
-        with (VideoReader(video) as reader, VideoWriter(outputs.stage(out), reader.fps) as writer,
-              TrackWriter(outputs.stage(track)) as records):
-            work = SideBySide(progress(reader, reader.frames or None, "running"), str(video), target, user, params,
-                              records, mask_only)
+        with (
+            VideoReader(video) as reader,
+            VideoWriter(outputs.stage(out), reader.fps) as writer,
+            TrackWriter(outputs.stage(track)) as records,
+        ):
+            work = SideBySide(
+                progress(reader, reader.frames or None, "running"), str(video), target, user, params, records, mask_only
+            )
             encode = write_frames(writer, work)
             result = work.result([out, track] + ([csv] if csv else []), encode)
             result.warnings.extend(reader.warnings)
             busy = sum(v for k, v in result.seconds.items() if k not in ("encode", "fit", "decode"))
             info = {"width": reader.width, "height": reader.height, "fps": reader.fps, "frames": result.frames}
-            records.close(info, {"processing_seconds": round(busy, 4), "frames_processed": result.frames},
-                          work.analysis.model_block, {"scene_departs": result.departs} if result.departs else None)
+            records.close(
+                info,
+                {"processing_seconds": round(busy, 4), "frames_processed": result.frames},
+                work.analysis.model_block,
+                {"scene_departs": result.departs} if result.departs else None,
+            )
             if csv is not None:
                 write_text(outputs.stage(csv), weights_csv(work.weights, reader.fps))
     return result
 
 
-def run_track(track: str | Path, out: str | Path, actor: str | Path | Actor | None = None,
-              user: UserMotion = UserMotion(), force: bool = False, mask_only: bool = False) -> RunResult:
+def run_track(
+    track: str | Path,
+    out: str | Path,
+    actor: str | Path | Actor | None = None,
+    user: UserMotion = UserMotion(),
+    force: bool = False,
+    mask_only: bool = False,
+) -> RunResult:
     """Play the motion of the ``facemime.track/1`` file ``track`` (from :func:`run_video`, or
     expression weights written by hand; :mod:`facemime.animate.replay`) on ``actor`` (an
     ``.actor`` file or an :class:`Actor`; default: the generic painted head) and write the
@@ -271,5 +314,6 @@ def run_track(track: str | Path, out: str | Path, actor: str | Path | Actor | No
 
         with VideoWriter(outputs.stage(out), replay.fps) as writer:
             encode = write_frames(writer, frames())
-    return RunResult(len(replay.motion), sum(not m.face for m in replay.motion), [out], [],
-                     {**seconds, "encode": encode})
+    return RunResult(
+        len(replay.motion), sum(not m.face for m in replay.motion), [out], [], {**seconds, "encode": encode}
+    )

@@ -98,8 +98,10 @@ def draw_mouth_interior(out: np.ndarray, upper: np.ndarray, lower: np.ndarray, u
     opening = (lower - upper) @ down if len(upper) == len(lower) else np.full(len(upper), width)
     # teeth grow from nothing at TEETH_FROM to their full share of the opening at twice it
     opening = (opening * np.clip(opening / (TEETH_FROM * width) - 1.0, 0.0, 1.0))[keep]
-    rows = ((upper, UPPER_TEETH, UPPER_SHARE, max(uncovered, UPPER_MIN), 1.0),
-            (lower, LOWER_TEETH, LOWER_SHARE, uncovered, -1.0))
+    rows = (
+        (upper, UPPER_TEETH, UPPER_SHARE, max(uncovered, UPPER_MIN), 1.0),
+        (lower, LOWER_TEETH, LOWER_SHARE, uncovered, -1.0),
+    )
     for curve, height, share, shown, sign in rows:
         edge = curve[keep]
         reach = shown * np.minimum(height * width, share * opening)[:, None]
@@ -111,7 +113,7 @@ def draw_mouth_interior(out: np.ndarray, upper: np.ndarray, lower: np.ndarray, u
             cv2.line(paint, a, b, GAPS, 1, cv2.LINE_AA, SHIFT)  # gaps between the teeth
     # shade the far corners of the cavity and the teeth towards dark
     cx = (np.arange(x0, x1, dtype=np.float32) - (upper[0, 0] + upper[-1, 0]) / 2.0) / max(width / 2.0, 1.0)
-    shade = np.clip(1.15 - 0.6 * cx ** 2, 0.35, 1.0).astype(np.float32)[None, :, None]
+    shade = np.clip(1.15 - 0.6 * cx**2, 0.35, 1.0).astype(np.float32)[None, :, None]
     alpha = (mask * np.float32(1.0 / 255.0))[:, :, None]
     roi = out[y0:y1, x0:x1]
     roi[:] = roi + alpha * (paint * shade - roi)
@@ -135,10 +137,17 @@ def key_frame(actor: Actor, scene: SceneMesh) -> np.ndarray:
     return cv2.resize(actor.scene, (w, h), interpolation=cv2.INTER_LINEAR)
 
 
-def synthesize(actor: Actor, vertices: np.ndarray, pose: Pose, size: tuple[int, int],
-               background: np.ndarray | tuple[int, int, int] = BACKGROUND, out: np.ndarray | None = None,
-               scene: SceneMesh | None = None, key: np.ndarray | None = None,
-               texture: np.ndarray | None = None) -> np.ndarray:
+def synthesize(
+    actor: Actor,
+    vertices: np.ndarray,
+    pose: Pose,
+    size: tuple[int, int],
+    background: np.ndarray | tuple[int, int, int] = BACKGROUND,
+    out: np.ndarray | None = None,
+    scene: SceneMesh | None = None,
+    key: np.ndarray | None = None,
+    texture: np.ndarray | None = None,
+) -> np.ndarray:
     """The actor with ``vertices`` (its model's, deformed) seen in ``pose``: an (H, W, 3) image
     of ``size`` = (width, height) over ``background`` (a colour or an image of that size), or
     drawn into ``out`` when given (the background is then what ``out`` holds). With ``scene``
@@ -159,8 +168,9 @@ def synthesize(actor: Actor, vertices: np.ndarray, pose: Pose, size: tuple[int, 
     g = actor.model.groups
     spread = mouth_width(actor.model, vertices) / max(mouth_width(actor.model, actor.model.vertices), 1e-9)
     draw_mouth_interior(out, points[g["mouth_inner_upper"]], points[g["mouth_inner_lower"]], teeth_uncovered(spread))
-    render_mesh_into(out, actor.texture if texture is None else texture, actor.model.uv, points, depth,
-                     actor.model.triangles)
+    render_mesh_into(
+        out, actor.texture if texture is None else texture, actor.model.uv, points, depth, actor.model.triangles
+    )
     return out
 
 
@@ -186,14 +196,18 @@ class UserMotion:
         if not (np.isfinite(self.gain) and 0.0 <= self.gain <= 10.0):
             raise InvalidInputError(f"exaggeration must be in [0, 10], got {self.gain}")
 
-    def changed(self, **deltas: float) -> "UserMotion":
+    def changed(self, **deltas: float) -> UserMotion:
         """A copy with ``deltas`` added (``zoom`` and ``gain`` multiply), kept in range."""
         v = {k: getattr(self, k) for k in ("yaw", "pitch", "roll", "zoom", "gain")}
         for k, d in deltas.items():
             v[k] = v[k] * d if k in ("zoom", "gain") else v[k] + d
-        v.update(yaw=float(np.clip(v["yaw"], -180, 180)), pitch=float(np.clip(v["pitch"], -180, 180)),
-                 roll=float(np.clip(v["roll"], -180, 180)), zoom=float(np.clip(v["zoom"], 0.1, 10)),
-                 gain=float(np.clip(v["gain"], 0.0, 10.0)))
+        v.update(
+            yaw=float(np.clip(v["yaw"], -180, 180)),
+            pitch=float(np.clip(v["pitch"], -180, 180)),
+            roll=float(np.clip(v["roll"], -180, 180)),
+            zoom=float(np.clip(v["zoom"], 0.1, 10)),
+            gain=float(np.clip(v["gain"], 0.0, 10.0)),
+        )
         return replace(self, **v)
 
 
@@ -212,8 +226,14 @@ class Puppet:
     keeps the measured face's size on screen.
     """
 
-    def __init__(self, actor: Actor, source_sizes: np.ndarray, source_iod: float, source_pose: Pose | None = None,
-                 mask_only: bool = False):
+    def __init__(
+        self,
+        actor: Actor,
+        source_sizes: np.ndarray,
+        source_iod: float,
+        source_pose: Pose | None = None,
+        mask_only: bool = False,
+    ):
         self.actor = actor
         self.source_pose = source_pose
         self.scene = None if mask_only else scene_mesh(actor)
@@ -224,8 +244,9 @@ class Puppet:
         self.painter = LookPainter(actor)
         sizes = np.asarray(source_sizes, np.float64)
         if sizes.shape != (len(self.deformer.knots),) or not np.isfinite(sizes).all() or (sizes <= 0).any():
-            raise InvalidInputError(f"the motion has {len(sizes)} knots but actor {actor.model.name!r} has "
-                                    f"{len(self.deformer.knots)}")
+            raise InvalidInputError(
+                f"the motion has {len(sizes)} knots but actor {actor.model.name!r} has {len(self.deformer.knots)}"
+            )
         self._ratio = (self.deformer.feature_sizes() / sizes)[:, None]
         self._scale = float(source_iod) / model_iod(actor.model)
 
@@ -241,11 +262,21 @@ class Puppet:
         else:
             rest, key = self.actor.pose, self.source_pose
             ratio = rest.scale / self._scale / key.scale  # target pixels per source pixel
-            shown = Pose(yaw=rest.yaw + measured.yaw - key.yaw, pitch=rest.pitch + measured.pitch - key.pitch,
-                         roll=rest.roll + measured.roll - key.roll, scale=rest.scale * measured.scale / key.scale,
-                         tx=rest.tx + ratio * (measured.tx - key.tx), ty=rest.ty + ratio * (measured.ty - key.ty))
-        return replace(shown, yaw=shown.yaw + user.yaw, pitch=shown.pitch + user.pitch, roll=shown.roll + user.roll,
-                       scale=shown.scale * user.zoom)
+            shown = Pose(
+                yaw=rest.yaw + measured.yaw - key.yaw,
+                pitch=rest.pitch + measured.pitch - key.pitch,
+                roll=rest.roll + measured.roll - key.roll,
+                scale=rest.scale * measured.scale / key.scale,
+                tx=rest.tx + ratio * (measured.tx - key.tx),
+                ty=rest.ty + ratio * (measured.ty - key.ty),
+            )
+        return replace(
+            shown,
+            yaw=shown.yaw + user.yaw,
+            pitch=shown.pitch + user.pitch,
+            roll=shown.roll + user.roll,
+            scale=shown.scale * user.zoom,
+        )
 
     def vertices(self, offsets: np.ndarray, user: UserMotion = UserMotion(), look: Look = Look()) -> np.ndarray:
         """The actor's vertices moved by the source's knot ``offsets`` (K, 2), lips all but
@@ -253,8 +284,15 @@ class Puppet:
         vertices = self.deformer.sealed(self.deformer.vertices(offsets * self._ratio, user.gain), SEAL)
         return self.painter.vertices(vertices, Look(look.closure * user.gain))
 
-    def render(self, measured: Pose, offsets: np.ndarray, size: tuple[int, int], user: UserMotion = UserMotion(),
-               out: np.ndarray | None = None, look: Look = Look()) -> np.ndarray:
+    def render(
+        self,
+        measured: Pose,
+        offsets: np.ndarray,
+        size: tuple[int, int],
+        user: UserMotion = UserMotion(),
+        out: np.ndarray | None = None,
+        look: Look = Look(),
+    ) -> np.ndarray:
         """The synthesised frame, (H, W, 3) of ``size`` = (width, height), drawn into ``out``
         when given, with the eyes of ``look``. A scene of another size is drawn at its
         own and fitted into ``size`` (its aspect kept, the rest :data:`BACKGROUND`); without a
@@ -268,10 +306,19 @@ class Puppet:
         if out is None:
             out = np.empty((size[1], size[0], 3), np.uint8)
         if tuple(size) == self.scene.size:
-            return synthesize(self.actor, vertices, pose, size, out=out, scene=self.scene, key=self._key,
-                              texture=texture)
-        synthesize(self.actor, vertices, pose, self.scene.size, out=self._picture, scene=self.scene, key=self._key,
-                   texture=texture)
+            return synthesize(
+                self.actor, vertices, pose, size, out=out, scene=self.scene, key=self._key, texture=texture
+            )
+        synthesize(
+            self.actor,
+            vertices,
+            pose,
+            self.scene.size,
+            out=self._picture,
+            scene=self.scene,
+            key=self._key,
+            texture=texture,
+        )
         return letterbox(self._picture, out)
 
 
@@ -284,5 +331,5 @@ def letterbox(image: np.ndarray, out: np.ndarray) -> np.ndarray:
     x0, y0 = (w - sw) // 2, (h - sh) // 2
     fill(out, BACKGROUND)
     shrink = cv2.INTER_AREA if f < 1 else cv2.INTER_LINEAR
-    out[y0:y0 + sh, x0:x0 + sw] = cv2.resize(image, (sw, sh), interpolation=shrink)
+    out[y0 : y0 + sh, x0 : x0 + sw] = cv2.resize(image, (sw, sh), interpolation=shrink)
     return out

@@ -9,6 +9,7 @@ redoes them; the manifest (:mod:`~facemime.batch.manifest`) gets a line for each
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import threading
 import time
@@ -24,7 +25,7 @@ from facemime.batch.worker import START_SECONDS, TIMEOUT_EVENT, Task, process
 from facemime.errors import InvalidInputError
 from facemime.io.outputs import OutputFileError
 
-__all__ = ["BatchResult", "run_batch", "WHAT"]
+__all__ = ["WHAT", "BatchResult", "run_batch"]
 
 #: What a batch can make of each video.
 WHAT = tuple(RESULTS)
@@ -49,8 +50,16 @@ class BatchResult:
     dashboard: str | None = None
 
 
-def check_task(name: str, video: str, results: list[str], what: str, timeout_per_frame: float | None,
-               task: Task | None, previous: dict[str, Any] | None, start_seconds: float) -> dict[str, Any]:
+def check_task(
+    name: str,
+    video: str,
+    results: list[str],
+    what: str,
+    timeout_per_frame: float | None,
+    task: Task | None,
+    previous: dict[str, Any] | None,
+    start_seconds: float,
+) -> dict[str, Any]:
     """A worker's task for one video: the earlier manifest line, marked ``skipped``, when the
     results it describes are complete and valid; otherwise the line of a new run
     (:func:`facemime.batch.worker.process`)."""
@@ -68,10 +77,19 @@ def _remove_temporaries(paths: list[Path]) -> None:
             tmp.unlink(missing_ok=True)
 
 
-def run_batch(source: str | Path, out_dir: str | Path, jobs: int = 2, scheduler: str | None = None,
-              what: str = "track", timeout_per_frame: float | None = TIMEOUT_PER_FRAME, retries: int = 2,
-              task: Task | None = None, progress: Callable[[BatchResult], None] | None = None,
-              on_dashboard: Callable[[str], None] | None = None, start_seconds: float = START_SECONDS) -> BatchResult:
+def run_batch(
+    source: str | Path,
+    out_dir: str | Path,
+    jobs: int = 2,
+    scheduler: str | None = None,
+    what: str = "track",
+    timeout_per_frame: float | None = TIMEOUT_PER_FRAME,
+    retries: int = 2,
+    task: Task | None = None,
+    progress: Callable[[BatchResult], None] | None = None,
+    on_dashboard: Callable[[str], None] | None = None,
+    start_seconds: float = START_SECONDS,
+) -> BatchResult:
     """Run ``what`` (track, run or encode) on every video of ``source`` (a folder or a list file,
     :func:`facemime.batch.inputs.list_videos`) into ``out_dir``, on a local cluster of ``jobs``
     single-threaded workers or on the Dask ``scheduler`` (``tcp://HOST:PORT``). A task is
@@ -105,8 +123,10 @@ def run_batch(source: str | Path, out_dir: str | Path, jobs: int = 2, scheduler:
         result.dashboard = dashboard_link(client)
         if result.dashboard and on_dashboard is not None:
             on_dashboard(result.dashboard)
-        futures = {_submit(client, it, out_dir, what, (timeout_per_frame, start_seconds), task, previous.get(it.name)):
-                   it for it in items}
+        futures = {
+            _submit(client, it, out_dir, what, (timeout_per_frame, start_seconds), task, previous.get(it.name)): it
+            for it in items
+        }
         timed_out = _watch_timeouts(client, {it.name: f for f, it in futures.items()})
         from distributed import as_completed
 
@@ -138,11 +158,29 @@ def _inside(path: Path, folder: Path) -> bool:
         return False
 
 
-def _submit(client: Any, item: Item, out_dir: Path, what: str, timeout: tuple[float | None, float],
-            task: Task | None, previous: dict[str, Any] | None) -> Any:
+def _submit(
+    client: Any,
+    item: Item,
+    out_dir: Path,
+    what: str,
+    timeout: tuple[float | None, float],
+    task: Task | None,
+    previous: dict[str, Any] | None,
+) -> Any:
     results = [str(p) for p in result_paths(out_dir, item.name, what)]
-    return client.submit(check_task, item.name, str(item.path), results, what, timeout[0], task, previous, timeout[1],
-                         pure=False, key=f"facemime-{what}-{item.name}-{time.time_ns()}")
+    return client.submit(
+        check_task,
+        item.name,
+        str(item.path),
+        results,
+        what,
+        timeout[0],
+        task,
+        previous,
+        timeout[1],
+        pure=False,
+        key=f"facemime-{what}-{item.name}-{time.time_ns()}",
+    )
 
 
 def _watch_timeouts(client: Any, by_name: dict[str, Any]) -> set[str]:
@@ -159,10 +197,9 @@ def _watch_timeouts(client: Any, by_name: dict[str, Any]) -> set[str]:
                 names.add(name)
             by_name[name].cancel()
 
-    try:
+    # An older scheduler lacks the topic: time limits of native code then go unreported.
+    with contextlib.suppress(Exception):
         client.subscribe_topic(TIMEOUT_EVENT, handler)
-    except Exception:  # noqa: BLE001 (an older scheduler: time limits of native code go unreported)
-        pass
     return names
 
 
@@ -171,19 +208,32 @@ def _record(future: Any, item: Item, what: str, timed_out: set[str], retries: in
     return (its worker ended for the time limit, or died ``retries`` + 1 times)."""
     from facemime.batch.manifest import source_stamp
 
-    base = {"video": item.name, "path": str(item.path), "what": what, "source": source_stamp(item.path),
-            "frames": None, "seconds": None}
+    base = {
+        "video": item.name,
+        "path": str(item.path),
+        "what": what,
+        "source": source_stamp(item.path),
+        "frames": None,
+        "seconds": None,
+    }
     if item.name in timed_out:
-        return {**base, "status": "timed out", "error": "stopped for its time limit (its worker was ended: "
-                                                         "stuck outside Python)"}
+        return {
+            **base,
+            "status": "timed out",
+            "error": "stopped for its time limit (its worker was ended: stuck outside Python)",
+        }
     if future.status == "finished":
         return future.result()
     if future.status == "cancelled":
         return {**base, "status": "failed", "error": "cancelled"}
     e = future.exception()
     if type(e).__name__ == "KilledWorker":
-        return {**base, "status": "failed", "error": f"its worker process died {retries + 1} time(s) while running "
-                                                      "it (a crash in native code, or out of memory)"}
+        return {
+            **base,
+            "status": "failed",
+            "error": f"its worker process died {retries + 1} time(s) while running "
+            "it (a crash in native code, or out of memory)",
+        }
     return {**base, "status": "failed", "error": " ".join(f"{type(e).__name__}: {e}".split())}
 
 
@@ -195,8 +245,15 @@ def print_progress() -> tuple[Callable[[BatchResult], None], Callable[[], None]]
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-    bar = Progress(TextColumn("videos"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[rate]}"),
-                   TimeRemainingColumn(), console=Console(stderr=True), transient=True)
+    bar = Progress(
+        TextColumn("videos"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("{task.fields[rate]}"),
+        TimeRemainingColumn(),
+        console=Console(stderr=True),
+        transient=True,
+    )
     task_id = None
 
     def update(r: BatchResult) -> None:

@@ -46,14 +46,21 @@ def open_client(jobs: int, scheduler: str | None = None, retries: int = 2) -> It
             try:
                 client = Client(scheduler, timeout=CONNECT_SECONDS)
             except (OSError, TimeoutError) as e:
-                raise ClusterError(f"cannot reach the Dask scheduler at {scheduler}: "
-                                   f"{' '.join(str(e).split()) or type(e).__name__}") from None
+                raise ClusterError(
+                    f"cannot reach the Dask scheduler at {scheduler}: {' '.join(str(e).split()) or type(e).__name__}"
+                ) from None
             with client:
                 yield client
             return
         try:  # the scheduler's web server (the dashboard with bokeh) on a free port
-            cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=":0",
-                                   silence_logs=logging.ERROR, env={v: "1" for v in THREAD_VARIABLES})
+            cluster = LocalCluster(
+                n_workers=jobs,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=":0",
+                silence_logs=logging.ERROR,
+                env=dict.fromkeys(THREAD_VARIABLES, "1"),
+            )
         except (OSError, TimeoutError) as e:
             raise ClusterError(f"cannot start a local Dask cluster: {' '.join(str(e).split())}") from None
         with cluster, Client(cluster) as client:

@@ -53,6 +53,7 @@ def list_videos(source: str | Path) -> list[Item]:
 
 def _walk(folder: Path) -> list[Path]:
     """Video files under ``folder``, sorted; an unreadable folder raises :class:`InputFileError`."""
+
     def fail(e: OSError) -> None:
         raise InputFileError(f"cannot read folder {e.filename or folder}: {e.strerror or e}") from None
 
@@ -69,5 +70,9 @@ def _named(paths: list[Path]) -> list[Item]:
     stems: dict[str, int] = {}
     for p in paths:
         stems[p.stem] = stems.get(p.stem, 0) + 1
-    return [Item(p.stem if stems[p.stem] == 1 else
-                 f"{p.stem}-{hashlib.sha1(str(p.absolute()).encode()).hexdigest()[:8]}", p) for p in paths]
+    return [
+        Item(
+            p.stem if stems[p.stem] == 1 else f"{p.stem}-{hashlib.sha1(str(p.absolute()).encode()).hexdigest()[:8]}", p
+        )
+        for p in paths
+    ]

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import json
 import os
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
@@ -70,8 +70,11 @@ def summarise(paths: list[Path], what: str) -> dict[str, Any]:
     lost = sum(bool(f.get("lost")) for f in frames)
     if what == "run":
         _check_video(paths[1], len(frames))
-    return {"frames": len(frames), "mean_confidence": round(sum(conf) / len(conf), 4) if conf else None,
-            "lost_frames": lost}
+    return {
+        "frames": len(frames),
+        "mean_confidence": round(sum(conf) / len(conf), 4) if conf else None,
+        "lost_frames": lost,
+    }
 
 
 def _check_video(path: Path, frames: int) -> None:
@@ -129,7 +132,7 @@ class Manifest:
 
     def append(self, record: dict[str, Any]) -> None:
         """Append one line (``finished`` is set to now)."""
-        record = {**record, "finished": datetime.now(timezone.utc).isoformat(timespec="seconds")}
+        record = {**record, "finished": datetime.now(UTC).isoformat(timespec="seconds")}
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             with open(self.path, "a", encoding="utf-8") as f:

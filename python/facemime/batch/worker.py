@@ -19,8 +19,13 @@ from facemime.errors import FacemimeError
 from facemime.io.video import VideoReader
 
 #: Environment variables that size the thread pools of BLAS and OpenMP libraries (read when they load).
-THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "VECLIB_MAXIMUM_THREADS",
-                    "NUMEXPR_NUM_THREADS")
+THREAD_VARIABLES = (
+    "OMP_NUM_THREADS",
+    "OPENBLAS_NUM_THREADS",
+    "MKL_NUM_THREADS",
+    "VECLIB_MAXIMUM_THREADS",
+    "NUMEXPR_NUM_THREADS",
+)
 #: Seconds a task may take beyond its per-frame allowance (start-up: loading models, fitting the face).
 START_SECONDS = 30.0
 #: Seconds a task stopped for its time limit has to end before its worker process is ended.
@@ -89,8 +94,15 @@ def declared_frames(video: Path) -> int:
         return 0
 
 
-def process(name: str, video: str, results: list[str], what: str, timeout_per_frame: float | None,
-            task: Task | None = None, start_seconds: float = START_SECONDS) -> dict[str, Any]:
+def process(
+    name: str,
+    video: str,
+    results: list[str],
+    what: str,
+    timeout_per_frame: float | None,
+    task: Task | None = None,
+    start_seconds: float = START_SECONDS,
+) -> dict[str, Any]:
     """Run ``task`` (default :func:`default_task`) on ``video`` within ``start_seconds`` +
     ``timeout_per_frame`` s × its declared frames (None: no limit), check the results and return
     its manifest line (see :mod:`facemime.batch.manifest`)."""
@@ -109,8 +121,11 @@ def process(name: str, video: str, results: list[str], what: str, timeout_per_fr
         if warnings:
             record["warnings"] = [" ".join(str(w).split()) for w in warnings]
     except TimedOut:
-        record.update(status="timed out", error=f"stopped after {limit:.1f} s, its limit ({start_seconds:g} s + "
-                                                f"{timeout_per_frame:g} s a frame for {frames} frames)")
+        record.update(
+            status="timed out",
+            error=f"stopped after {limit:.1f} s, its limit ({start_seconds:g} s + "
+            f"{timeout_per_frame:g} s a frame for {frames} frames)",
+        )
     except FacemimeError as e:
         record.update(status="failed", error=" ".join(str(e).split()))
     except MemoryError:

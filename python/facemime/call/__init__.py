@@ -17,7 +17,7 @@ from facemime.errors import InvalidInputError
 from facemime.fit.actor import Actor
 from facemime.io.outputs import OutputFileError, check_outputs, temporary_sibling
 
-__all__ = ["Call", "KEYFRAME", "PACKET_FRAMES", "PORT", "RATE", "WARMUP"]
+__all__ = ["KEYFRAME", "PACKET_FRAMES", "PORT", "RATE", "WARMUP", "Call"]
 
 #: The suffix of a recording (``--record``).
 SUFFIX = ".fmstream"
@@ -60,10 +60,22 @@ class Call:
     :meth:`start` serves and streams, :meth:`wait` returns when the source has ended, :meth:`close`
     (or leaving a ``with`` block) stops everything within a second or two."""
 
-    def __init__(self, source: str | Path, actor: Actor | None = None, port: int = PORT, quality: int | None = None,
-                 packet_frames: int = PACKET_FRAMES, record: str | Path | None = None, force: bool = False,
-                 loop: bool = False, web: Path | None = None, keyframe: float = KEYFRAME, warmup: float = WARMUP,
-                 actor_path: str | Path | None = None, rate: float = RATE):
+    def __init__(
+        self,
+        source: str | Path,
+        actor: Actor | None = None,
+        port: int = PORT,
+        quality: int | None = None,
+        packet_frames: int = PACKET_FRAMES,
+        record: str | Path | None = None,
+        force: bool = False,
+        loop: bool = False,
+        web: Path | None = None,
+        keyframe: float = KEYFRAME,
+        warmup: float = WARMUP,
+        actor_path: str | Path | None = None,
+        rate: float = RATE,
+    ):
         self.record_path = None if record is None else Path(record)
         if self.record_path is not None:
             if self.record_path.suffix.lower() != SUFFIX:
@@ -75,8 +87,15 @@ class Call:
         self.server = None
         try:
             self.sender = Sender(self.source, self, actor, quality, packet_frames, keyframe, warmup, rate)
-            self.hub = Hub({"source": self.source.name, "fps": self.source.fps, "width": self.source.size[0],
-                            "height": self.source.size[1]}, self.sender.request_intra)
+            self.hub = Hub(
+                {
+                    "source": self.source.name,
+                    "fps": self.source.fps,
+                    "width": self.source.size[0],
+                    "height": self.source.size[1],
+                },
+                self.sender.request_intra,
+            )
             self.server = make_server(self.hub, port, web)
             if self.record_path is not None:
                 self._recording = _Recording(self.record_path)
@@ -143,7 +162,7 @@ class Call:
         if self._recording is not None:
             self._recording.close(keep=self.sender.error is None and self.sender.stats.header_bytes > 0)
 
-    def __enter__(self) -> "Call":
+    def __enter__(self) -> Call:
         return self
 
     def __exit__(self, *exc: object) -> None:

@@ -22,8 +22,8 @@ import numpy as np
 
 from facemime import _core
 from facemime.animate.analysis import Analysis, FrameMotion
-from facemime.codec.params import Basis, pose_vector
 from facemime.codec.files import Clip, encode_clip
+from facemime.codec.params import Basis, pose_vector
 from facemime.codec.stream import DEFAULT_QUALITY, LADDER, MotionEncoder, Settings
 from facemime.errors import InputFileError, InvalidInputError, NoFaceError
 from facemime.fit.actor import Actor
@@ -173,9 +173,17 @@ class Sender(threading.Thread):
     the constructor, so that a source without a face fails there, in one line; :attr:`error` is
     what stopped the thread otherwise (None: the source ended, or it was stopped)."""
 
-    def __init__(self, source: FileSource | CameraSource, sink: Sink, actor: Actor | None = None,
-                 quality: int | None = None, packet_frames: int = PACKET_FRAMES, keyframe: float = KEYFRAME,
-                 warmup: float = WARMUP, rate: float = RATE):
+    def __init__(
+        self,
+        source: FileSource | CameraSource,
+        sink: Sink,
+        actor: Actor | None = None,
+        quality: int | None = None,
+        packet_frames: int = PACKET_FRAMES,
+        keyframe: float = KEYFRAME,
+        warmup: float = WARMUP,
+        rate: float = RATE,
+    ):
         super().__init__(name="call sender", daemon=True)
         if not 1 <= packet_frames <= 32:
             raise InvalidInputError(f"frames per packet must be 1-32, got {packet_frames}")
@@ -184,8 +192,9 @@ class Sender(threading.Thread):
         if not (np.isfinite(rate) and rate > 0):
             raise InvalidInputError(f"the target rate must be a positive number of kbit/s, got {rate}")
         self.quality, self.rate = quality, float(rate)
-        self.settings = Settings(quality=DEFAULT_QUALITY if quality is None else quality, packet=packet,
-                                 keyframe=max(keyframe, packet))
+        self.settings = Settings(
+            quality=DEFAULT_QUALITY if quality is None else quality, packet=packet, keyframe=max(keyframe, packet)
+        )
         self.packet_frames, self.keyframe_packets = self.settings.framing(self.fps)
         self.warmup_frames = max(1, round(warmup * self.fps))
         self.stats = SenderStats()
@@ -273,11 +282,22 @@ class Sender(threading.Thread):
         m = self.settings.basis_size
         basis = Basis.learn(np.array([f.offsets for f in faces]).reshape(len(faces), -1, 2), m)
         steps = self.settings.steps(len(basis.raw), True)
-        values = np.array([np.concatenate([pose_vector(f.pose), basis.coefficients(f.offsets), f.look.vector()])
-                           for f in faces])
+        values = np.array(
+            [np.concatenate([pose_vector(f.pose), basis.coefficients(f.offsets), f.look.vector()]) for f in faces]
+        )
         classes = _core.choose_classes(steps, self.settings.hysteresis, values.reshape(len(faces), len(steps)))
-        encoder = MotionEncoder(self.actor, self.fps, self.source.size, basis, self.settings, True, classes,
-                                reference=self._warm[0][0].pose, look=True, actor_data=self._actor_data)
+        encoder = MotionEncoder(
+            self.actor,
+            self.fps,
+            self.source.size,
+            basis,
+            self.settings,
+            True,
+            classes,
+            reference=self._warm[0][0].pose,
+            look=True,
+            actor_data=self._actor_data,
+        )
         start = encoder.start()
         header = encoder.header
         self.stats.warmup_frames, self.stats.header_bytes = len(self._warm), len(header)
@@ -285,7 +305,7 @@ class Sender(threading.Thread):
         self._pending: list[float] = []  # arrival times of the frames of the packet being filled
         with self._lock:
             self.encoder = encoder
-        self.sink.start_stream(header, start[len(header):])
+        self.sink.start_stream(header, start[len(header) :])
 
     def _push(self, motion: FrameMotion, arrived: float) -> None:
         with self._lock:

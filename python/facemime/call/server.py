@@ -27,6 +27,7 @@ connected are closed with 1001.
 
 from __future__ import annotations
 
+import contextlib
 import email.utils
 import json
 import logging
@@ -59,8 +60,10 @@ MAX_CLIENTS = 16
 #: Seconds a closing handshake may take before the connection is dropped.
 CLOSE_TIMEOUT = 1.0
 #: Path -> (file in the web folder, content type).
-PAGES = {"/": ("index.html", "text/html; charset=utf-8"),
-         "/receiver.js": ("receiver.js", "text/javascript; charset=utf-8")}
+PAGES = {
+    "/": ("index.html", "text/html; charset=utf-8"),
+    "/receiver.js": ("receiver.js", "text/javascript; charset=utf-8"),
+}
 #: WebSocket close codes.
 NORMAL, GOING_AWAY, UNSUPPORTED, POLICY = 1000, 1001, 1003, 1008
 
@@ -131,10 +134,8 @@ class Client:
             return None
 
     def _abort(self) -> None:
-        try:
+        with contextlib.suppress(OSError):
             self.connection.socket.shutdown(socket.SHUT_RDWR)
-        except OSError:
-            pass
 
 
 class Hub:
@@ -217,10 +218,8 @@ def _read(connection: ServerConnection, client: Client, hub: Hub) -> None:
         for message in connection:
             request = None
             if isinstance(message, str):
-                try:
+                with contextlib.suppress(ValueError):
                     request = json.loads(message)
-                except ValueError:
-                    pass
             if isinstance(request, dict) and request.get("type") == "intra":
                 hub.on_intra()
                 continue
@@ -249,9 +248,20 @@ def _handle(connection: ServerConnection, hub: Hub) -> None:
 
 
 def _response(status: int, phrase: str, body: bytes, kind: str) -> Response:
-    return Response(status, phrase, Headers([("Date", email.utils.formatdate(usegmt=True)), ("Connection", "close"),
-                                             ("Content-Length", str(len(body))), ("Content-Type", kind),
-                                             ("Cache-Control", "no-store")]), body)
+    return Response(
+        status,
+        phrase,
+        Headers(
+            [
+                ("Date", email.utils.formatdate(usegmt=True)),
+                ("Connection", "close"),
+                ("Content-Length", str(len(body))),
+                ("Content-Type", kind),
+                ("Cache-Control", "no-store"),
+            ]
+        ),
+        body,
+    )
 
 
 def make_server(hub: Hub, port: int = PORT, web: Path | Traversable | None = None) -> Server:
@@ -265,8 +275,12 @@ def make_server(hub: Hub, port: int = PORT, web: Path | Traversable | None = Non
     def process_request(connection: ServerConnection, request: Request) -> Response | None:
         names = rf"(?:127\.0\.0\.1|localhost):{bound[0]}"
         hosts, origins = request.headers.get_all("Host"), request.headers.get_all("Origin")
-        if (len(hosts) != 1 or not re.fullmatch(names, hosts[0], re.IGNORECASE) or len(origins) > 1
-                or (origins and not re.fullmatch(rf"http://{names}", origins[0], re.IGNORECASE))):
+        if (
+            len(hosts) != 1
+            or not re.fullmatch(names, hosts[0], re.IGNORECASE)
+            or len(origins) > 1
+            or (origins and not re.fullmatch(rf"http://{names}", origins[0], re.IGNORECASE))
+        ):
             return _response(403, "Forbidden", b"only pages of this machine may use the call", "text/plain")
         path = urlsplit(request.path).path
         if path == "/stream":
@@ -283,9 +297,17 @@ def make_server(hub: Hub, port: int = PORT, web: Path | Traversable | None = Non
         return _response(200, "OK", body, kind)
 
     try:
-        server = serve(lambda connection: _handle(connection, hub), "127.0.0.1", port,
-                       process_request=process_request, max_size=MAX_MESSAGE, compression=None,
-                       close_timeout=CLOSE_TIMEOUT, server_header=None, logger=_LOGGER)
+        server = serve(
+            lambda connection: _handle(connection, hub),
+            "127.0.0.1",
+            port,
+            process_request=process_request,
+            max_size=MAX_MESSAGE,
+            compression=None,
+            close_timeout=CLOSE_TIMEOUT,
+            server_header=None,
+            logger=_LOGGER,
+        )
     except OSError as e:
         raise InvalidInputError(f"cannot listen on port {port}: {e.strerror or e}; pick another with --port") from None
     bound.append(server.socket.getsockname()[1])

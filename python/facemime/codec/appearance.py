@@ -67,7 +67,9 @@ class Update:
 
     def payload(self, quality: int = QUALITY) -> bytes:
         """The chunk's payload (the image as lossy WebP at ``quality``)."""
-        ok, data = cv2.imencode(".webp", cv2.cvtColor(self.image, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_WEBP_QUALITY, quality])
+        ok, data = cv2.imencode(
+            ".webp", cv2.cvtColor(self.image, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_WEBP_QUALITY, quality]
+        )
         if not ok:
             raise ValueError("WebP encoding failed")
         return HEAD.pack(self.frame, self.x, self.y) + data.tobytes()
@@ -97,17 +99,25 @@ def paste(texture: np.ndarray, update: Update) -> bool:
         return False
     far = np.full(max(uw, uh), BLEND)
     i, j = np.arange(uw), np.arange(uh)
-    d = np.minimum(np.minimum(j if update.y > 0 else far[:uh], uh - 1 - j if update.y + uh < h else far[:uh])[:, None],
-                   np.minimum(i if update.x > 0 else far[:uw], uw - 1 - i if update.x + uw < w else far[:uw])[None, :])
+    d = np.minimum(
+        np.minimum(j if update.y > 0 else far[:uh], uh - 1 - j if update.y + uh < h else far[:uh])[:, None],
+        np.minimum(i if update.x > 0 else far[:uw], uw - 1 - i if update.x + uw < w else far[:uw])[None, :],
+    )
     k = np.minimum(BLEND, d + 1)[: y1 - update.y, : x1 - update.x, None].astype(np.int32)
     u = update.image[: y1 - update.y, : x1 - update.x].astype(np.int32)
-    t = texture[update.y:y1, update.x:x1].astype(np.int32)
-    texture[update.y:y1, update.x:x1] = ((k * u + (BLEND - k) * t + BLEND // 2) // BLEND).astype(np.uint8)
+    t = texture[update.y : y1, update.x : x1].astype(np.int32)
+    texture[update.y : y1, update.x : x1] = ((k * u + (BLEND - k) * t + BLEND // 2) // BLEND).astype(np.uint8)
     return True
 
 
-def lay_back(frame: np.ndarray, model_uv: np.ndarray, triangles: np.ndarray, points: np.ndarray,
-             facing: np.ndarray, size: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+def lay_back(
+    frame: np.ndarray,
+    model_uv: np.ndarray,
+    triangles: np.ndarray,
+    points: np.ndarray,
+    facing: np.ndarray,
+    size: tuple[int, int],
+) -> tuple[np.ndarray, np.ndarray]:
     """``frame`` (H, W, 3) laid onto a texture of ``size`` (width, height) through the triangles
     ``facing`` (indices into ``triangles``) whose vertices are seen at ``points`` (N, 2) px and
     sit at ``model_uv`` (N, 2) in the texture: (texture, coverage 0..255)."""
@@ -139,7 +149,9 @@ class AppearanceSender:
             eye[model.groups[e]] = True
         self._triangles = tri[~eye[tri].all(axis=1)]  # the eye openings: the look moves them
         v = model.vertices
-        n = np.cross(v[self._triangles[:, 1]] - v[self._triangles[:, 0]], v[self._triangles[:, 2]] - v[self._triangles[:, 0]])
+        n = np.cross(
+            v[self._triangles[:, 1]] - v[self._triangles[:, 0]], v[self._triangles[:, 2]] - v[self._triangles[:, 0]]
+        )
         self._normals = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
         h, w = texture.shape[:2]
         self._eyes = np.zeros((h, w), np.uint8)  # the eyes and a margin: never sent

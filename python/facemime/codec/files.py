@@ -108,8 +108,14 @@ def analyse(video: str | Path, actor: Actor | None = None) -> Clip:
                 motion.append(analysis.update(frame))
         if analysis is None:
             raise InputFileError(f"video {video} has no frames")
-        return Clip(actor or analysis.actor, reader.fps, (reader.width, reader.height), motion,
-                    list(analysis.warnings) + list(reader.warnings), time.perf_counter() - t0)
+        return Clip(
+            actor or analysis.actor,
+            reader.fps,
+            (reader.width, reader.height),
+            motion,
+            list(analysis.warnings) + list(reader.warnings),
+            time.perf_counter() - t0,
+        )
 
 
 def track_clip(track: str | Path, actor: Actor | None = None) -> Clip:
@@ -130,8 +136,9 @@ def _look(frame: FrameMotion) -> Look:
     return getattr(frame, "look", None) or Look()
 
 
-def encode_clip(clip: Clip, settings: Settings, carry_actor: bool,
-                basis: Basis | None = None) -> tuple[bytes, bytes, list[bytes]]:
+def encode_clip(
+    clip: Clip, settings: Settings, carry_actor: bool, basis: Basis | None = None
+) -> tuple[bytes, bytes, list[bytes]]:
     """The stream of an analysed clip: (header, actor chunk or b"", packets). ``basis``: the
     clip's (default: learned from it, at the settings' size). The stream carries the frames'
     looks (format version 2) when a frame with a face has a look that is not neutral; otherwise
@@ -143,19 +150,31 @@ def encode_clip(clip: Clip, settings: Settings, carry_actor: bool,
     basis = Basis(basis.raw[:m])
     look = any(np.any(_look(f).vector() != 0) for f in faces)
     steps = settings.steps(m, look)
-    values = np.array([np.concatenate([pose_vector(f.pose), basis.coefficients(f.offsets)]
-                                      + ([_look(f).vector()] if look else [])) for f in faces])
+    values = np.array(
+        [
+            np.concatenate([pose_vector(f.pose), basis.coefficients(f.offsets)] + ([_look(f).vector()] if look else []))
+            for f in faces
+        ]
+    )
     classes = _core.choose_classes(steps, settings.hysteresis, values.reshape(len(faces), len(steps)))
-    enc = MotionEncoder(clip.actor, clip.fps, clip.size, basis, settings, carry_actor, classes,
-                        reference=clip.motion[0].pose, look=look)
+    enc = MotionEncoder(
+        clip.actor, clip.fps, clip.size, basis, settings, carry_actor, classes, reference=clip.motion[0].pose, look=look
+    )
     packets = [enc.push(f.face, f.lost, f.pose, f.offsets, _look(f) if look else None).data for f in clip.motion]
     packets.append(enc.finish())
     start = enc.start()
-    return enc.header, start[len(enc.header):], [p for p in packets if p]
+    return enc.header, start[len(enc.header) :], [p for p in packets if p]
 
 
-def with_appearance(video: str | Path, clip: Clip, header: bytes, actor_chunk: bytes, packets: list[bytes],
-                    settings: Settings, budget: float) -> tuple[list[bytes], AppearanceSender]:
+def with_appearance(
+    video: str | Path,
+    clip: Clip,
+    header: bytes,
+    actor_chunk: bytes,
+    packets: list[bytes],
+    settings: Settings,
+    budget: float,
+) -> tuple[list[bytes], AppearanceSender]:
     """``packets`` with appearance updates (:mod:`facemime.codec.appearance`) of at most
     ``budget`` kbit/s put before the packet holding each update's first frame: ``video`` is read
     again, each frame laid onto the texture through what the receiver draws (the stream decoded
@@ -176,9 +195,16 @@ def with_appearance(video: str | Path, clip: Clip, header: bytes, actor_chunk: b
     return [c for k, p in enumerate(packets) for c in before.get(k, []) + [p]], sender
 
 
-def encode_video(video: str | Path, out: str | Path, actor: str | Path | None = None, settings: Settings = Settings(),
-                 rate: float | None = None, carry_actor: bool | None = None, force: bool = False,
-                 appearance: float = 0.0) -> EncodeResult:
+def encode_video(
+    video: str | Path,
+    out: str | Path,
+    actor: str | Path | None = None,
+    settings: Settings = Settings(),
+    rate: float | None = None,
+    carry_actor: bool | None = None,
+    force: bool = False,
+    appearance: float = 0.0,
+) -> EncodeResult:
     """Analyse ``video`` and write the stream ``out`` (``.fmstream``); a ``video`` ending in
     ``.json`` is a track file whose motion is coded instead (:func:`track_clip`). ``actor``: an
     ``.actor`` file the receiver holds (the stream names it; default: fit one on the first frame,
@@ -215,8 +241,10 @@ def encode_video(video: str | Path, out: str | Path, actor: str | Path | None = 
             if sum(map(len, packets)) * 8 / 1000 / duration <= rate:
                 break
         else:
-            warnings.append(f"the coarsest quality needs {sum(map(len, packets)) * 8 / 1000 / duration:.2f} kbit/s, "
-                            f"more than the {rate:g} asked for")
+            warnings.append(
+                f"the coarsest quality needs {sum(map(len, packets)) * 8 / 1000 / duration:.2f} kbit/s, "
+                f"more than the {rate:g} asked for"
+            )
     motion_bytes, updates, sent = sum(map(len, packets)), 0, 0
     if appearance > 0:
         chunks, sender = with_appearance(video, clip, header, actor_chunk, packets, chosen, appearance)
@@ -224,8 +252,19 @@ def encode_video(video: str | Path, out: str | Path, actor: str | Path | None = 
         packets = chunks
     write_bytes(out, header + actor_chunk + b"".join(packets))
     seconds = {"analysis": clip.seconds, "coding": time.perf_counter() - t0}
-    return EncodeResult(len(clip.motion), clip.fps, chosen.quality, len(header), len(actor_chunk), motion_bytes,
-                        seconds, warnings, scene_bytes(actor_chunk), sent, updates)
+    return EncodeResult(
+        len(clip.motion),
+        clip.fps,
+        chosen.quality,
+        len(header),
+        len(actor_chunk),
+        motion_bytes,
+        seconds,
+        warnings,
+        scene_bytes(actor_chunk),
+        sent,
+        updates,
+    )
 
 
 def scene_bytes(actor_chunk: bytes) -> int:
@@ -236,7 +275,7 @@ def scene_bytes(actor_chunk: bytes) -> int:
     at = 3
     while actor_chunk[at] & 0x80:  # the length's bytes
         at += 1
-    with zipfile.ZipFile(io.BytesIO(actor_chunk[at + 1:-4])) as z:
+    with zipfile.ZipFile(io.BytesIO(actor_chunk[at + 1 : -4])) as z:
         return sum(i.compress_size for i in z.infolist() if i.filename.startswith("scene."))
 
 
@@ -268,8 +307,9 @@ def read_stream(path: str | Path) -> bytes:
         raise InputFileError(f"cannot read {path}: {e.strerror or e}") from None
 
 
-def decode_stream(stream: str | Path, out: str | Path, actor: str | Path | None = None,
-                  force: bool = False, mask_only: bool = False) -> DecodeResult:
+def decode_stream(
+    stream: str | Path, out: str | Path, actor: str | Path | None = None, force: bool = False, mask_only: bool = False
+) -> DecodeResult:
     """Decode ``stream`` and write the synthesised picture to ``out`` (.mp4 or .webm) at the
     stream's frame rate and size: the face in its actor's scene, or alone with ``mask_only`` (or
     when the actor has no scene). ``actor``: the ``.actor`` file the stream names when it does
@@ -281,14 +321,16 @@ def decode_stream(stream: str | Path, out: str | Path, actor: str | Path | None 
     check_outputs([out], force, inputs=[stream, actor])
     t0 = time.perf_counter()
     data = read_stream(stream)
-    decoder = MotionDecoder(load_actor(actor) if actor is not None else None, name=str(stream),
-                            max_concealed=MAX_CONCEALED_RATIO)
+    decoder = MotionDecoder(
+        load_actor(actor) if actor is not None else None, name=str(stream), max_concealed=MAX_CONCEALED_RATIO
+    )
     frames = decoder.push(data) + decoder.finish()
     if decoder.stats["frames"] == 0:
         raise StreamError(f"{stream}: no frame could be decoded ({decoder.stats['damaged_bytes']} damaged bytes)")
     info, target = decoder.info, decoder.actor
-    puppet = Puppet(target, Deformer(target.model).feature_sizes(), model_iod(target.model), decoder.reference(),
-                    mask_only)
+    puppet = Puppet(
+        target, Deformer(target.model).feature_sizes(), model_iod(target.model), decoder.reference(), mask_only
+    )
     w, h = info.size
     image, shown = np.empty((h, w, 3), np.uint8), np.empty((h, w, 3), np.uint8)
     updates = Appearance(target.texture, decoder.appearance, decoder.appearance_after)
@@ -302,5 +344,11 @@ def decode_stream(stream: str | Path, out: str | Path, actor: str | Path | None 
                 puppet.render(f.pose, f.offsets, (w, h), out=image, look=f.look)
                 shown[:] = image if f.face else (image * NO_FACE_DIM).astype(np.uint8)
             writer.write(shown)
-    return DecodeResult(len(frames), decoder.stats["concealed"], decoder.stats, time.perf_counter() - t0,
-                        updates.applied, updates.refused)
+    return DecodeResult(
+        len(frames),
+        decoder.stats["concealed"],
+        decoder.stats,
+        time.perf_counter() - t0,
+        updates.applied,
+        updates.refused,
+    )

@@ -40,8 +40,9 @@ def pose_vector(pose: Pose) -> np.ndarray:
 
 def pose_from_vector(v: np.ndarray) -> Pose:
     """The pose of a (6,) :func:`pose_vector`."""
-    return Pose(yaw=float(v[0]), pitch=float(v[1]), roll=float(v[2]), scale=float(np.exp(v[3])), tx=float(v[4]),
-                ty=float(v[5]))
+    return Pose(
+        yaw=float(v[0]), pitch=float(v[1]), roll=float(v[2]), scale=float(np.exp(v[3])), tx=float(v[4]), ty=float(v[5])
+    )
 
 
 def look_from_extras(kinds: tuple[int, ...], values: np.ndarray) -> Look:
@@ -94,6 +95,9 @@ class Basis:
 def topology_id(model: HeadModel) -> bytes:
     """Eight bytes naming the model's topology: its vertex count, triangles and knot vertices
     (the first 8 bytes of the SHA-256 of their compact JSON, ``docs/bitstream.md``)."""
-    doc = {"vertices": len(model.vertices), "triangles": np.asarray(model.triangles).tolist(),
-           "knots": Deformer(model).knots.tolist()}
+    doc = {
+        "vertices": len(model.vertices),
+        "triangles": np.asarray(model.triangles).tolist(),
+        "knots": Deformer(model).knots.tolist(),
+    }
     return hashlib.sha256(json.dumps(doc, separators=(",", ":")).encode()).digest()[:8]

@@ -11,7 +11,7 @@ good one and resynchronises at the next intra packet.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
 
@@ -20,8 +20,15 @@ import numpy as np
 from facemime import _core
 from facemime.animate.deform import Deformer
 from facemime.animate.look import Look
-from facemime.codec.params import (LOOK_KINDS, POSE_PARAMETERS, Basis, look_from_extras, pose_from_vector, pose_vector,
-                                   topology_id)
+from facemime.codec.params import (
+    LOOK_KINDS,
+    POSE_PARAMETERS,
+    Basis,
+    look_from_extras,
+    pose_from_vector,
+    pose_vector,
+    topology_id,
+)
 from facemime.errors import FacemimeError, InvalidInputError
 from facemime.fit.actor import Actor
 from facemime.io.actor_file import ActorFileError, actor_bytes, actor_from_bytes, actor_id
@@ -32,8 +39,19 @@ from facemime.track.contours import FEATURES
 DEFAULT_QUALITY = 5
 #: Per quality: the factor on the steps below, and the basis coefficients sent. Quality 5 is the
 #: finest whose motion stays under 2 kbit/s on every shared video (``benchmarks/codec.py``).
-LADDER = ((2.83, 4), (2.0, 6), (1.68, 8), (1.41, 10), (1.19, 12), (1.0, 16), (0.71, 16), (0.5, 20), (0.35, 24),
-          (0.25, 28), (0.18, 32))
+LADDER = (
+    (2.83, 4),
+    (2.0, 6),
+    (1.68, 8),
+    (1.41, 10),
+    (1.19, 12),
+    (1.0, 16),
+    (0.71, 16),
+    (0.5, 20),
+    (0.35, 24),
+    (0.25, 28),
+    (0.18, 32),
+)
 #: Quantiser steps at factor 1: yaw, pitch, roll (degrees), ln scale, tx, ty (px), and the
 #: basis coefficients (model units). The synthesised face's fidelity is sensitive to the pose:
 #: on lp_d0, steps of 1 degree and 1 px cost 0.008 in face SSIM, 0.7 degrees 0.0055, 0.5 degrees
@@ -132,9 +150,19 @@ class MotionEncoder:
     hundred milliseconds).
     """
 
-    def __init__(self, actor: Actor, fps: float, size: tuple[int, int], basis: Basis, settings: Settings = Settings(),
-                 carry_actor: bool = True, classes: Sequence[int] | None = None, reference: Pose | None = None,
-                 look: bool = False, actor_data: bytes | None = None):
+    def __init__(
+        self,
+        actor: Actor,
+        fps: float,
+        size: tuple[int, int],
+        basis: Basis,
+        settings: Settings = Settings(),
+        carry_actor: bool = True,
+        classes: Sequence[int] | None = None,
+        reference: Pose | None = None,
+        look: bool = False,
+        actor_data: bytes | None = None,
+    ):
         self.settings, self.basis, self.look = settings, basis, bool(look)
         m = len(basis.raw)
         steps = settings.steps(m, self.look)
@@ -145,9 +173,20 @@ class MotionEncoder:
             raise InvalidInputError(f"classes must have one entry per parameter ({len(steps)}), got {len(classes)}")
         frames, keyframes = settings.framing(fps)
         self._core = _core.StreamEncoder(
-            _fps_fraction(fps), (int(size[0]), int(size[1])), topology_id(actor.model), frames, keyframes, steps,
-            references, list(classes) if classes is not None else [6] * len(steps), basis.raw,
-            actor_id(actor), carry_actor, settings.hysteresis, extras)
+            _fps_fraction(fps),
+            (int(size[0]), int(size[1])),
+            topology_id(actor.model),
+            frames,
+            keyframes,
+            steps,
+            references,
+            list(classes) if classes is not None else [6] * len(steps),
+            basis.raw,
+            actor_id(actor),
+            carry_actor,
+            settings.hysteresis,
+            extras,
+        )
         if not carry_actor:
             actor_data = b""
         elif actor_data is None:
@@ -163,8 +202,9 @@ class MotionEncoder:
         """The header chunk alone (what a sender repeats to a receiver that joins)."""
         return self._core.header_chunk()
 
-    def push(self, face: bool, lost: Sequence[str], pose: Pose, offsets: np.ndarray,
-             look: Look | None = None) -> EncodedFrame:
+    def push(
+        self, face: bool, lost: Sequence[str], pose: Pose, offsets: np.ndarray, look: Look | None = None
+    ) -> EncodedFrame:
         """Adds a frame: ``face`` (False: the pose, offsets and look are not sent), the features
         ``lost``, the ``pose``, (K, 2) ``offsets`` (model units) and the ``look`` (None:
         neutral; only an encoder made with ``look=True`` sends one)."""
@@ -174,13 +214,17 @@ class MotionEncoder:
         if not self.look and np.any(look_values != 0):
             raise InvalidInputError("this encoder's stream carries no look: make it with look=True to send one")
         m = len(self.basis.raw)
-        values = np.concatenate([pose_vector(pose), self.basis.coefficients(offsets)]
-                                + ([look_values] if self.look else []))
+        values = np.concatenate(
+            [pose_vector(pose), self.basis.coefficients(offsets)] + ([look_values] if self.look else [])
+        )
         recon, packet = self._core.push(bool(face), _lost_bits(lost), values)
-        coded = recon[POSE_PARAMETERS + m:]
-        return EncodedFrame(pose_from_vector(recon[:POSE_PARAMETERS]),
-                            self.basis.offsets(recon[POSE_PARAMETERS:POSE_PARAMETERS + m]), packet or b"",
-                            look_from_extras(LOOK_KINDS, coded) if self.look else Look())
+        coded = recon[POSE_PARAMETERS + m :]
+        return EncodedFrame(
+            pose_from_vector(recon[:POSE_PARAMETERS]),
+            self.basis.offsets(recon[POSE_PARAMETERS : POSE_PARAMETERS + m]),
+            packet or b"",
+            look_from_extras(LOOK_KINDS, coded) if self.look else Look(),
+        )
 
     def request_intra(self) -> None:
         """Makes the next packet an intra packet, whatever its number (a live receiver that
@@ -245,8 +289,13 @@ class MotionDecoder:
     read, so it falls between those frames and the next.
     """
 
-    def __init__(self, actor: Actor | None = None, from_start: bool = True, name: str = "the stream",
-                 max_concealed: float | None = None):
+    def __init__(
+        self,
+        actor: Actor | None = None,
+        from_start: bool = True,
+        name: str = "the stream",
+        max_concealed: float | None = None,
+    ):
         self._core = _core.StreamDecoder(from_start)
         self._max_concealed = max_concealed
         self._given, self.name = actor, name
@@ -260,13 +309,25 @@ class MotionDecoder:
 
     def _read_header(self) -> None:
         h = self._core.header()
-        if h is None or (self.info is not None and h["basis"].tobytes() == self.info.basis.raw.tobytes()
-                         and h["actor_id"] == self.info.actor_id and tuple(h["extras"]) == self.info.extras):
+        if h is None or (
+            self.info is not None
+            and h["basis"].tobytes() == self.info.basis.raw.tobytes()
+            and h["actor_id"] == self.info.actor_id
+            and tuple(h["extras"]) == self.info.extras
+        ):
             return
         self.actor = None  # a first header, or a new one: its actor is looked up again
-        self.info = StreamInfo(h["fps"][0] / h["fps"][1], tuple(h["size"]), h["packet_frames"], h["keyframe_packets"],
-                               Basis(h["basis"]), h["actor_in_stream"], h["actor_id"], h["topology"],
-                               tuple(int(k) for k in h["extras"]))
+        self.info = StreamInfo(
+            h["fps"][0] / h["fps"][1],
+            tuple(h["size"]),
+            h["packet_frames"],
+            h["keyframe_packets"],
+            Basis(h["basis"]),
+            h["actor_in_stream"],
+            h["actor_id"],
+            h["topology"],
+            tuple(int(k) for k in h["extras"]),
+        )
 
     def _resolve_actor(self) -> None:
         if self.actor is not None or self.info is None:
@@ -294,7 +355,7 @@ class MotionDecoder:
             raise StreamError(f"{self.name}'s basis does not fit the {knots} knots of its actor")
         self.actor = actor
 
-    def _collect(self, decoded: tuple) -> tuple:
+    def _collect(self, decoded: _core.Decoded) -> _core.Decoded:
         """Takes the appearance payloads out of what the core decoded, noting where they fall."""
         index, concealed, updates = decoded[0], decoded[4], decoded[5]
         for before, payload in updates:
@@ -303,21 +364,38 @@ class MotionDecoder:
         self._output += len(index) + int(concealed[:, 1].sum())
         return decoded
 
-    def _frames(self, decoded: tuple) -> list[DecodedFrame]:
+    def _frames(self, decoded: _core.Decoded) -> list[DecodedFrame]:
         index, face, lost, values, concealed, _ = decoded
         stats = self._core.stats()
-        if (self._max_concealed is not None and self.info is not None
-                and stats["concealed"] > self._max_concealed * stats["frames"] + 60 * self.info.fps):
-            raise StreamError(f"{self.name} is too damaged to play: {stats['concealed']} frames lost against "
-                              f"{stats['frames']} decoded")
+        if (
+            self._max_concealed is not None
+            and self.info is not None
+            and stats["concealed"] > self._max_concealed * stats["frames"] + 60 * self.info.fps
+        ):
+            raise StreamError(
+                f"{self.name} is too damaged to play: {stats['concealed']} frames lost against "
+                f"{stats['frames']} decoded"
+            )
         out: list[tuple[int, DecodedFrame | None, int]] = []
-        m = len(self.info.basis.raw) if self.info is not None else 0
-        for i, f, l, v in zip(index, face, lost, values):
-            look = look_from_extras(self.info.extras, v[POSE_PARAMETERS + m:]) if self.info.extras else Look()
-            out.append((int(i), DecodedFrame(int(i), bool(f), [n for b, n in enumerate(FEATURES) if l >> b & 1],
-                                             pose_from_vector(v[:POSE_PARAMETERS]),
-                                             self.info.basis.offsets(v[POSE_PARAMETERS:POSE_PARAMETERS + m]),
-                                             look=look), 0))
+        info = self.info
+        m = len(info.basis.raw) if info is not None else 0
+        for i, f, lost_bits, v in zip(index, face, lost, values):
+            assert info is not None  # frames come after a header
+            look = look_from_extras(info.extras, v[POSE_PARAMETERS + m :]) if info.extras else Look()
+            out.append(
+                (
+                    int(i),
+                    DecodedFrame(
+                        int(i),
+                        bool(f),
+                        [n for b, n in enumerate(FEATURES) if lost_bits >> b & 1],
+                        pose_from_vector(v[:POSE_PARAMETERS]),
+                        info.basis.offsets(v[POSE_PARAMETERS : POSE_PARAMETERS + m]),
+                        look=look,
+                    ),
+                    0,
+                )
+            )
         for first, count in concealed:
             out.append((int(first), None, int(count)))
         frames = []
@@ -331,20 +409,24 @@ class MotionDecoder:
                 if last is None:
                     frames.append(DecodedFrame(first + k, False, list(FEATURES), self.reference(), self._rest(), True))
                 else:
-                    frames.append(DecodedFrame(first + k, last.face, last.lost, last.pose, last.offsets, True,
-                                               last.look))
+                    frames.append(
+                        DecodedFrame(first + k, last.face, last.lost, last.pose, last.offsets, True, last.look)
+                    )
         return frames
 
     def reference(self) -> Pose:
         """The pose the stream's motion starts from (its header's reference, quantised): the
         source face's pose on its key frame."""
         h = self._core.header()
+        if h is None:
+            raise StreamError(f"{self.name} has no header")
         return pose_from_vector(np.array(h["references"][:POSE_PARAMETERS]) * np.array(h["steps"][:POSE_PARAMETERS]))
 
     def _rest(self) -> np.ndarray:
+        assert self.info is not None  # read with the header
         return np.zeros((self.info.basis.raw.shape[1] // 2, 2))
 
-    def _segments(self, decoded: tuple, again) -> list[DecodedFrame]:
+    def _segments(self, decoded: _core.Decoded, again: Callable[[], _core.Decoded]) -> list[DecodedFrame]:
         """The frames of what the core decoded, and of what it has left after a new header (each
         part read with its own header)."""
         frames = []

@@ -29,8 +29,15 @@ def _multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Hamilton products of (T, 4) quaternions (x, y, z, w): rotation ``b`` then ``a``."""
     ax, ay, az, aw = a.T
     bx, by, bz, bw = b.T
-    return np.stack([aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
-                     aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz], axis=1)
+    return np.stack(
+        [
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+            aw * bw - ax * bx - ay * by - az * bz,
+        ],
+        axis=1,
+    )
 
 
 def quaternions(yaw: np.ndarray, pitch: np.ndarray, roll: np.ndarray) -> np.ndarray:
@@ -41,6 +48,7 @@ def quaternions(yaw: np.ndarray, pitch: np.ndarray, roll: np.ndarray) -> np.ndar
     >>> np.round(quaternions(np.array([90.0]), np.zeros(1), np.zeros(1)), 4).tolist()
     [[0.0, 0.7071, 0.0, 0.7071]]
     """
+
     def about(axis: int, degrees: np.ndarray) -> np.ndarray:
         half = np.radians(np.asarray(degrees, np.float64)) / 2
         q = np.zeros((len(half), 4))

@@ -22,7 +22,12 @@ BIN_CHUNK = 0x004E4942  # "BIN\0"
 ARRAY_BUFFER = 34962
 ELEMENT_ARRAY_BUFFER = 34963
 #: glTF component types of the numpy dtypes written.
-COMPONENTS = {np.dtype("<f4"): 5126, np.dtype("<u4"): 5125, np.dtype("<u2"): 5123, np.dtype("<u1"): 5121}
+COMPONENTS: dict[np.dtype[Any], int] = {
+    np.dtype("<f4"): 5126,
+    np.dtype("<u4"): 5125,
+    np.dtype("<u2"): 5123,
+    np.dtype("<u1"): 5121,
+}
 #: glTF accessor types by the number of components per element.
 TYPES = {1: "SCALAR", 2: "VEC2", 3: "VEC3", 4: "VEC4"}
 
@@ -68,8 +73,12 @@ class Glb:
         positions and animation times). Its accessor index."""
         a = np.ascontiguousarray(array, dtype=array.dtype.newbyteorder("<"))
         width = 1 if a.ndim == 1 else a.shape[1]
-        entry: dict[str, Any] = {"bufferView": self.view(a.tobytes(), target), "componentType": COMPONENTS[a.dtype],
-                                 "count": int(a.shape[0]), "type": TYPES[width]}
+        entry: dict[str, Any] = {
+            "bufferView": self.view(a.tobytes(), target),
+            "componentType": COMPONENTS[a.dtype],
+            "count": int(a.shape[0]),
+            "type": TYPES[width],
+        }
         if bounds:
             flat = a.reshape(len(a), width)
             cast = float if a.dtype.kind == "f" else int
@@ -105,12 +114,12 @@ def read_glb(data: bytes) -> tuple[dict[str, Any], bytes]:
     size, kind = struct.unpack_from("<II", data, 12)
     if kind != JSON_CHUNK:
         raise ValueError("the first chunk of a .glb must be JSON")
-    doc = json.loads(data[20:20 + size])
+    doc = json.loads(data[20 : 20 + size])
     rest = 20 + size
     blob = b""
     if rest < len(data):
         size, kind = struct.unpack_from("<II", data, rest)
-        blob = data[rest + 8:rest + 8 + size] if kind == BIN_CHUNK else b""
+        blob = data[rest + 8 : rest + 8 + size] if kind == BIN_CHUNK else b""
     return doc, blob
 
 

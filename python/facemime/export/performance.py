@@ -30,8 +30,8 @@ import cv2
 import numpy as np
 
 from facemime import __version__
-from facemime.errors import InputFileError, InvalidInputError
 from facemime.animate.replay import track_settings
+from facemime.errors import InputFileError, InvalidInputError
 from facemime.export.animation import POSE_KEYS, node_keys
 from facemime.export.gltf import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, Glb
 from facemime.fit.actor import Actor, generic_actor
@@ -91,14 +91,17 @@ def glb_bytes(perf: Performance) -> bytes:
     g = Glb(f"facemime {__version__}")
     n = len(model.vertices)
     index_type = np.uint16 if n < 65535 else np.uint32
-    attributes = {"POSITION": g.accessor((model.vertices * m).astype(np.float32), ARRAY_BUFFER, bounds=True),
-                  "TEXCOORD_0": g.accessor(model.uv.astype(np.float32), ARRAY_BUFFER)}
+    attributes = {
+        "POSITION": g.accessor((model.vertices * m).astype(np.float32), ARRAY_BUFFER, bounds=True),
+        "TEXCOORD_0": g.accessor(model.uv.astype(np.float32), ARRAY_BUFFER),
+    }
     indices = g.accessor(model.triangles.astype(index_type).ravel(), ELEMENT_ARRAY_BUFFER)
     primitive: dict[str, Any] = {"attributes": attributes, "indices": indices, "mode": 4}
     mesh: dict[str, Any] = {"name": "face", "primitives": [primitive]}
     if perf.names:
-        primitive["targets"] = [{"POSITION": g.accessor((f * m).astype(np.float32), ARRAY_BUFFER, bounds=True)}
-                                for f in perf.fields]
+        primitive["targets"] = [
+            {"POSITION": g.accessor((f * m).astype(np.float32), ARRAY_BUFFER, bounds=True)} for f in perf.fields
+        ]
         mesh["weights"] = [float(w) for w in perf.weights[0]]
         mesh["extras"] = {"targetNames": list(perf.names)}
     ok, png = cv2.imencode(".png", cv2.cvtColor(perf.actor.texture, cv2.COLOR_RGB2BGR))
@@ -107,18 +110,34 @@ def glb_bytes(perf: Performance) -> bytes:
     image = g.add("images", {"bufferView": g.view(png.tobytes()), "mimeType": "image/png"})
     sampler = g.add("samplers", {"magFilter": LINEAR, "minFilter": LINEAR, "wrapS": CLAMP, "wrapT": CLAMP})
     texture = g.add("textures", {"source": image, "sampler": sampler})
-    primitive["material"] = g.add("materials", {
-        "name": "face", "pbrMetallicRoughness": {"baseColorTexture": {"index": texture}, "metallicFactor": 0.0},
-        "extensions": {"KHR_materials_unlit": {}}})
+    primitive["material"] = g.add(
+        "materials",
+        {
+            "name": "face",
+            "pbrMetallicRoughness": {"baseColorTexture": {"index": texture}, "metallicFactor": 0.0},
+            "extensions": {"KHR_materials_unlit": {}},
+        },
+    )
     g.doc["extensionsUsed"] = ["KHR_materials_unlit"]
     translation, rotation, scale = node_keys(perf.poses, m)
     node = g.add("nodes", {"name": model.name, "mesh": g.add("meshes", mesh), "rotation": rotation[0].tolist()})
     first = perf.poses[0]
     per_pixel = m / float(first[3])
-    g.doc["scenes"] = [{"name": "performance", "nodes": [node], "extras": {"facemime": {
-        "size": list(perf.size), "metres_per_pixel": per_pixel, "origin": [float(first[4]), float(first[5])],
-        "pose_mapping": "rotation Rz(roll)Rx(pitch)Ry(yaw); scale relative to the first frame; translation: "
-                        "pixel shift from the first frame times metres_per_pixel, image y down = -y"}}}]
+    g.doc["scenes"] = [
+        {
+            "name": "performance",
+            "nodes": [node],
+            "extras": {
+                "facemime": {
+                    "size": list(perf.size),
+                    "metres_per_pixel": per_pixel,
+                    "origin": [float(first[4]), float(first[5])],
+                    "pose_mapping": "rotation Rz(roll)Rx(pitch)Ry(yaw); scale relative to the first frame; "
+                    "translation: pixel shift from the first frame times metres_per_pixel, image y down = -y",
+                }
+            },
+        }
+    ]
     g.doc["scene"] = 0
     times = g.accessor(perf.times.astype(np.float32), bounds=True)
     channels = [("translation", translation), ("rotation", rotation), ("scale", scale)]
@@ -146,8 +165,9 @@ def _file_weights(path: Path, names: tuple[str, ...]) -> np.ndarray | None:
             raise ContourFileError(f"{path}: frame entry {t} has malformed 'weights'")
         for name, value in w.items():
             if name not in slot:
-                raise ContourFileError(f"{path}: frame entry {t} weighs {name!r}, not a control of this actor "
-                                       f"({', '.join(names)})")
+                raise ContourFileError(
+                    f"{path}: frame entry {t} weighs {name!r}, not a control of this actor ({', '.join(names)})"
+                )
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 1.0:
                 raise ContourFileError(f"{path}: frame entry {t} weight {name!r} must be a number in [0, 1]")
             out[t, slot[name]] = value
@@ -174,10 +194,13 @@ def load_performance(track: str | Path, actor: Actor | None = None) -> Performan
         raise InvalidInputError(f"actor {model.name!r} is not a facemime head with expression controls ({e})") from None
     names = tuple(ex.names)
     knots = block.get("knots", ex.deformer.knots.tolist())
-    if len(knots) != len(ex.deformer.knots) or not all(isinstance(k, int) and 0 <= k < len(model.vertices)
-                                                       for k in knots):
-        raise InvalidInputError(f"the track's motion has {len(knots)} knots of another head model than actor "
-                                f"{model.name!r} ({len(ex.deformer.knots)} knots, {len(model.vertices)} vertices)")
+    if len(knots) != len(ex.deformer.knots) or not all(
+        isinstance(k, int) and 0 <= k < len(model.vertices) for k in knots
+    ):
+        raise InvalidInputError(
+            f"the track's motion has {len(knots)} knots of another head model than actor "
+            f"{model.name!r} ({len(ex.deformer.knots)} knots, {len(model.vertices)} vertices)"
+        )
     weights = _file_weights(track, names)
     if weights is None:  # solved as the actor would play the knots: offsets scaled per feature (Puppet)
         ratio = (ex.deformer.feature_sizes() / sizes)[:, None]
@@ -202,8 +225,9 @@ class ExportResult:
     seconds: float
 
 
-def export_track(track: str | Path, out: str | Path, actor: str | Path | Actor | None = None,
-                 force: bool = False) -> ExportResult:
+def export_track(
+    track: str | Path, out: str | Path, actor: str | Path | Actor | None = None, force: bool = False
+) -> ExportResult:
     """Write the performance of ``track`` (``facemime.track/1`` from ``facemime run``) on
     ``actor`` (an ``.actor`` file or an :class:`Actor`; default the generic head) to ``out``
     (``.glb``); an existing ``out`` is refused unless ``force``."""
@@ -216,8 +240,9 @@ def export_track(track: str | Path, out: str | Path, actor: str | Path | Actor |
     actor_path = actor if isinstance(actor, (str, Path)) else None
     check_outputs([out], force, inputs=[track, actor_path])
     if not Path(track).is_file():
-        raise InputFileError(f"track file {track} does not exist" if not Path(track).exists()
-                             else f"track file {track} is not a file")
+        raise InputFileError(
+            f"track file {track} does not exist" if not Path(track).exists() else f"track file {track} is not a file"
+        )
     chosen = load_actor(actor_path) if actor_path is not None else actor
     perf = load_performance(track, chosen)
     data = glb_bytes(perf)

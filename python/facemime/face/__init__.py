@@ -8,6 +8,17 @@ from facemime.face.landmarks import Crop, crop_from_detection, crop_from_landmar
 from facemime.face.mesh import FACE_OVAL, POINT_INDICES, reference_points
 
 __all__ = [
-    "Detection", "detect_faces", "FACE_SCORE", "Face", "find_face", "follow_face", "Crop", "crop_from_detection",
-    "crop_from_landmarks", "landmark_pass", "FACE_OVAL", "POINT_INDICES", "reference_points",
+    "FACE_OVAL",
+    "FACE_SCORE",
+    "POINT_INDICES",
+    "Crop",
+    "Detection",
+    "Face",
+    "crop_from_detection",
+    "crop_from_landmarks",
+    "detect_faces",
+    "find_face",
+    "follow_face",
+    "landmark_pass",
+    "reference_points",
 ]

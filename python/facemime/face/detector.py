@@ -166,8 +166,12 @@ def _turn_map(quarters: int, width: int, height: int) -> np.ndarray:
     True
     """
     w, h = width - 1, height - 1
-    return {0: np.array([[1.0, 0, 0], [0, 1, 0]]), 1: np.array([[0.0, -1, w], [1, 0, 0]]),
-            2: np.array([[-1.0, 0, w], [0, -1, h]]), 3: np.array([[0.0, 1, 0], [-1, 0, h]])}[quarters % 4]
+    return {
+        0: np.array([[1.0, 0, 0], [0, 1, 0]]),
+        1: np.array([[0.0, -1, w], [1, 0, 0]]),
+        2: np.array([[-1.0, 0, w], [0, -1, h]]),
+        3: np.array([[0.0, 1, 0], [-1, 0, h]]),
+    }[quarters % 4]
 
 
 def _compose(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -188,8 +192,10 @@ def windows(width: int, height: int) -> list[tuple[int, int, int]]:
     out = [((width - long) // 2, (height - long) // 2, long)]
     sides = ([short] if long > short else []) + ([short // 2] if short // 2 >= INPUT else [])
     for side in sides:
-        spots = [np.linspace(0, extent - side, int(np.ceil(2 * (extent - side) / side)) + 1).round().astype(int)
-                 for extent in (width, height)]
+        spots = [
+            np.linspace(0, extent - side, int(np.ceil(2 * (extent - side) / side)) + 1).round().astype(int)
+            for extent in (width, height)
+        ]
         out += [(int(x), int(y), side) for y in spots[1] for x in spots[0]]
     return out
 
@@ -199,8 +205,9 @@ def _search(rgb: np.ndarray, back: np.ndarray) -> list[Detection]:
     input pixels to image pixels; zero beyond the image), detections of :data:`MIN_SCORE` or
     more in image pixels."""
     net = load_network("face_detection_short_range.tflite")
-    crop = cv2.warpAffine(rgb, back, (INPUT, INPUT), flags=cv2.INTER_AREA | cv2.WARP_INVERSE_MAP,
-                          borderMode=cv2.BORDER_CONSTANT)
+    crop = cv2.warpAffine(
+        rgb, back, (INPUT, INPUT), flags=cv2.INTER_AREA | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_CONSTANT
+    )
     # MediaPipe feeds this model pixels scaled to [-1, 1].
     net.setInput(cv2.dnn.blobFromImage(crop, 2.0 / 255.0, mean=(127.5, 127.5, 127.5)))
     scores, regressors = net.forward(["classificators", "regressors"])

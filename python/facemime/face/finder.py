@@ -79,4 +79,3 @@ def follow_face(rgb: np.ndarray, previous: np.ndarray) -> np.ndarray | None:
     detection); None when the crop holds no face."""
     points, score = landmark_pass(rgb, crop_from_landmarks(previous))
     return points if score >= MIN_FACE_SCORE else None
-

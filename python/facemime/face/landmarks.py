@@ -69,8 +69,13 @@ class Crop:
     def sample(self, rgb: np.ndarray, size: int = INPUT) -> np.ndarray:
         """The crop of ``rgb`` (H, W, 3 uint8) as a ``size`` x ``size`` image (edges
         replicated beyond the image)."""
-        return cv2.warpAffine(rgb, self.affine(size), (size, size), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-                              borderMode=cv2.BORDER_REPLICATE)
+        return cv2.warpAffine(
+            rgb,
+            self.affine(size),
+            (size, size),
+            flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
+            borderMode=cv2.BORDER_REPLICATE,
+        )
 
 
 def crop_from_detection(detection: Detection) -> Crop:

@@ -25,8 +25,10 @@ def load_network(name: str) -> cv2.dnn.Net:
         try:
             if hasattr(cv2.dnn, "ENGINE_CLASSIC"):
                 # OpenCV 5's new engine gives only one of each model's two outputs (5.0.0)
-                return cv2.dnn.readNetFromTFLite(str(path), engine=cv2.dnn.ENGINE_CLASSIC)
+                # (OpenCV 4's annotations, which mypy reads, lack the argument)
+                return cv2.dnn.readNetFromTFLite(str(path), engine=cv2.dnn.ENGINE_CLASSIC)  # type: ignore[call-overload]
             return cv2.dnn.readNetFromTFLite(str(path))
         except cv2.error as e:
-            raise FacemimeError(f"the face model {name} cannot be loaded by OpenCV {cv2.__version__}: "
-                                f"{str(e).strip().splitlines()[-1]}") from None
+            raise FacemimeError(
+                f"the face model {name} cannot be loaded by OpenCV {cv2.__version__}: {str(e).strip().splitlines()[-1]}"
+            ) from None

@@ -6,6 +6,15 @@ from facemime.fit.placement import Fit, fit_model, frontal_pose
 from facemime.fit.points import GROUPS, NAMES, REQUIRED, ReferencePoints, check_points, model_chain
 
 __all__ = [
-    "AutoPoints", "auto_points", "Fit", "fit_model",
-    "frontal_pose", "GROUPS", "NAMES", "REQUIRED", "ReferencePoints", "check_points", "model_chain",
+    "GROUPS",
+    "NAMES",
+    "REQUIRED",
+    "AutoPoints",
+    "Fit",
+    "ReferencePoints",
+    "auto_points",
+    "check_points",
+    "fit_model",
+    "frontal_pose",
+    "model_chain",
 ]

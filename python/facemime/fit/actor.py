@@ -60,12 +60,19 @@ class Actor:
         for name, t in (("texture", self.texture), ("scene", self.scene)):
             if t is None and name == "scene":
                 continue
-            if not (isinstance(t, np.ndarray) and t.dtype == np.uint8 and t.ndim == 3 and t.shape[2] == 3
-                    and min(t.shape[:2]) >= 1):
-                raise InvalidInputError(f"actor {name} must be an (H, W, 3) uint8 image, "
-                                        f"got {getattr(t, 'shape', type(t).__name__)}")
-        if self.scene is not None and not all(isinstance(self.source.get(k), int) and self.source[k] > 0
-                                              for k in ("width", "height")):
+            if not (
+                isinstance(t, np.ndarray)
+                and t.dtype == np.uint8
+                and t.ndim == 3
+                and t.shape[2] == 3
+                and min(t.shape[:2]) >= 1
+            ):
+                raise InvalidInputError(
+                    f"actor {name} must be an (H, W, 3) uint8 image, got {getattr(t, 'shape', type(t).__name__)}"
+                )
+        if self.scene is not None and not all(
+            isinstance(self.source.get(k), int) and self.source[k] > 0 for k in ("width", "height")
+        ):
             raise InvalidInputError("an actor with a scene needs its source picture's width and height")
         if self.model.uv is None:
             raise InvalidInputError("actor model needs texture coordinates (uv)")
@@ -85,8 +92,14 @@ def smear_texture(model: HeadModel, photo: np.ndarray, fit: Fit, points: Referen
     crop = _shrunk(photo[y0:y1, x0:x1], TEXTURE_MAX_SIDE)
     uv = np.clip((px - [x0, y0] + 0.5) / [x1 - x0, y1 - y0], 0.0, 1.0)
     adjusted = replace(model, vertices=fit.vertices, uv=uv, name=f"{source.get('file', 'photo')} actor")
-    return Actor(adjusted, crop, fit.pose, dict(source), {k: np.asarray(v, float) for k, v in points.items()},
-                 _shrunk(photo, SCENE_MAX_SIDE))
+    return Actor(
+        adjusted,
+        crop,
+        fit.pose,
+        dict(source),
+        {k: np.asarray(v, float) for k, v in points.items()},
+        _shrunk(photo, SCENE_MAX_SIDE),
+    )
 
 
 def _shrunk(image: np.ndarray, side: int) -> np.ndarray:
@@ -95,8 +108,9 @@ def _shrunk(image: np.ndarray, side: int) -> np.ndarray:
     f = side / max(image.shape[:2])
     if f >= 1.0:
         return np.ascontiguousarray(image).copy()
-    return cv2.resize(image, (max(1, round(image.shape[1] * f)), max(1, round(image.shape[0] * f))),
-                      interpolation=cv2.INTER_AREA)
+    return cv2.resize(
+        image, (max(1, round(image.shape[1] * f)), max(1, round(image.shape[0] * f))), interpolation=cv2.INTER_AREA
+    )
 
 
 def generic_actor(size: tuple[int, int] = (512, 512)) -> Actor:

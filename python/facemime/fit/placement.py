@@ -103,7 +103,11 @@ def fit_model(model: HeadModel, points: ReferencePoints) -> Fit:
         np.array([len(c) for c in chains], np.uint32),
         np.ascontiguousarray(np.concatenate([points[n] for n in names])),
         np.array([len(points[n]) for n in names], np.uint32),
-        PSI * iod, SHRINK, EPSILON, ITERATIONS, TOLERANCE * iod,
+        PSI * iod,
+        SHRINK,
+        EPSILON,
+        ITERATIONS,
+        TOLERANCE * iod,
     )
     # Back to model space: undo translation, scale and roll; depth stays the generic one.
     rot = rotation_matrix(roll=pose.roll)[:2, :2]

@@ -38,8 +38,14 @@ LIDS = ("eye_right_upper", "eye_right_lower", "eye_left_upper", "eye_left_lower"
 #: Every name a reference-point set may hold.
 NAMES = tuple(POINTS) + CURVES
 #: Names a set must hold: enough to place and scale the model.
-REQUIRED = ("eye_right_outer", "eye_right_inner", "eye_left_inner", "eye_left_outer",
-            "mouth_outer_upper", "mouth_outer_lower")
+REQUIRED = (
+    "eye_right_outer",
+    "eye_right_inner",
+    "eye_left_inner",
+    "eye_left_outer",
+    "mouth_outer_upper",
+    "mouth_outer_lower",
+)
 #: The point groups accuracy is reported for (README of the shared data): name -> members.
 GROUPS = {
     "eye_corners": ("eye_right_outer", "eye_right_inner", "eye_left_inner", "eye_left_outer"),
@@ -60,7 +66,7 @@ def model_chain(model: HeadModel, name: str) -> np.ndarray:
     raise InvalidInputError(f"unknown reference point {name!r}; known: {', '.join(NAMES)}")
 
 
-def check_points(points: Mapping[str, object], width: int, height: int, where: str = "points") -> ReferencePoints:
+def check_points(points: object, width: int, height: int, where: str = "points") -> ReferencePoints:
     """Validate a reference-point set for a ``width`` x ``height`` image: known names, the
     required ones present, single points as (2,) or (1, 2), curves as (K >= 2, 2), all inside
     the image. Returns name -> (K, 2) float64 arrays."""
@@ -88,4 +94,3 @@ def check_points(points: Mapping[str, object], width: int, height: int, where: s
             raise InvalidInputError(f"{where}: {name} has points outside the {width}x{height} image")
         out[name] = arr
     return out
-

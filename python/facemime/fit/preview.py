@@ -23,8 +23,9 @@ def preview_sheet(actor: Actor, photo: np.ndarray, cell: int = 360) -> np.ndarra
     # The face's square neighbourhood of the photo, scaled to the cell, wireframe on top.
     zoom = cell / (2 * half)
     affine = np.array([[zoom, 0, cell / 2 - zoom * cx], [0, zoom, cell / 2 - zoom * cy]])
-    panel = cv2.warpAffine(photo, affine, (cell, cell), flags=cv2.INTER_AREA, borderMode=cv2.BORDER_CONSTANT,
-                           borderValue=(36, 36, 40))
+    panel = cv2.warpAffine(
+        photo, affine, (cell, cell), flags=cv2.INTER_AREA, borderMode=cv2.BORDER_CONSTANT, borderValue=(36, 36, 40)
+    )
     draw_wireframe(panel, points * zoom + affine[:, 2], m.triangles, (40, 230, 90))
     panels = [panel]
     for yaw in YAWS:

@@ -35,8 +35,9 @@ class FitRun:
     residual: float = 0.0
 
 
-def fit_actor(photo: np.ndarray, name: str, points: dict | None = None, frame: int = 0,
-              model: HeadModel | None = None) -> tuple[Actor, list[str], float]:
+def fit_actor(
+    photo: np.ndarray, name: str, points: dict | None = None, frame: int = 0, model: HeadModel | None = None
+) -> tuple[Actor, list[str], float]:
     """Fit ``model`` (default: the generic head) to ``photo`` ((H, W, 3) uint8 RGB) on the given
     validated reference ``points`` or, without them, on points found automatically. ``name`` is
     the photo's file name, for messages and the actor's metadata. Returns the actor, warnings
@@ -56,8 +57,9 @@ def fit_actor(photo: np.ndarray, name: str, points: dict | None = None, frame: i
     return smear_texture(model, photo, fit, points, source), warnings, float(fit.residuals[-1])
 
 
-def fit_file(source: str | Path, out: str | Path, frame: int = 0, points_file: str | Path | None = None,
-             force: bool = False) -> FitRun:
+def fit_file(
+    source: str | Path, out: str | Path, frame: int = 0, points_file: str | Path | None = None, force: bool = False
+) -> FitRun:
     """Fit an actor to ``source`` (an image, or frame ``frame`` of a video) and write ``out``
     (``NAME.actor``) and its preview ``NAME.preview.png``, both or neither; existing files are
     refused unless ``force``, an input always."""
@@ -72,8 +74,9 @@ def fit_file(source: str | Path, out: str | Path, frame: int = 0, points_file: s
         try:
             actor, warnings, residual = fit_actor(photo, str(source), points, frame)
         except NoFaceError as e:
-            raise NoFaceError(f"{e}; mark the face by hand and pass the points with --points POINTS.json "
-                              "(format facemime.points/1)") from None
+            raise NoFaceError(
+                f"{e}; mark the face by hand and pass the points with --points POINTS.json (format facemime.points/1)"
+            ) from None
         seconds = time.perf_counter() - t0
         write_bytes(outputs.stage(out), actor_bytes(actor))
         write_image(outputs.stage(preview), preview_sheet(actor, photo))

@@ -26,6 +26,7 @@ import json
 import zipfile
 import zlib
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -85,8 +86,11 @@ def actor_bytes(actor: Actor, texture: str = "png", quality: int = 90) -> bytes:
 
 def _encoded(image: np.ndarray, what: str, kind: str, quality: int) -> bytes:
     """The RGB ``image`` encoded as ``kind`` (a key of :data:`TEXTURES`)."""
-    ok, data = cv2.imencode("." + kind, cv2.cvtColor(image, cv2.COLOR_RGB2BGR),
-                            [p for flag in TEXTURES[kind][1] for p in (flag, int(quality))])
+    ok, data = cv2.imencode(
+        "." + kind,
+        cv2.cvtColor(image, cv2.COLOR_RGB2BGR),
+        [p for flag in TEXTURES[kind][1] for p in (flag, int(quality))],
+    )
     if not ok:
         raise OutputFileError(f"cannot encode the {what} as {kind}")
     return data.tobytes()
@@ -120,7 +124,9 @@ def load_actor(path: str | Path) -> Actor:
     """Read and validate an ``.actor`` file."""
     path = Path(path)
     if not path.is_file():
-        raise InputFileError(f"actor file {path} does not exist" if not path.exists() else f"actor file {path} is not a file")
+        raise InputFileError(
+            f"actor file {path} does not exist" if not path.exists() else f"actor file {path} is not a file"
+        )
     return actor_from_bytes(path, str(path))
 
 
@@ -150,12 +156,20 @@ def actor_from_bytes(source: str | Path | bytes, where: str) -> Actor:
         raise ActorFileError(f"{where}: actor.json is not valid JSON ({e})") from None
     if not isinstance(doc, dict) or doc.get("format") != ACTOR_FORMAT:
         found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
-        raise ActorFileError(f"{where}: expected format {ACTOR_FORMAT!r}, got {found!r}"
-                             + (" (a newer facemime wrote it?)" if isinstance(found, str) and found.startswith("facemime.actor/") else ""))
+        raise ActorFileError(
+            f"{where}: expected format {ACTOR_FORMAT!r}, got {found!r}"
+            + (
+                " (a newer facemime wrote it?)"
+                if isinstance(found, str) and found.startswith("facemime.actor/")
+                else ""
+            )
+        )
     texture = _texture(image, member, doc.get("texture"), where)
     if (scene is None) != ("scene" not in doc):
         raise ActorFileError(f"{where}: actor.json and the file's members disagree on whether it has a scene")
-    scene = None if scene is None else _texture(scene, scene_member, doc["scene"], where, "scene")
+    scene_image = None
+    if scene is not None and scene_member is not None:
+        scene_image = _texture(scene, scene_member, doc["scene"], where, "scene")
     try:
         model = head_from_document(doc.get("model"), f"{where}: model")
     except ModelFormatError as e:
@@ -170,15 +184,15 @@ def actor_from_bytes(source: str | Path | bytes, where: str) -> Actor:
             raise ValueError("bad pose or source")
     except (KeyError, TypeError, ValueError, AttributeError, OverflowError) as e:
         raise ActorFileError(f"{where}: malformed actor ({e})") from None
-    if scene is not None:
-        _check_scene_source(source, scene, where)
+    if scene_image is not None:
+        _check_scene_source(source, scene_image, where)
     try:
-        return Actor(model, texture, pose, source, points, scene)
+        return Actor(model, texture, pose, source, points, scene_image)
     except InvalidInputError as e:
         raise ActorFileError(f"{where}: malformed actor ({e})") from None
 
 
-def _check_scene_source(source: dict, scene: np.ndarray, where: str) -> None:
+def _check_scene_source(source: dict[str, Any], scene: np.ndarray, where: str) -> None:
     """Refuse a scene whose source picture (what it is drawn at) is larger than the input policy
     allows for an image (:mod:`facemime.io.limits`), or of another shape than the scene: the
     scene is that picture, at most shrunk."""
@@ -187,8 +201,10 @@ def _check_scene_source(source: dict, scene: np.ndarray, where: str) -> None:
         raise ActorFileError(f"{where}: an actor with a scene needs its source picture's width and height")
     most = limit("FACEMIME_MAX_IMAGE_PIXELS")
     if w * h > most:
-        raise ActorFileError(f"{where}: its source picture is {w}x{h}, more than {most} pixels; "
-                             "set FACEMIME_MAX_IMAGE_PIXELS to allow more")
+        raise ActorFileError(
+            f"{where}: its source picture is {w}x{h}, more than {most} pixels; "
+            "set FACEMIME_MAX_IMAGE_PIXELS to allow more"
+        )
     sh, sw = scene.shape[:2]
     if sw > w or sh > h or abs(sw / sh - w / h) > 2.0 / min(sw, sh):
         raise ActorFileError(f"{where}: its scene is {sw}x{sh}, not its source picture ({w}x{h}) or a shrunk copy")

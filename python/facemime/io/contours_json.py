@@ -125,12 +125,19 @@ def read_init(path: str | Path, size: tuple[int, int] | None = None) -> tuple[in
 
 def init_document(frame: int, contours: Mapping[str, np.ndarray]) -> dict[str, Any]:
     """A ``facemime.init/1`` document."""
-    return {"format": INIT_FORMAT, "frame": int(frame),
-            "contours": {n: np.round(np.asarray(contours[n], float), 3).tolist() for n in CONTOUR_NAMES}}
+    return {
+        "format": INIT_FORMAT,
+        "frame": int(frame),
+        "contours": {n: np.round(np.asarray(contours[n], float), 3).tolist() for n in CONTOUR_NAMES},
+    }
 
 
-def track_document(video: Mapping[str, Any], frames: Sequence[Mapping[str, Any]],
-                   timing: Mapping[str, float] | None = None, model: Mapping[str, Any] | None = None) -> dict[str, Any]:
+def track_document(
+    video: Mapping[str, Any],
+    frames: Sequence[Mapping[str, Any]],
+    timing: Mapping[str, float] | None = None,
+    model: Mapping[str, Any] | None = None,
+) -> dict[str, Any]:
     """A ``facemime.track/1`` document. ``frames``: dicts with ``index``, ``contours`` (name ->
     (N, 2) array) and optionally ``confidence`` (feature -> float), ``lost`` (list of
     features), ``redetected`` (bool: the face landmark model put the contours right on this
@@ -140,8 +147,12 @@ def track_document(video: Mapping[str, Any], frames: Sequence[Mapping[str, Any]]
     return {**doc, **_closing(video, timing, model)}
 
 
-def _closing(video: Mapping[str, Any], timing: Mapping[str, float] | None,
-             model: Mapping[str, Any] | None, extra: Mapping[str, Any] | None = None) -> dict[str, Any]:
+def _closing(
+    video: Mapping[str, Any],
+    timing: Mapping[str, float] | None,
+    model: Mapping[str, Any] | None,
+    extra: Mapping[str, Any] | None = None,
+) -> dict[str, Any]:
     """A track document's entries after its frames (``extra``: more top-level entries)."""
     out: dict[str, Any] = {"video": {k: video[k] for k in ("width", "height", "fps", "frames")}, **(extra or {})}
     if model is not None:
@@ -154,8 +165,10 @@ def _closing(video: Mapping[str, Any], timing: Mapping[str, float] | None,
 def track_entry(f: Mapping[str, Any]) -> dict[str, Any]:
     """One frame's entry of a track document (see :func:`track_document`), rounded to what the
     format keeps."""
-    entry: dict[str, Any] = {"index": int(f["index"]),
-                             "contours": {n: np.round(np.asarray(c, float), 3).tolist() for n, c in f["contours"].items()}}
+    entry: dict[str, Any] = {
+        "index": int(f["index"]),
+        "contours": {n: np.round(np.asarray(c, float), 3).tolist() for n, c in f["contours"].items()},
+    }
     if "confidence" in f:
         entry["confidence"] = {k: round(float(v), 4) for k, v in f["confidence"].items()}
     if "lost" in f:
@@ -186,7 +199,7 @@ class TrackWriter:
 
     def __init__(self, path: Path):
         self._path = path
-        self._file = self._io(lambda: open(path, "w", encoding="utf-8"))
+        self._file = self._io(lambda: open(path, "w", encoding="utf-8"))  # noqa: SIM115 (open until close())
         self._write(f'{{"format": {json.dumps(TRACK_FORMAT)}, "frames": [')
         self.frames = 0
 
@@ -203,12 +216,17 @@ class TrackWriter:
         self._write(("," if self.frames else "") + "\n" + json.dumps(track_entry(frame)))
         self.frames += 1
 
-    def close(self, video: Mapping[str, Any], timing: Mapping[str, float] | None = None,
-              model: Mapping[str, Any] | None = None, extra: Mapping[str, Any] | None = None) -> None:
+    def close(
+        self,
+        video: Mapping[str, Any],
+        timing: Mapping[str, float] | None = None,
+        model: Mapping[str, Any] | None = None,
+        extra: Mapping[str, Any] | None = None,
+    ) -> None:
         self._write("\n], " + json.dumps(_closing(video, timing, model, extra))[1:])
         self._io(self._file.close)
 
-    def __enter__(self) -> "TrackWriter":
+    def __enter__(self) -> TrackWriter:
         return self
 
     def __exit__(self, exc_type: type | None, *exc: object) -> None:
@@ -247,8 +265,9 @@ def _weights(raw: Any, where: str) -> np.ndarray:
         raise ContourFileError(f"{where}: 'weights' must be an object of expression name -> weight in [0, 1]")
     unknown = [k for k in raw if k not in NAMES]
     if unknown:
-        raise ContourFileError(f"{where}: unknown expression weight {unknown[0]!r} in 'weights' "
-                               f"(known: {', '.join(NAMES)})")
+        raise ContourFileError(
+            f"{where}: unknown expression weight {unknown[0]!r} in 'weights' (known: {', '.join(NAMES)})"
+        )
     w = np.zeros(len(NAMES))
     for k, v in raw.items():
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0.0 <= float(v) <= 1.0:
@@ -265,19 +284,24 @@ def _generic_model_block() -> dict[str, Any]:
 
     head = generic_head()
     d = Deformer(head)
-    return {"unit": head.unit, "knots": d.knots.tolist(), "feature_sizes": d.feature_sizes().tolist(),
-            "iod": model_iod(head)}
+    return {
+        "unit": head.unit,
+        "knots": d.knots.tolist(),
+        "feature_sizes": d.feature_sizes().tolist(),
+        "iod": model_iod(head),
+    }
 
 
 def weights_to_motion(weights: np.ndarray, sizes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(knot offsets (K, 2), lid closures (2,)) of expression ``weights`` (E,) on a face whose
     knots (the generic head's, as every actor fitted from it) have feature ``sizes`` (K,)."""
-    from facemime.animate.expressions import generic_unit_patterns, BLINKS, NAMES
+    from facemime.animate.expressions import BLINKS, NAMES, generic_unit_patterns
 
     unit = generic_unit_patterns()
     if len(sizes) != unit.shape[1]:
-        raise ValueError(f"expression weights need the generic head's {unit.shape[1]} knots, "
-                         f"the motion has {len(sizes)}")
+        raise ValueError(
+            f"expression weights need the generic head's {unit.shape[1]} knots, the motion has {len(sizes)}"
+        )
     offsets = np.tensordot(weights, unit * np.asarray(sizes, np.float64)[None, :, None], axes=([-1], [0]))
     return offsets, np.array([weights[NAMES.index(n)] for n in BLINKS])
 
@@ -287,26 +311,34 @@ def read_motion(path: str | Path) -> tuple[dict[str, Any], dict[str, Any], list[
     the ``model`` block, frames in order as dicts with ``index``, ``face`` (bool), ``pose``
     (mapping of the six pose values), ``offsets`` ((K, 2) float64 array), ``look`` (a
     :class:`facemime.animate.look.Look`; neutral for files written before it, or without one),
-    ``weights`` ((E,) expression weights, or None) and ``lost`` (the features named lost). A frame with ``weights`` and no
-    ``offsets`` gets its offsets from them, and its lid closures unless its ``look`` gives them
+    ``weights`` ((E,) expression weights, or None) and ``lost`` (the features named lost). A frame with
+    ``weights`` and no ``offsets`` gets its offsets from them, and its lid closures unless its ``look`` gives them
     (:mod:`facemime.animate.expressions`); a file of such frames needs no ``model`` block."""
     doc = load_document(path, "track", TRACK_FORMAT)
     where = str(path)
     model = doc.get("model")
     frames = doc.get("frames")
-    authored = isinstance(frames, list) and bool(frames) and all(
-        isinstance(f, dict) and "offsets" not in f and "weights" in f for f in frames)
+    authored = (
+        isinstance(frames, list)
+        and bool(frames)
+        and all(isinstance(f, dict) and "offsets" not in f and "weights" in f for f in frames)
+    )
     if model is None and authored:
         model = _generic_model_block()
-    if not isinstance(model, dict) or not isinstance(model.get("knots"), list) or not isinstance(model.get("feature_sizes"), list):
-        raise ContourFileError(f"{where}: has no head motion ('model' with 'knots' and 'feature_sizes'); "
-                               "write it with facemime run")
+    if (
+        not isinstance(model, dict)
+        or not isinstance(model.get("knots"), list)
+        or not isinstance(model.get("feature_sizes"), list)
+    ):
+        raise ContourFileError(
+            f"{where}: has no head motion ('model' with 'knots' and 'feature_sizes'); write it with facemime run"
+        )
     if not isinstance(frames, list) or not frames:
         raise ContourFileError(f"{where}: 'frames' must be a non-empty list")
     k = len(model["knots"])
     out = []
     for n, f in enumerate(frames):
-        pose, offsets = (f.get("pose"), f.get("offsets")) if isinstance(f, dict) else (None, None)
+        pose, offsets = (f.get("pose", {}), f.get("offsets")) if isinstance(f, dict) else ({}, None)
         weights = None
         if isinstance(f, dict) and "weights" in f:
             weights = _weights(f["weights"], f"{where}: frame entry {n}")
@@ -320,9 +352,15 @@ def read_motion(path: str | Path) -> tuple[dict[str, Any], dict[str, Any], list[
             values = {key: float(pose[key]) for key in POSE_KEYS}
             arr = np.asarray(offsets, dtype=np.float64)
         except (TypeError, KeyError, ValueError, OverflowError):
-            raise ContourFileError(f"{where}: frame entry {n} needs a 'pose' with {', '.join(POSE_KEYS)} and 'offsets' "
-                                   "(or 'weights')") from None
-        if arr.shape != (k, 2) or not np.isfinite(arr).all() or not all(np.isfinite(list(values.values()))) or values["scale"] <= 0:
+            raise ContourFileError(
+                f"{where}: frame entry {n} needs a 'pose' with {', '.join(POSE_KEYS)} and 'offsets' (or 'weights')"
+            ) from None
+        if (
+            arr.shape != (k, 2)
+            or not np.isfinite(arr).all()
+            or not all(np.isfinite(list(values.values())))
+            or values["scale"] <= 0
+        ):
             raise ContourFileError(f"{where}: frame entry {n} has malformed 'offsets' or 'pose'")
         try:
             look = f.get("look", {})
@@ -338,6 +376,15 @@ def read_motion(path: str | Path) -> tuple[dict[str, Any], dict[str, Any], list[
         lost = f.get("lost", [])
         if not isinstance(lost, list) or not all(isinstance(x, str) for x in lost):
             raise ContourFileError(f"{where}: frame entry {n}: 'lost' must be a list of feature names")
-        out.append({"index": f.get("index", n), "face": bool(f.get("face", True)), "pose": values, "offsets": arr,
-                    "look": look, "weights": weights, "lost": lost})
+        out.append(
+            {
+                "index": f.get("index", n),
+                "face": bool(f.get("face", True)),
+                "pose": values,
+                "offsets": arr,
+                "look": look,
+                "weights": weights,
+                "lost": lost,
+            }
+        )
     return doc.get("video", {}), model, out

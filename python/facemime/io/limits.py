@@ -23,9 +23,14 @@ from typing import Any
 
 from facemime.errors import InputFileError, InvalidInputError
 
-DEFAULTS = {"FACEMIME_MAX_IMAGE_PIXELS": 100_000_000, "FACEMIME_MAX_JSON_BYTES": 64 << 20,
-            "FACEMIME_MAX_VERTICES": 200_000, "FACEMIME_MAX_TRIANGLES": 400_000, "FACEMIME_MAX_MODEL_BYTES": 256 << 20,
-            "FACEMIME_MAX_UNIT_VALUES": 20_000_000}
+DEFAULTS = {
+    "FACEMIME_MAX_IMAGE_PIXELS": 100_000_000,
+    "FACEMIME_MAX_JSON_BYTES": 64 << 20,
+    "FACEMIME_MAX_VERTICES": 200_000,
+    "FACEMIME_MAX_TRIANGLES": 400_000,
+    "FACEMIME_MAX_MODEL_BYTES": 256 << 20,
+    "FACEMIME_MAX_UNIT_VALUES": 20_000_000,
+}
 
 
 def limit(name: str) -> int:
@@ -76,7 +81,7 @@ def image_size(data: bytes) -> tuple[int, int] | None:
             if 0xC0 <= marker <= 0xCF and marker not in (0xC4, 0xC8, 0xCC):  # a start of frame
                 h, w = struct.unpack_from(">HH", data, at + 5)
                 return w, h
-            at += 2 + int.from_bytes(data[at + 2:at + 4], "big")
+            at += 2 + int.from_bytes(data[at + 2 : at + 4], "big")
     return None
 
 
@@ -90,8 +95,10 @@ def check_image_file(path: Path) -> None:
     size = image_size(head)
     most = limit("FACEMIME_MAX_IMAGE_PIXELS")
     if size is not None and size[0] * size[1] > most:
-        raise InvalidInputError(f"{path} is {size[0]}x{size[1]} pixels, more than the {most} allowed "
-                                "(set FACEMIME_MAX_IMAGE_PIXELS to allow more)")
+        raise InvalidInputError(
+            f"{path} is {size[0]}x{size[1]} pixels, more than the {most} allowed "
+            "(set FACEMIME_MAX_IMAGE_PIXELS to allow more)"
+        )
 
 
 def parse_json(text: str | bytes, where: str) -> Any:
@@ -106,11 +113,15 @@ def parse_json(text: str | bytes, where: str) -> Any:
 def read_json_text(path: Path, what: str) -> bytes:
     """The bytes of the JSON ``what`` file ``path``, refused when larger than the policy allows."""
     if not path.is_file():
-        raise InputFileError(f"{what} file {path} does not exist" if not path.exists() else f"{what} file {path} is not a file")
+        raise InputFileError(
+            f"{what} file {path} does not exist" if not path.exists() else f"{what} file {path} is not a file"
+        )
     size, most = path.stat().st_size, limit("FACEMIME_MAX_JSON_BYTES")
     if size > most:
-        raise InvalidInputError(f"{what} file {path} is {size} bytes, more than the {most} allowed "
-                                "(set FACEMIME_MAX_JSON_BYTES to allow more)")
+        raise InvalidInputError(
+            f"{what} file {path} is {size} bytes, more than the {most} allowed "
+            "(set FACEMIME_MAX_JSON_BYTES to allow more)"
+        )
     try:
         return path.read_bytes()
     except OSError as e:

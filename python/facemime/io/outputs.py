@@ -49,19 +49,20 @@ def check_outputs(paths: Iterable[str | Path], force: bool, inputs: Iterable[str
     """Refuse (with one message naming them) an output that is one of the command's ``inputs``
     or another of its outputs, whatever ``force`` says; existing files unless ``force``; and
     outputs whose folder cannot be created."""
-    paths = [Path(p) for p in paths]
-    for i, p in enumerate(paths):
+    files = [Path(p) for p in paths]
+    for i, p in enumerate(files):
         for q in (Path(q) for q in inputs if q is not None):
             if _same(p, q):
                 raise InvalidInputError(f"the output {p} would replace the input {q}; choose another name")
-        for q in paths[i + 1:]:
+        for q in files[i + 1 :]:
             if _same(p, q):
                 raise InvalidInputError(f"two outputs are one file: {p} and {q}")
-    existing = [str(p) for p in paths if p.exists()]
+    existing = [str(p) for p in files if p.exists()]
     if existing and not force:
-        raise OutputExistsError(f"{', '.join(existing)} already exist{'s' if len(existing) == 1 else ''}; "
-                                "use --force to overwrite")
-    for p in paths:
+        raise OutputExistsError(
+            f"{', '.join(existing)} already exist{'s' if len(existing) == 1 else ''}; use --force to overwrite"
+        )
+    for p in files:
         if p.is_dir():
             raise InvalidInputError(f"{p} is a folder, expected a file name")
         parent = p.parent
@@ -105,7 +106,7 @@ class Outputs:
         check_outputs(self.paths, force, inputs)
         self._staged: dict[Path, Path] = {}
 
-    def __enter__(self) -> "Outputs":
+    def __enter__(self) -> Outputs:
         return self
 
     def stage(self, path: str | Path) -> Path:
@@ -121,8 +122,9 @@ class Outputs:
         if isinstance(exc, FacemimeError) and exc.args:  # name the output, not its temporary file
             message = str(exc.args[0])
             for final in self.paths:
-                temporary = (re.escape(str(final.parent / f".{final.stem}.")) + r"\S*?"
-                             + re.escape(f".part{final.suffix}"))
+                temporary = (
+                    re.escape(str(final.parent / f".{final.stem}.")) + r"\S*?" + re.escape(f".part{final.suffix}")
+                )
                 message = re.sub(temporary, str(final).replace("\\", "\\\\"), message)
             exc.args = (message, *exc.args[1:])
         try:

@@ -37,9 +37,12 @@ def read_photo(path: str | Path, frame: int = 0) -> np.ndarray:
         image = cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB)
     else:
         with VideoReader(path) as reader:
-            image = next((f for i, f in enumerate(reader) if i == frame), None)
-            if image is None:
+            found = next((f for i, f in enumerate(reader) if i == frame), None)
+            if found is None:
                 raise InvalidInputError(f"{path} has no frame {frame} (it has {reader.frames or 'fewer'} frames)")
+            image = found
     if min(image.shape[:2]) < MIN_SIDE:
-        raise InvalidInputError(f"{path} is {image.shape[1]}x{image.shape[0]} pixels; at least {MIN_SIDE} a side is needed")
+        raise InvalidInputError(
+            f"{path} is {image.shape[1]}x{image.shape[0]} pixels; at least {MIN_SIDE} a side is needed"
+        )
     return np.ascontiguousarray(image)

@@ -4,14 +4,15 @@ Frames are RGB uint8 (H, W, 3)."""
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import math
 import os
 import queue
 import threading
+from collections.abc import Callable, Iterator
 from fractions import Fraction
 from pathlib import Path
-from collections.abc import Callable, Iterator
 from types import TracebackType
 
 import av
@@ -24,9 +25,10 @@ from facemime.io.outputs import temporary_sibling
 
 # VP9 in real time makes no use of frames held back ("lag"): a video of the same size (0.1 % apart), without 25 raw
 # frames held (0.7 GB at 7680x2160).
-CODECS = {".mp4": ("libx264", {"crf": "20", "preset": "veryfast", "movflags": "+faststart"}),
-          ".webm": ("libvpx-vp9", {"crf": "32", "b": "0", "deadline": "realtime", "cpu-used": "8",
-                                   "lag-in-frames": "0"})}
+CODECS = {
+    ".mp4": ("libx264", {"crf": "20", "preset": "veryfast", "movflags": "+faststart"}),
+    ".webm": ("libvpx-vp9", {"crf": "32", "b": "0", "deadline": "realtime", "cpu-used": "8", "lag-in-frames": "0"}),
+}
 #: Frames of more pixels than 4K UHD's are encoded by x264 without B-frames and look-ahead
 #: ("zerolatency"): 0.9 GB less memory at 7680x2160 (a 4K video beside its synthesis), files
 #: somewhat larger.
@@ -69,15 +71,15 @@ class VideoWriter:
             raise InvalidInputError(f"fps must be positive and finite, got {fps}")
         self.fps = Fraction(fps).limit_denominator(1001)
         self._tmp: Path | None = None
-        self._container = None
-        self._stream = None
+        self._container: av.container.OutputContainer | None = None
+        self._stream: av.video.stream.VideoStream | None = None
         self._queue: queue.Queue[np.ndarray | None] | None = None
         self._encoder: threading.Thread | None = None
         self._error: BaseException | None = None
         self._cancelled = False
         self.frames = 0
 
-    def __enter__(self) -> "VideoWriter":
+    def __enter__(self) -> VideoWriter:
         self._tmp = temporary_sibling(self.path)
         return self
 
@@ -92,41 +94,57 @@ class VideoWriter:
         if self._stream is None:
             codec, options = CODECS[self.path.suffix.lower()]
             fmt = "mp4" if self.path.suffix.lower() == ".mp4" else "webm"
-            self._container = av.open(str(self._tmp), "w", format=fmt,
-                                      options={"movflags": options["movflags"]} if "movflags" in options else {})
-            self._stream = self._container.add_stream(codec, rate=self.fps)
-            self._stream.width, self._stream.height = frame.shape[1], frame.shape[0]
-            self._stream.pix_fmt = "yuv420p"
+            self._container = container = av.open(
+                str(self._tmp),
+                "w",
+                format=fmt,
+                options={"movflags": options["movflags"]} if "movflags" in options else {},
+            )
+            stream = container.add_stream(codec, rate=self.fps)
+            assert isinstance(stream, av.VideoStream)  # a video codec's
+            self._stream = stream
+            stream.width, stream.height = frame.shape[1], frame.shape[0]
+            stream.pix_fmt = "yuv420p"
             pixels = frame.shape[0] * frame.shape[1]
-            large = {"tune": "zerolatency"} if codec == "libx264" and pixels > LARGE_FRAME else {}
-            self._stream.options = {k: v for k, v in options.items() if k != "movflags"} | large
+            large: dict[str, object] = {"tune": "zerolatency"} if codec == "libx264" and pixels > LARGE_FRAME else {}
+            stream.options = {k: v for k, v in options.items() if k != "movflags"} | large
             i420_bytes = pixels * 3 // 2
-            self._queue = queue.Queue(max(1, min(self.QUEUED, self.QUEUED_BYTES // i420_bytes)))
+            self._queue = frames = queue.Queue[np.ndarray | None](
+                max(1, min(self.QUEUED, self.QUEUED_BYTES // i420_bytes))
+            )
             self._encoder = threading.Thread(target=self._encode, name=f"encoder {self.path.name}", daemon=True)
             self._encoder.start()
         elif (frame.shape[1], frame.shape[0]) != (self._stream.width, self._stream.height):
-            raise InvalidInputError(f"video frame size changed from {self._stream.width}x{self._stream.height} "
-                                    f"to {w}x{h}")
+            raise InvalidInputError(
+                f"video frame size changed from {self._stream.width}x{self._stream.height} to {w}x{h}"
+            )
+        else:
+            assert self._queue is not None  # made with the stream
+            frames = self._queue
         # OpenCV's RGB -> I420 (BT.601, limited range, as FFmpeg's default) takes a tenth of
         # the time of the encoder's own conversion.
-        self._queue.put(cv2.cvtColor(np.ascontiguousarray(frame), cv2.COLOR_RGB2YUV_I420))
+        frames.put(cv2.cvtColor(np.ascontiguousarray(frame), cv2.COLOR_RGB2YUV_I420))
         self.frames += 1
 
     def _encode(self) -> None:
         """The encoder thread: encodes queued frames until None, then flushes the encoder. After
         an error, or once cancelled, it keeps taking frames (so that no writer waits forever)
         and encodes none."""
-        while (i420 := self._queue.get()) is not None:
+        frames, stream, container = self._queue, self._stream, self._container
+        assert frames is not None and stream is not None and container is not None  # started by write()
+        while (i420 := frames.get()) is not None:
             if self._error is None and not self._cancelled:
-                self._guarded(lambda: self._stream.encode(av.VideoFrame.from_ndarray(i420, format="yuv420p")))
+                self._guarded(container, lambda: stream.encode(av.VideoFrame.from_ndarray(i420, format="yuv420p")))
         if self._error is None and not self._cancelled:
-            self._guarded(lambda: self._stream.encode())
+            self._guarded(container, lambda: stream.encode())
 
-    def _guarded(self, encode: Callable[[], list]) -> None:
+    def _guarded(
+        self, container: av.container.OutputContainer, encode: Callable[[], list[av.Packet[av.VideoStream]]]
+    ) -> None:
         """Mux the packets ``encode`` gives; keep an error for the writer's thread to raise."""
         try:
             for packet in encode():
-                self._container.mux(packet)
+                container.mux(packet)
         except (av.FFmpegError, OSError) as e:
             self._error = OutputFileError(f"cannot write video {self.path}: {_reason(e)}")
         except BaseException as e:  # noqa: BLE001 (an unexpected error, raised as it is)
@@ -138,7 +156,7 @@ class VideoWriter:
 
     def __exit__(self, exc_type: type | None, exc: BaseException | None, tb: TracebackType | None) -> None:
         try:
-            if self._encoder is not None:
+            if self._encoder is not None and self._queue is not None:
                 self._cancelled = exc_type is not None
                 self._queue.put(None)
                 self._encoder.join()
@@ -151,7 +169,8 @@ class VideoWriter:
                 self._raise_error()
                 if self.frames == 0:
                     raise InvalidInputError(f"no frames were written to {self.path}")
-                os.replace(self._tmp, self.path)
+                if self._tmp is not None:
+                    os.replace(self._tmp, self.path)
         finally:
             if self._tmp is not None:
                 self._tmp.unlink(missing_ok=True)
@@ -222,8 +241,9 @@ class VideoReader:
             raise InputFileError(f"video {self.path} has no decodable frames")
         quarters = round(self._first.rotation / 90) or round(-_rotate_tag(self._stream.metadata) / 90)
         self.rotation = 90 * (quarters % 4)
-        self._turn = {90: cv2.ROTATE_90_COUNTERCLOCKWISE, 180: cv2.ROTATE_180,
-                      270: cv2.ROTATE_90_CLOCKWISE}.get(self.rotation)
+        self._turn = {90: cv2.ROTATE_90_COUNTERCLOCKWISE, 180: cv2.ROTATE_180, 270: cv2.ROTATE_90_CLOCKWISE}.get(
+            self.rotation
+        )
         self.width, self.height = self._first.width, self._first.height
         if self.rotation in (90, 270):
             self.width, self.height = self.height, self.width
@@ -235,7 +255,7 @@ class VideoReader:
         self._ahead = max(1, min(self.AHEAD, self.AHEAD_BYTES // (self.width * self.height * 3)))
         # One converter for all frames: ``VideoFrame.to_ndarray`` sets up a new one per frame.
         self._to_rgb = VideoReformatter()
-        self._decoding: tuple[threading.Thread, threading.Event, queue.Queue] | None = None
+        self._decoding: tuple[threading.Thread, threading.Event, queue.Queue[object]] | None = None
 
     def _packets_decoded(self) -> Iterator[av.VideoFrame]:
         """The stream's frames. A packet the demuxer marks corrupt (as the last one of a truncated
@@ -254,10 +274,11 @@ class VideoReader:
 
     def __iter__(self) -> Iterator[np.ndarray]:
         self._stop_decoding()
-        frames: queue.Queue[np.ndarray | BaseException | object | None] = queue.Queue(self._ahead)
+        frames: queue.Queue[object] = queue.Queue(self._ahead)
         stop = threading.Event()
-        decoder = threading.Thread(target=self._decode, args=(frames, stop), name=f"decoder {self.path.name}",
-                                   daemon=True)
+        decoder = threading.Thread(
+            target=self._decode, args=(frames, stop), name=f"decoder {self.path.name}", daemon=True
+        )
         self._decoding = (decoder, stop, frames)
         decoder.start()
         try:
@@ -267,12 +288,13 @@ class VideoReader:
                     break
                 if isinstance(item, BaseException):
                     raise item
+                assert isinstance(item, np.ndarray)
                 self.decoded += 1
                 yield item
         finally:
             self._stop_decoding()
 
-    def _decode(self, frames: queue.Queue, stop: threading.Event) -> None:
+    def _decode(self, frames: queue.Queue[object], stop: threading.Event) -> None:
         """The decoder thread: queues each frame, then :data:`_END` at the end of the file or
         the error that ended it; returns once ``stop`` is set."""
         try:
@@ -295,11 +317,14 @@ class VideoReader:
         """Set ``warnings`` once the file's end is reached."""
         self.warnings = []
         if self.frames - self.decoded > self.SHORT_OK:
-            self.warnings.append(f"video {self.path} ended after {self.decoded} of the {self.frames} frames its "
-                                 "container declares (a truncated file?)")
+            self.warnings.append(
+                f"video {self.path} ended after {self.decoded} of the {self.frames} frames its "
+                "container declares (a truncated file?)"
+            )
         if self.damaged:
-            self.warnings.append(f"{self.damaged} damaged packet(s) of video {self.path} did not decode and were "
-                                 "skipped")
+            self.warnings.append(
+                f"{self.damaged} damaged packet(s) of video {self.path} did not decode and were skipped"
+            )
 
     def _stop_decoding(self) -> None:
         """Stops the decoder thread, if any, taking the frames it still queues."""
@@ -308,10 +333,8 @@ class VideoReader:
         decoder, stop, frames = self._decoding
         stop.set()
         while decoder.is_alive():
-            try:
+            with contextlib.suppress(queue.Empty):
                 frames.get(timeout=0.01)
-            except queue.Empty:
-                pass
         decoder.join()
         while not frames.empty():  # what it queued last
             frames.get_nowait()
@@ -322,7 +345,7 @@ class VideoReader:
         self._stop_decoding()
         self._container.close()
 
-    def __enter__(self) -> "VideoReader":
+    def __enter__(self) -> VideoReader:
         return self
 
     def __exit__(self, *exc: object) -> None:

@@ -30,8 +30,14 @@ HEAD_FORMAT = "facemime.head/1"
 
 #: Groups ordered like the snake contours (image-left to image-right), one vertex per knot.
 CONTOUR_GROUPS = (
-    "mouth_outer_upper", "mouth_outer_lower", "mouth_inner_upper", "mouth_inner_lower",
-    "brow_left_upper", "brow_left_lower", "brow_right_upper", "brow_right_lower",
+    "mouth_outer_upper",
+    "mouth_outer_lower",
+    "mouth_inner_upper",
+    "mouth_inner_lower",
+    "brow_left_upper",
+    "brow_left_lower",
+    "brow_right_upper",
+    "brow_right_lower",
 )
 #: Groups every facemime head file must have.
 REQUIRED_GROUPS = CONTOUR_GROUPS + ("eye_left", "eye_right", "nose", "face_outline")
@@ -39,8 +45,11 @@ REQUIRED_GROUPS = CONTOUR_GROUPS + ("eye_left", "eye_right", "nose", "face_outli
 #: Largest vertex coordinate, model units (a face is some hundreds of millimetres; a farther vertex
 #: is a broken file, and would overflow the pixel arithmetic of previews).
 MAX_COORDINATE = 1e6
-_COUNT_LIMITS = {"vertices": "FACEMIME_MAX_VERTICES", "triangles": "FACEMIME_MAX_TRIANGLES",
-                 "deformation unit values (units x vertices)": "FACEMIME_MAX_UNIT_VALUES"}
+_COUNT_LIMITS = {
+    "vertices": "FACEMIME_MAX_VERTICES",
+    "triangles": "FACEMIME_MAX_TRIANGLES",
+    "deformation unit values (units x vertices)": "FACEMIME_MAX_UNIT_VALUES",
+}
 
 
 def check_model_count(where: str, what: str, count: int) -> None:
@@ -50,8 +59,9 @@ def check_model_count(where: str, what: str, count: int) -> None:
     variable = _COUNT_LIMITS[what]
     most = limit(variable)
     if count > most:
-        raise ModelFormatError(f"{where}: the model has {count} {what}, more than the limit of {most}; "
-                               f"set {variable} to allow more")
+        raise ModelFormatError(
+            f"{where}: the model has {count} {what}, more than the limit of {most}; set {variable} to allow more"
+        )
 
 
 def read_model_file(path: Path) -> bytes:
@@ -114,7 +124,9 @@ class HeadModel:
         if problem:
             raise InvalidInputError(f"head model {self.name!r}: {problem}")
 
-    def deform(self, weights: Mapping[str, float] | None = None, shape: Mapping[str, float] | None = None) -> np.ndarray:
+    def deform(
+        self, weights: Mapping[str, float] | None = None, shape: Mapping[str, float] | None = None
+    ) -> np.ndarray:
         """Vertices with deformation units (and shape units) applied: (N, 3) float64.
 
         >>> head = generic_head()
@@ -231,8 +243,9 @@ def head_from_document(doc: object, where: str) -> HeadModel:
         if isinstance(doc.get(what), list):
             check_model_count(where, what, len(doc[what]))
     if isinstance(doc.get("vertices"), list) and isinstance(doc.get("deformation_units"), dict):
-        check_model_count(where, "deformation unit values (units x vertices)",
-                          len(doc["vertices"]) * len(doc["deformation_units"]))
+        check_model_count(
+            where, "deformation unit values (units x vertices)", len(doc["vertices"]) * len(doc["deformation_units"])
+        )
     try:
         vertices = np.asarray(doc["vertices"], dtype=np.float64)
         n = len(vertices)
@@ -245,7 +258,9 @@ def head_from_document(doc: object, where: str) -> HeadModel:
             for row in u["displacements"]:
                 i, dx, dy, dz = row
                 if not (isinstance(i, int) and 0 <= i < n):
-                    raise ModelFormatError(f"{where}: deformation unit {name!r} names vertex {i!r}, but there are {n} vertices")
+                    raise ModelFormatError(
+                        f"{where}: deformation unit {name!r} names vertex {i!r}, but there are {n} vertices"
+                    )
                 dense[i] = (dx, dy, dz)
             units[str(name)] = dense
             descriptions[str(name)] = str(u.get("description", ""))
@@ -261,4 +276,14 @@ def head_from_document(doc: object, where: str) -> HeadModel:
     problem = _first_problem(vertices, triangles, uv, groups, (units,))
     if problem:
         raise ModelFormatError(f"{where}: {problem}")
-    return HeadModel(vertices, triangles, uv, groups, units, {}, descriptions, str(doc.get("name", where)), str(doc.get("unit", "mm")))
+    return HeadModel(
+        vertices,
+        triangles,
+        uv,
+        groups,
+        units,
+        {},
+        descriptions,
+        str(doc.get("name", where)),
+        str(doc.get("unit", "mm")),
+    )

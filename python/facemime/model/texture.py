@@ -45,7 +45,7 @@ def painted_texture(model: HeadModel, size: int = 512) -> np.ndarray:
     shade = 1.0 - 0.35 * np.clip(np.hypot((xx - centre[0]) * 1.3, yy - centre[1]) * 1.6, 0, 1) ** 2
     img = np.clip(np.array(SKIN, np.float32) * shade[..., None], 0, 255).astype(np.uint8)
 
-    draw = dict(lineType=cv2.LINE_AA, shift=4)
+    draw = {"lineType": cv2.LINE_AA, "shift": 4}
     for side in ("left", "right"):
         cv2.fillPoly(img, [poly(f"brow_{side}_upper", f"brow_{side}_lower")], BROW, **draw)
         eye = np.round(px[model.groups[f"eye_{side}"]] * 16).astype(np.int32)
@@ -66,5 +66,15 @@ def painted_texture(model: HeadModel, size: int = 512) -> np.ndarray:
     nose = px[model.groups["nose"]]
     for k in (8, 9):  # the two alae: nostrils just inside them, towards the nose tip
         c = 0.6 * nose[k] + 0.4 * nose[7]
-        cv2.ellipse(img, tuple(np.round(c * 16).astype(int)), (int(7 * scale * 16), int(4 * scale * 16)), 0, 0, 360, (120, 70, 60), -1, **draw)
+        cv2.ellipse(
+            img,
+            tuple(np.round(c * 16).astype(int)),
+            (int(7 * scale * 16), int(4 * scale * 16)),
+            0,
+            0,
+            360,
+            (120, 70, 60),
+            -1,
+            **draw,
+        )
     return cv2.GaussianBlur(img, (0, 0), 0.8 * scale)

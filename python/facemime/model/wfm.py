@@ -28,8 +28,16 @@ import numpy as np
 from facemime.errors import InvalidInputError, ModelFormatError
 from facemime.model.head import HeadModel, check_model_count, read_model_file
 
-_SECTIONS = ("VERTEX LIST", "FACE LIST", "ANIMATION UNITS LIST", "SHAPE UNITS LIST",
-             "ANIMATION PARAMETERS", "SHAPE PARAMETERS", "TEXTURE", "END OF FILE")
+_SECTIONS = (
+    "VERTEX LIST",
+    "FACE LIST",
+    "ANIMATION UNITS LIST",
+    "SHAPE UNITS LIST",
+    "ANIMATION PARAMETERS",
+    "SHAPE PARAMETERS",
+    "TEXTURE",
+    "END OF FILE",
+)
 _COUNTED = {"VERTEX LIST": "vertices", "FACE LIST": "triangles"}  # sections whose count has a limit
 
 
@@ -57,13 +65,15 @@ class _Lines:
             return [kind(p) for p in parts]
         except ValueError:
             self.pos -= 1
-            raise self.fail(f"expected {count} {'integers' if kind is int else 'numbers'}, got {' '.join(parts)!r}") from None
+            raise self.fail(
+                f"expected {count} {'integers' if kind is int else 'numbers'}, got {' '.join(parts)!r}"
+            ) from None
 
     def table(self, rows: int, columns: int, kind: type) -> np.ndarray:
         """The next ``rows`` lines as a (rows, columns) float64 or int64 array (``kind`` float or
         int): numpy's parser first, then line by line, naming the first bad line, if that fails."""
         dtype = np.int64 if kind is int else np.float64
-        chunk = [line for _, line in self.lines[self.pos:self.pos + rows]]
+        chunk = [line for _, line in self.lines[self.pos : self.pos + rows]]
         if rows and len(chunk) == rows:
             try:
                 table = np.loadtxt(io.StringIO("\n".join(chunk)), dtype=dtype, comments=None, ndmin=2)
@@ -124,7 +134,10 @@ def load_wfm(path: str | Path) -> HeadModel:
     s = _Lines(where, "FACE LIST", sections["FACE LIST"])
     faces = s.table(s.count(), 3, int)
     if faces.size and (faces.min() < 0 or faces.max() >= n):
-        raise ModelFormatError(f"{where}: FACE LIST uses vertex {int(faces.max() if faces.max() >= n else faces.min())}, but there are {n} vertices")
+        raise ModelFormatError(
+            f"{where}: FACE LIST uses vertex {int(faces.max() if faces.max() >= n else faces.min())}, but "
+            f"there are {n} vertices"
+        )
 
     total = [0]  # deformation units so far, both sections
 

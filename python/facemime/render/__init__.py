@@ -4,4 +4,4 @@ per-triangle affine texture mapping, the last three in the Rust core."""
 from facemime.render.projection import Pose, project, rotation_matrix
 from facemime.render.texture_map import RenderStats, coverage, fill, render_mesh, render_mesh_into
 
-__all__ = ["Pose", "project", "rotation_matrix", "RenderStats", "coverage", "fill", "render_mesh", "render_mesh_into"]
+__all__ = ["Pose", "RenderStats", "coverage", "fill", "project", "render_mesh", "render_mesh_into", "rotation_matrix"]

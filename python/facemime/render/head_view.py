@@ -33,12 +33,28 @@ def render_head(
     points, depth = project(model.vertices if vertices is None else vertices, pose)
     if model.uv is None:
         raise InvalidInputError(f"head model {model.name!r} has no texture coordinates (uv)")
-    return render_mesh(texture, model.uv, points, depth, model.triangles, size,
-                       background=background, filter=filter, depth_test=depth_test)
+    return render_mesh(
+        texture,
+        model.uv,
+        points,
+        depth,
+        model.triangles,
+        size,
+        background=background,
+        filter=filter,
+        depth_test=depth_test,
+    )
 
 
-def render_shaded(model: HeadModel, pose: Pose, size: tuple[int, int], *, vertices: np.ndarray | None = None,
-                  colour: tuple[int, int, int] = (205, 180, 160), background: int = 255) -> np.ndarray:
+def render_shaded(
+    model: HeadModel,
+    pose: Pose,
+    size: tuple[int, int],
+    *,
+    vertices: np.ndarray | None = None,
+    colour: tuple[int, int, int] = (205, 180, 160),
+    background: int = 255,
+) -> np.ndarray:
     """Flat Lambert shading of the front faces, far to near: an (H, W, 3) preview image of
     ``size`` = (width, height) pixels, drawn by the Rust rasteriser.
 
@@ -61,12 +77,25 @@ def render_shaded(model: HeadModel, pose: Pose, size: tuple[int, int], *, vertic
     uv[:, 0] = (face_texel + 0.5) / len(palette_keys)
     uv[:, 1] = 0.5
     corners = t.ravel()
-    return render_mesh(palette, np.repeat(uv, 3, axis=0), points[corners], depth[corners],
-                       np.arange(len(corners)).reshape(-1, 3), size, background=background, filter="nearest")
+    return render_mesh(
+        palette,
+        np.repeat(uv, 3, axis=0),
+        points[corners],
+        depth[corners],
+        np.arange(len(corners)).reshape(-1, 3),
+        size,
+        background=background,
+        filter="nearest",
+    )
 
 
-def draw_wireframe(image: np.ndarray, points: np.ndarray, triangles: np.ndarray,
-                   colour: tuple[int, int, int] = (40, 220, 90), thickness: int = 1) -> np.ndarray:
+def draw_wireframe(
+    image: np.ndarray,
+    points: np.ndarray,
+    triangles: np.ndarray,
+    colour: tuple[int, int, int] = (40, 220, 90),
+    thickness: int = 1,
+) -> np.ndarray:
     """Draw every triangle edge of a projected mesh (``points`` (N, 2) pixels) onto ``image``
     in place and return it."""
     n = len(points)
@@ -80,8 +109,13 @@ def draw_wireframe(image: np.ndarray, points: np.ndarray, triangles: np.ndarray,
     return image
 
 
-def views_sheet(model: HeadModel, texture: np.ndarray | None, cell: int = 320,
-                yaws: tuple[float, ...] = (-60, -30, 0, 30, 60), vertices: np.ndarray | None = None) -> np.ndarray:
+def views_sheet(
+    model: HeadModel,
+    texture: np.ndarray | None,
+    cell: int = 320,
+    yaws: tuple[float, ...] = (-60, -30, 0, 30, 60),
+    vertices: np.ndarray | None = None,
+) -> np.ndarray:
     """One picture of a model seen at several yaw angles (degrees): a row of textured renders
     (when a texture is given), a row of flat-shaded renders with the wireframe on top."""
     v = model.vertices if vertices is None else vertices

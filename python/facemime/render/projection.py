@@ -53,7 +53,7 @@ class Pose:
     ty: float = 0.0
 
     @classmethod
-    def framing(cls, vertices: np.ndarray, size: tuple[int, int], fill: float = 0.9, **angles: float) -> "Pose":
+    def framing(cls, vertices: np.ndarray, size: tuple[int, int], fill: float = 0.9, **angles: float) -> Pose:
         """The pose that shows ``vertices`` (rotated by ``angles``) centred in an image of
         ``size`` = (width, height), its bounding box filling ``fill`` of the tighter side.
 

@@ -82,7 +82,7 @@ class SceneMesh:
     triangles: np.ndarray
 
     @classmethod
-    def build(cls, size: tuple[int, int], anchors: np.ndarray, outline: np.ndarray) -> "SceneMesh":
+    def build(cls, size: tuple[int, int], anchors: np.ndarray, outline: np.ndarray) -> SceneMesh:
         """The mesh of a picture of ``size`` = (width, height) whose face outline lies at
         ``outline`` ((A, 2) pixels, the projections of model vertices ``anchors``)."""
         w, h = size
@@ -125,16 +125,19 @@ class SceneMesh:
         written: the key frame is copied and only the triangles that moved are drawn again,
         those that moved less than :data:`SLOW` pixels sampled nearest, the others bilinear."""
         if key.shape != out.shape:
-            raise InvalidInputError(f"the key frame is {key.shape[1]}x{key.shape[0]}, "
-                                    f"the picture {out.shape[1]}x{out.shape[0]}")
+            raise InvalidInputError(
+                f"the key frame is {key.shape[1]}x{key.shape[0]}, the picture {out.shape[1]}x{out.shape[0]}"
+            )
         w, h = self.size
         points = self.points(outline)
         moved = np.abs(points - self.rest).max(axis=1)[self.triangles].max(axis=1)
         out[...] = key
         uv = (self.rest + 0.5) / [w, h]
         depth = np.zeros(len(points))
-        for tris, sampling in ((self.triangles[(moved > STILL) & (moved < SLOW)], "nearest"),
-                               (self.triangles[moved >= SLOW], "bilinear")):
+        for tris, sampling in (
+            (self.triangles[(moved > STILL) & (moved < SLOW)], "nearest"),
+            (self.triangles[moved >= SLOW], "bilinear"),
+        ):
             if len(tris):  # no culling: a triangle the motion folds over shows as a fold, never a hole
                 render_mesh_into(out, key, uv, points, depth, tris, filter=sampling, cull=False)
 

@@ -43,7 +43,9 @@ class BrowSearch:
             return None
         templ = self._template
         if abs(scale - 1.0) > 0.02:
-            templ = cv2.resize(templ, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR)
+            templ = cv2.resize(
+                templ, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR
+            )
         centre = np.asarray(expected, np.float64).mean(axis=0) + (self._centre0 - self._knots0.mean(axis=0)) * scale
         found = find(image, templ, centre, REACH * self._width * scale, MIN_MATCH)
         return None if found is None else (self._knots0 - self._centre0) * scale + found

@@ -82,8 +82,9 @@ class EyeFrame:
         step = self.axes / DENSITY
         start = self.to_image(np.array([SPAN_U[0], SPAN_V[0]]))
         m = np.column_stack([step[0], step[1], start])  # patch (col, row) -> image (x, y)
-        rgb = cv2.warpAffine(frame, m, (cols, rows), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-                             borderMode=cv2.BORDER_REPLICATE)
+        rgb = cv2.warpAffine(
+            frame, m, (cols, rows), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE
+        )
         return cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY).astype(np.float32)
 
 
@@ -122,7 +123,7 @@ def _peak(values: np.ndarray, i: int) -> float:
 def _disc(radius: float) -> np.ndarray:
     """A normalised disc kernel of ``radius`` px (read only)."""
     r = int(np.ceil(radius))
-    y, x = np.mgrid[-r:r + 1, -r:r + 1]
+    y, x = np.mgrid[-r : r + 1, -r : r + 1]
     k = (x * x + y * y <= radius * radius).astype(np.float32)
     k /= k.sum()
     k.flags.writeable = False
@@ -134,8 +135,8 @@ def find_iris(patch: np.ndarray, radius: float = IRIS_RADIUS) -> tuple[np.ndarra
     widths) is darkest against the picture beside it (the mean of a box of the disc's height on
     either side: taking the brighter box instead pulled the centre towards the side with more
     sclera, 0.031 against 0.029 IOD on the shared videos). Returns the centre and its contrast
-    (grey levels: how much brighter the sides are than the disc; low when no iris shows). (Taking the disc's darkness inside the eye's
-    opening only, to keep the lashes out, doubled the error on the shared videos: 0.031 to
+    (grey levels: how much brighter the sides are than the disc; low when no iris shows). (Taking the disc's
+    darkness inside the eye's opening only, to keep the lashes out, doubled the error on the shared videos: 0.031 to
     0.050 IOD.)"""
     r = radius * DENSITY
     inside = cv2.filter2D(patch, -1, _disc(r), borderType=cv2.BORDER_REPLICATE)
@@ -143,14 +144,14 @@ def find_iris(patch: np.ndarray, radius: float = IRIS_RADIUS) -> tuple[np.ndarra
     box = cv2.blur(patch, (side, int(round(1.2 * r))), borderType=cv2.BORDER_REPLICATE)
     shift = int(round(r + side / 2.0))
     beside = np.empty_like(box)
-    beside[:, shift:-shift] = 0.5 * (box[:, :-2 * shift] + box[:, 2 * shift:])
-    beside[:, :shift] = beside[:, shift:shift + 1]
-    beside[:, -shift:] = beside[:, -shift - 1:-shift]
+    beside[:, shift:-shift] = 0.5 * (box[:, : -2 * shift] + box[:, 2 * shift :])
+    beside[:, :shift] = beside[:, shift : shift + 1]
+    beside[:, -shift:] = beside[:, -shift - 1 : -shift]
     score = inside - 0.5 * beside
     r0, c0 = _row(IRIS_V[0]), _col(-IRIS_U)
-    window = score[r0:_row(IRIS_V[1]) + 1, c0:_col(IRIS_U) + 1]
+    window = score[r0 : _row(IRIS_V[1]) + 1, c0 : _col(IRIS_U) + 1]
     row, col = np.unravel_index(int(np.argmin(window)), window.shape)
-    centre = np.array([_u(c0 + _peak(window[row], col)), _v(r0 + _peak(window[:, col], row))])
+    centre = np.array([_u(c0 + _peak(window[row], int(col))), _v(r0 + _peak(window[:, col], int(row)))])
     return centre, float(beside[r0 + row, c0 + col] - inside[r0 + row, c0 + col])
 
 
@@ -164,7 +165,7 @@ def profiles(patch: np.ndarray) -> np.ndarray:
     """(C, R) the mean of an eye's :meth:`EyeFrame.patch` over each of :data:`COLUMNS`' bands,
     per row."""
     half = max(1, int(round(COLUMN_HALF * DENSITY)))
-    return np.array([patch[:, _col(u) - half:_col(u) + half + 1].mean(axis=1) for u in COLUMNS])
+    return np.array([patch[:, _col(u) - half : _col(u) + half + 1].mean(axis=1) for u in COLUMNS])
 
 
 #: Openings (shares of the key frame's) and lower-lid shifts (eye widths) tried by
@@ -218,8 +219,11 @@ class LidModel:
         i1 = np.minimum(i0 + 1, rows - 1)
         c = np.arange(len(key))[:, None]
         self._trials = _normalised(key[c, i0] * (1 - f) + key[c, i1] * f)  # (O, L, M, C, R')
-        prior = (OPENINGS[:, None, None] - 1.0) ** 2 + (LOWER_SHIFTS[None, :, None] / LOWER_SHIFTS[-1]) ** 2 \
+        prior = (
+            (OPENINGS[:, None, None] - 1.0) ** 2
+            + (LOWER_SHIFTS[None, :, None] / LOWER_SHIFTS[-1]) ** 2
             + (SHIFTS[None, None, :] / SHIFTS[-1]) ** 2
+        )
         self._prior = PRIOR * prior
 
     def share(self, now: np.ndarray) -> float:
@@ -229,7 +233,7 @@ class LidModel:
         seen = _normalised(now[:, self._rows])
         cost = ((self._trials - seen) ** 2).mean(axis=(-1, -2)) + self._prior
         i, j, k = np.unravel_index(int(np.argmin(cost)), cost.shape)
-        return float(np.interp(_peak(cost[:, j, k], i), np.arange(len(OPENINGS)), OPENINGS))
+        return float(np.interp(_peak(cost[:, j, k], int(i)), np.arange(len(OPENINGS)), OPENINGS))
 
 
 @dataclass(frozen=True)

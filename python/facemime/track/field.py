@@ -9,13 +9,16 @@ Rust core; it equals OpenCV's GaussianBlur and Sobel(ksize=1, scale=0.5) on the 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from facemime import _core
 
 
-def regions(knots: np.ndarray, bands: list[tuple[np.ndarray, float]], width: int, height: int,
-            sigma: float) -> tuple[tuple[int, int, int, int], list[tuple[int, int, int, int]]]:
+def regions(
+    knots: np.ndarray, bands: list[tuple[np.ndarray, float]], width: int, height: int, sigma: float
+) -> tuple[tuple[int, int, int, int], list[tuple[int, int, int, int]]]:
     """The field's regions for ``knots`` (K, 2) px in a ``width`` × ``height`` frame, smoothed
     by ``sigma`` px: each of ``bands``, (knot indices as np.uintp, margin px: how far around
     them the field is read), gives the integer box (x0, y0, x1, y1), exclusive ends, around its
@@ -23,11 +26,21 @@ def regions(knots: np.ndarray, bands: list[tuple[np.ndarray, float]], width: int
     returns (the field's box, those boxes). The box holds them all grown by the smoothing's
     radius, so that every pixel read holds the values it would in a field of the whole frame."""
     box, boxes = _core.field_regions(np.ascontiguousarray(knots, np.float64), bands, width, height, sigma)
-    return tuple(box), [tuple(b) for b in boxes]
+    return _box(box), [_box(b) for b in boxes]
 
 
-def build_field(frame: np.ndarray, prev: np.ndarray | None, box: tuple[int, int, int, int], sigma: float,
-                bands: list[tuple[int, int, int, int]] | None = None, out: np.ndarray | None = None) -> np.ndarray:
+def _box(b: Sequence[int]) -> tuple[int, int, int, int]:
+    return int(b[0]), int(b[1]), int(b[2]), int(b[3])
+
+
+def build_field(
+    frame: np.ndarray,
+    prev: np.ndarray | None,
+    box: tuple[int, int, int, int],
+    sigma: float,
+    bands: list[tuple[int, int, int, int]] | None = None,
+    out: np.ndarray | None = None,
+) -> np.ndarray:
     """The (h, w, 6) float32 field of ``frame`` (H, W, 3) uint8 RGB over ``box``
     (x0, y0, x1, y1), exclusive ends, smoothed by a Gaussian of ``sigma`` px; ``prev`` is the
     previous frame (or None: L_prev = L). With ``bands``, (x0, y0, x1, y1) frame rectangles,

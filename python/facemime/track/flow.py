@@ -35,7 +35,9 @@ class FrameFlow:
         """The next frame, (H, W) grey or (H, W, 3) RGB uint8 (read as OpenCV's ``RGB2GRAY``
         grey levels); only ``crop`` = (x0, y0, x1, y1) px, exclusive ends, is used: points
         outside it are not followed."""
-        self._frames.push(np.ascontiguousarray(frame, np.uint8), tuple(int(v) for v in crop))
+        self._frames.push(
+            np.ascontiguousarray(frame, np.uint8), (int(crop[0]), int(crop[1]), int(crop[2]), int(crop[3]))
+        )
 
     def track(self, points: np.ndarray, backward: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """Positions in the current frame of (N, 2) points of the previous one (the reverse

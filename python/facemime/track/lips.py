@@ -110,16 +110,29 @@ class LipSearch:
     (w_r, w_g, bias) when it is True.
     """
 
-    def __init__(self, frame: np.ndarray, contours: Mapping[str, np.ndarray], index: Mapping[str, np.ndarray],
-                 edges: np.ndarray, reach: float, min_step: float):
+    def __init__(
+        self,
+        frame: np.ndarray,
+        contours: Mapping[str, np.ndarray],
+        index: Mapping[str, np.ndarray],
+        edges: np.ndarray,
+        reach: float,
+        min_step: float,
+    ):
         self.colour = lip_colour(frame, contours)
         corners = np.asarray(contours["mouth_outer_upper"], np.float64)[[0, -1]]
         reach_px = reach * float(np.linalg.norm(corners[1] - corners[0]))
         self.active = self.colour is not None and reach_px >= 1.0
-        if self.active:
+        if self.active and self.colour is not None:
             self._placer = _core.LipPlacer(
-                np.ascontiguousarray(frame), self.colour, reach_px, min_step, [list(map(int, index[n])) for n in MOUTH],
-                [POLARITY[n][1] for n in MOUTH], as_points(edges))
+                np.ascontiguousarray(frame),
+                self.colour,
+                reach_px,
+                min_step,
+                [list(map(int, index[n])) for n in MOUTH],
+                [POLARITY[n][1] for n in MOUTH],
+                as_points(edges),
+            )
 
     def move(self, frame: np.ndarray, knots: np.ndarray, unfollowed: np.ndarray, scale: float) -> None:
         """Move the interior mouth knots flagged in ``unfollowed`` (a mask over ``knots``, a

@@ -37,7 +37,9 @@ def gray_crop(image: np.ndarray, lo: np.ndarray | tuple[int, int], hi: np.ndarra
     return _core.grey_area(np.ascontiguousarray(image), (int(lo[0]), int(lo[1]), int(hi[0]), int(hi[1])))
 
 
-def find(image: np.ndarray, template: np.ndarray, centre: np.ndarray, reach: float, min_match: float) -> np.ndarray | None:
+def find(
+    image: np.ndarray, template: np.ndarray, centre: np.ndarray, reach: float, min_match: float
+) -> np.ndarray | None:
     """Where the centre of ``template`` ((h, w) uint8 grey) matches ``image`` ((H, W) grey or
     (H, W, 3) RGB uint8, see :func:`gray_crop`) best, (2,) px, searched within ± ``reach`` px of
     ``centre`` (x, y) px; None where the window does not hold the template or the best
@@ -68,8 +70,13 @@ class Placement:
         return centre + self.scale * (points - centre) + self.shift
 
 
-def locate(channel: np.ndarray, polygon: np.ndarray, reach: tuple[float, float], band: float,
-           scales: tuple[float, ...] = (1.0,)) -> Placement:
+def locate(
+    channel: np.ndarray,
+    polygon: np.ndarray,
+    reach: tuple[float, float],
+    band: float,
+    scales: tuple[float, ...] = (1.0,),
+) -> Placement:
     """Best placement of ``polygon`` on ``channel`` (H, W float32, larger = more feature-like).
 
     ``reach`` = (rx, ry): the largest shift searched in x and y, pixels; ``band``: width of the
@@ -96,7 +103,7 @@ def locate(channel: np.ndarray, polygon: np.ndarray, reach: tuple[float, float],
         if x0 < 0 or y0 < 0 or x1 > w or y1 > h:
             pad = max(0, -x0, -y0, x1 - w, y1 - h)
             padded = cv2.copyMakeBorder(channel, pad, pad, pad, pad, cv2.BORDER_REPLICATE)
-            window = padded[y0 + pad:y1 + pad, x0 + pad:x1 + pad]
+            window = padded[y0 + pad : y1 + pad, x0 + pad : x1 + pad]
         else:
             window = channel[y0:y1, x0:x1]
         score = cv2.matchTemplate(np.ascontiguousarray(window, np.float32), kernel.astype(np.float32), cv2.TM_CCORR)

@@ -69,7 +69,9 @@ def zone_polygons(contours: Mapping[str, np.ndarray]) -> list[np.ndarray]:
     return polys
 
 
-def robust_similarity(src: np.ndarray, dst: np.ndarray, limit: float, rounds: int = FIT_ROUNDS) -> tuple[np.ndarray, np.ndarray]:
+def robust_similarity(
+    src: np.ndarray, dst: np.ndarray, limit: float, rounds: int = FIT_ROUNDS
+) -> tuple[np.ndarray, np.ndarray]:
     """The 2×3 similarity (rotation, uniform scale, translation) mapping ``src`` (N, 2) onto
     ``dst`` (N, 2) px despite outliers, and the (N,) inlier mask (residual below ``limit`` px).
     Iteratively reweighted least squares with Tukey's biweight, started from the median
@@ -127,8 +129,19 @@ class HeadMotion:
         self._brows = tuple(n for n in contours if n.startswith("brow"))
         zones = zone_polygons(contours)
         self._head = _core.HeadFollower(
-            frame, self.brow_points(contours), np.stack(zones), WINDOW, LEVELS, GUIDED_LEVELS, FB_LIMIT, MIN_POINTS,
-            FIT_ROUNDS, ITERATIONS, EPSILON, MIN_EIGEN)
+            frame,
+            self.brow_points(contours),
+            np.stack(zones),
+            WINDOW,
+            LEVELS,
+            GUIDED_LEVELS,
+            FB_LIMIT,
+            MIN_POINTS,
+            FIT_ROUNDS,
+            ITERATIONS,
+            EPSILON,
+            MIN_EIGEN,
+        )
         self._head.detected(self._detect(zones))
 
     @property
@@ -153,7 +166,9 @@ class HeadMotion:
         return as_points(np.concatenate([contours[n] for n in self._brows]))
 
     @staticmethod
-    def _zones_box(zones: np.ndarray | list[np.ndarray], shape: tuple[int, ...], margin: int) -> tuple[int, int, int, int]:
+    def _zones_box(
+        zones: np.ndarray | list[np.ndarray], shape: tuple[int, ...], margin: int
+    ) -> tuple[int, int, int, int]:
         """(x0, y0, x1, y1), exclusive ends: the ``zones``' box, from the floor of their
         smallest to the ceiling of their largest coordinates, grown by ``margin`` px, inside
         the frame."""
@@ -171,8 +186,7 @@ class HeadMotion:
         mask = np.zeros((y1 - y0, x1 - x0), np.uint8)
         for poly in np.rint(np.asarray(zones) - (x0, y0)).astype(np.int32):
             cv2.fillConvexPoly(mask, poly, 255)
-        return self._head.corners((x0, y0, x1, y1), mask, self._max_points, QUALITY, self._min_distance,
-                                  CORNER_BLOCK)
+        return self._head.corners((x0, y0, x1, y1), mask, self._max_points, QUALITY, self._min_distance, CORNER_BLOCK)
 
     def _coarse_shift(self, frame: np.ndarray) -> tuple[np.ndarray, bool]:
         """Fallback for motion too fast or blurred for the flow: the translation that best
@@ -184,7 +198,10 @@ class HeadMotion:
         rx, ry = (x1 - x0) // 2, (y1 - y0) // 2
         sx0, sy0 = max(x0 - rx, 0), max(y0 - ry, 0)
         sx1, sy1 = min(x1 + rx, frame.shape[1]), min(y1 + ry, frame.shape[0])
-        small = lambda img: cv2.resize(img, None, fx=0.25, fy=0.25, interpolation=cv2.INTER_AREA)  # noqa: E731
+
+        def small(img: np.ndarray) -> np.ndarray:
+            return np.asarray(cv2.resize(img, None, fx=0.25, fy=0.25, interpolation=cv2.INTER_AREA), np.uint8)
+
         templ = small(gray_crop(self._prev, (x0, y0), (x1, y1)))
         search = small(gray_crop(frame, (sx0, sy0), (sx1, sy1)))
         if templ.shape[0] > search.shape[0] or templ.shape[1] > search.shape[1] or templ.std() < 1.0:
@@ -198,8 +215,9 @@ class HeadMotion:
         self._head.drop_points()
         return step, True
 
-    def update(self, frame: np.ndarray, brows: np.ndarray,
-               extra: np.ndarray | None = None) -> tuple[np.ndarray, bool, np.ndarray | None]:
+    def update(
+        self, frame: np.ndarray, brows: np.ndarray, extra: np.ndarray | None = None
+    ) -> tuple[np.ndarray, bool, np.ndarray | None]:
         """Motion from the previous frame to ``frame`` (grey or RGB, as the first).
 
         ``brows``: (N, 2) px, the brow points tracked in the previous frame

@@ -72,8 +72,9 @@ def mouth_shift(prev_image: np.ndarray, image: np.ndarray, prev: np.ndarray, car
     return None if found is None else found - expected
 
 
-def relocate(frame: np.ndarray, colour: tuple[float, float, float], expected: np.ndarray,
-             current: np.ndarray, down: np.ndarray) -> Placement | None:
+def relocate(
+    frame: np.ndarray, colour: tuple[float, float, float], expected: np.ndarray, current: np.ndarray, down: np.ndarray
+) -> Placement | None:
     """Where the lips of ``frame`` ((H, W, 3) uint8 RGB; lip score ``colour`` = (w_r, w_g,
     bias), :func:`facemime.track.lips.lip_colour`) are, as the placement of the outer mouth
     polygon ``expected`` ((N, 2) px, where the mouth is expected) that fits them best, searched

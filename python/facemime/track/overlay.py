@@ -10,13 +10,23 @@ import numpy as np
 from facemime.track.contours import FEATURES
 
 #: Feature -> RGB colour of its curves.
-COLOURS = {"mouth_outer": (255, 64, 64), "mouth_inner": (255, 220, 40), "brow_left": (60, 200, 255), "brow_right": (60, 255, 120)}
+COLOURS = {
+    "mouth_outer": (255, 64, 64),
+    "mouth_inner": (255, 220, 40),
+    "brow_left": (60, 200, 255),
+    "brow_right": (60, 255, 120),
+}
 LOST_COLOUR = (255, 0, 255)
 SHIFT = 4  # sub-pixel bits for cv2 drawing
 
 
-def draw_contours(frame: np.ndarray, contours: Mapping[str, np.ndarray], lost: Iterable[str] = (),
-                  thickness: int | None = None, out: np.ndarray | None = None) -> np.ndarray:
+def draw_contours(
+    frame: np.ndarray,
+    contours: Mapping[str, np.ndarray],
+    lost: Iterable[str] = (),
+    thickness: int | None = None,
+    out: np.ndarray | None = None,
+) -> np.ndarray:
     """``frame`` (H, W, 3) uint8 RGB with the contours drawn as anti-aliased polylines, knots as
     dots; curves of ``lost`` features in magenta. Drawn on a copy, or on ``out`` (an (H, W, 3)
     uint8 array or view, e.g. half of a side-by-side canvas) after ``frame`` is copied into it."""

@@ -87,14 +87,15 @@ def sparse_grid(frame: np.ndarray) -> np.ndarray:
     """Every k-th pixel of every k-th row of an (H, W, 3) frame, k = min(H, W) // 32, as
     float32: a glance at the whole picture for finding cuts."""
     k = max(1, min(frame.shape[:2]) // 32)
-    return frame[k // 2::k, k // 2::k].astype(np.float32)
+    return frame[k // 2 :: k, k // 2 :: k].astype(np.float32)
 
 
 def disagreement(tracked: Mapping[str, np.ndarray], found: Mapping[str, np.ndarray], iod: float) -> dict[str, float]:
     """Per feature, the mean over its curves of the symmetric curve distance between
     ``tracked`` and ``found`` contours, over ``iod`` pixels."""
-    return {f: float(np.mean([curve_error(tracked[n], found[n]) for n in names])) / iod
-            for f, names in FEATURES.items()}
+    return {
+        f: float(np.mean([curve_error(tracked[n], found[n]) for n in names])) / iod for f, names in FEATURES.items()
+    }
 
 
 class FaceTracker:
@@ -123,8 +124,13 @@ class FaceTracker:
         contours were given).
     """
 
-    def __init__(self, frame: np.ndarray, contours: Mapping[str, np.ndarray] | None = None,
-                 params: TrackerParams | None = None, redetection: Redetection | None = None):
+    def __init__(
+        self,
+        frame: np.ndarray,
+        contours: Mapping[str, np.ndarray] | None = None,
+        params: TrackerParams | None = None,
+        redetection: Redetection | None = None,
+    ):
         self.params = params
         self.redetection = redetection or Redetection()
         landmarks, self.faces = None, 1
@@ -213,8 +219,9 @@ class FaceTracker:
         try:
             found = find_face(frame, SEARCH_SCORE).landmarks
         except NoFaceError:
-            return FrameResult(self.frame_index, self.tracker.contours, dict.fromkeys(FEATURES, 0.0), list(FEATURES),
-                               0, False)
+            return FrameResult(
+                self.frame_index, self.tracker.contours, dict.fromkeys(FEATURES, 0.0), list(FEATURES), 0, False
+            )
         self.tracker = Tracker(frame, contours_of(found, frame.shape[1::-1]), self.params)
         self._measured = 1
         self._face = True
@@ -227,8 +234,9 @@ class FaceTracker:
         self._lost_for = dict.fromkeys(FEATURES, 0)
         self.redetected.append(self.frame_index)
         self._anchor = np.concatenate([self.tracker.contours[n] for n in CONTOUR_NAMES])
-        return FrameResult(self.frame_index, self.tracker.contours, dict.fromkeys(FEATURES, 1.0), [], 0, True,
-                           redetected=True)
+        return FrameResult(
+            self.frame_index, self.tracker.contours, dict.fromkeys(FEATURES, 1.0), [], 0, True, redetected=True
+        )
 
     def _note(self, landmarks: np.ndarray, contours: np.ndarray) -> None:
         """Keep a landmark pass and the tracked contours of its frame ((K, 2) pixels), which

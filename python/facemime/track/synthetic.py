@@ -22,9 +22,15 @@ def _curve(x0: float, x1: float, y: float, bulge: float, count: int, centre: np.
     return np.stack([centre[0] + x0 + (x1 - x0) * s, centre[1] + y - bulge * np.sin(np.pi * s)], axis=1)
 
 
-def band_face_contours(shift: tuple[float, float] = (0.0, 0.0), opening: float = 0.0, bend: float = 0.0,
-                       brow_raise: float = 0.0, lips: float = 1.0, size: tuple[int, int] = (256, 256),
-                       parting: float = 0.0) -> dict[str, np.ndarray]:
+def band_face_contours(
+    shift: tuple[float, float] = (0.0, 0.0),
+    opening: float = 0.0,
+    bend: float = 0.0,
+    brow_raise: float = 0.0,
+    lips: float = 1.0,
+    size: tuple[int, int] = (256, 256),
+    parting: float = 0.0,
+) -> dict[str, np.ndarray]:
     """The true contours of :func:`band_face` (same arguments)."""
     c = np.array([size[0] / 2.0 + shift[0], size[1] / 2.0 + shift[1]])
     my = 40.0
@@ -42,9 +48,17 @@ def band_face_contours(shift: tuple[float, float] = (0.0, 0.0), opening: float =
     return out
 
 
-def band_face(shift: tuple[float, float] = (0.0, 0.0), opening: float = 0.0, bend: float = 0.0,
-              brow_raise: float = 0.0, lips: float = 1.0, size: tuple[int, int] = (256, 256), noise: float = 0.0,
-              seed: int = 0, parting: float = 0.0) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+def band_face(
+    shift: tuple[float, float] = (0.0, 0.0),
+    opening: float = 0.0,
+    bend: float = 0.0,
+    brow_raise: float = 0.0,
+    lips: float = 1.0,
+    size: tuple[int, int] = (256, 256),
+    noise: float = 0.0,
+    seed: int = 0,
+    parting: float = 0.0,
+) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Render the synthetic face; returns ((H, W, 3) uint8 RGB frame, true contours).
 
     ``shift`` moves the whole face (px); ``opening`` opens the mouth (px); ``bend`` raises the

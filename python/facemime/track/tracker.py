@@ -90,9 +90,10 @@ class TrackerParams:
     thickness (repulsion between the outer and inner curves; the inner curves never cross).
     ``gap_weight``: weight of those minimum gaps. ``brow_weight``: weight holding each brow's
     upper-to-lower thickness at its first-frame value (scaled with the head). ``mouth_knots``,
-    ``brow_knots``: knots per curve (None: the init's own points). ``knot_flow``: start each knot where the optical flow carries it (when the flow passes its
-    forward-backward check) rather than where the head motion alone puts it. ``lost_response``: a feature
-    is lost when its edge response falls below this fraction of the first frame's.
+    ``brow_knots``: knots per curve (None: the init's own points). ``knot_flow``: start each knot where the
+    optical flow carries it (when the flow passes its forward-backward check) rather than where the head
+    motion alone puts it. ``lost_response``: a feature is lost when its edge response falls below this
+    fraction of the first frame's.
     ``calibration_passes``: solver runs on the first frame that measure how far the image edges
     lie from the given contours (0: no correction). ``mouth_affine``: how far each mouth
     feature's rest shape follows the affine map that best carries it onto the knots' starting
@@ -192,7 +193,7 @@ class TrackerParams:
         """The farthest a solver pass moves a knot coordinate, δ0/(1−σ) px."""
         return self.delta0 / (1.0 - self.sigma)
 
-    def with_(self, **changes: object) -> "TrackerParams":
+    def with_(self, **changes: object) -> TrackerParams:
         """A copy with some settings changed."""
         return replace(self, **changes)
 
@@ -243,7 +244,9 @@ def _layout(contours: Mapping[str, np.ndarray], params: TrackerParams) -> tuple[
 
 def _check_contours(contours: Mapping[str, object], width: int, height: int) -> dict[str, np.ndarray]:
     if not isinstance(contours, Mapping):
-        raise InvalidInputError(f"contours must be a mapping of contour name to (N, 2) points, got {type(contours).__name__}")
+        raise InvalidInputError(
+            f"contours must be a mapping of contour name to (N, 2) points, got {type(contours).__name__}"
+        )
     missing = [n for n in CONTOUR_NAMES if n not in contours]
     if missing:
         raise InvalidInputError(f"contours lack {', '.join(missing)}")
@@ -299,18 +302,25 @@ class Tracker:
         self.width, self.height = self._scale.work  # px: the frames the snakes see
         self._knots0, self._index = _layout(contours, p)
         self._down0 = self._mouth_down(self._knots0)
-        self._features = {f: np.unique(np.concatenate([self._index[n] for n in names])) for f, names in FEATURES.items()}
+        self._features = {
+            f: np.unique(np.concatenate([self._index[n] for n in names])) for f, names in FEATURES.items()
+        }
         self._mouth_knots = np.unique(np.concatenate([self._features["mouth_outer"], self._features["mouth_inner"]]))
         self._affine_groups = [[int(i) for i in self._features[f]] for f in ("mouth_outer", "mouth_inner")]
         # The field's bands: the mouth's knots with its solver passes, each brow's with one (a
         # band apiece, so that where a tilted head puts one brow above the other, the rows of
         # one brow alone are computed only around it).
-        self._frame_bands = self._band_args(((self._mouth_knots, p.mouth_passes), (self._features["brow_left"], 1),
-                                             (self._features["brow_right"], 1)))
+        self._frame_bands = self._band_args(
+            ((self._mouth_knots, p.mouth_passes), (self._features["brow_left"], 1), (self._features["brow_right"], 1))
+        )
         self._mouth_uintp = self._mouth_knots.astype(np.uintp)
-        self._inner_uintp, self._outer_uintp = (self._features[f].astype(np.uintp) for f in ("mouth_inner", "mouth_outer"))
+        self._inner_uintp, self._outer_uintp = (
+            self._features[f].astype(np.uintp) for f in ("mouth_inner", "mouth_outer")
+        )
         # Each feature's upper curve's end knots and how far its chord may shrink.
-        self._chord_ends = np.array([[self._index[up][0], self._index[up][-1]] for up, _ in FEATURES.values()], np.uintp)
+        self._chord_ends = np.array(
+            [[self._index[up][0], self._index[up][-1]] for up, _ in FEATURES.values()], np.uintp
+        )
         # The inner lips' knots pair by pair, corners left out: (upper, lower).
         self._inner_pairs = tuple(self._index[n][1:-1].astype(np.uintp) for n in FEATURES["mouth_inner"])
         self._least_chord = np.array([NARROWEST if up == "mouth_inner_upper" else 0.5 for up, _ in FEATURES.values()])
@@ -320,7 +330,9 @@ class Tracker:
         self._spans = list(zip(CONTOUR_NAMES, ends[:-1], ends[1:]))
         self._feature_rows = {f: tuple(CONTOUR_NAMES.index(n) for n in names) for f, names in FEATURES.items()}
         # Curve masks of the features solved on their own: the mouth's second pass, a brow found again.
-        self._feature_curves = {f: np.isin(np.arange(len(CONTOUR_NAMES)), rows) for f, rows in self._feature_rows.items()}
+        self._feature_curves = {
+            f: np.isin(np.arange(len(CONTOUR_NAMES)), rows) for f, rows in self._feature_rows.items()
+        }
         self._mouth_curves = np.array([n.startswith("mouth") for n in CONTOUR_NAMES])
         self._solver, self._targets0 = self._build_solver()
         self._field_buffer = np.empty(0, np.float32)
@@ -351,10 +363,22 @@ class Tracker:
         # The frame's steps around the solver, in the core: the start, the rest shape and gap
         # targets, then the confidences and shape checks.
         self._plan = _core.FramePlan(
-            self._knots0, tuple(self._down0), self._targets0, self._response0, (self.width - 1.0, self.height - 1.0),
-            self._mouth_uintp, p.mouth_patch, self._affine_groups, p.mouth_affine, self._inner_uintp,
-            self._outer_uintp, CENTRING, self._chord_ends, self._least_chord,
-            np.array(list(self._feature_rows.values()), np.uintp))
+            self._knots0,
+            tuple(self._down0),
+            self._targets0,
+            self._response0,
+            (self.width - 1.0, self.height - 1.0),
+            self._mouth_uintp,
+            p.mouth_patch,
+            self._affine_groups,
+            p.mouth_affine,
+            self._inner_uintp,
+            self._outer_uintp,
+            CENTRING,
+            self._chord_ends,
+            self._least_chord,
+            np.array(list(self._feature_rows.values()), np.uintp),
+        )
 
     def _build_solver(self) -> tuple[_core.SnakeSolver, np.ndarray]:
         p = self.params
@@ -363,7 +387,9 @@ class Tracker:
         for name in order:
             w = p.mouth_inner if name.startswith("mouth_inner") else p.mouth if name.startswith("mouth") else p.brows
             sl, sc = POLARITY[name]
-            rows.append([w.alpha, w.beta, w.tau, w.rho, w.gamma, sl * w.luma, sc * w.chroma, OPERATORS.index(p.operator)])
+            rows.append(
+                [w.alpha, w.beta, w.tau, w.rho, w.gamma, sl * w.luma, sc * w.chroma, OPERATORS.index(p.operator)]
+            )
         pairs, kinds, targets = [], [], []
         k0, down = self._knots0, self._down0
 
@@ -387,7 +413,11 @@ class Tracker:
             np.array(rows, np.float64),
             np.array(pairs, np.uint32).reshape(-1, 2),
             np.array(kinds, np.float64).reshape(-1, 2),
-            p.points_per_segment, p.delta0, p.sigma, p.iterations, p.tol,
+            p.points_per_segment,
+            p.delta0,
+            p.sigma,
+            p.iterations,
+            p.tol,
         )
         return solver, targets_arr
 
@@ -410,8 +440,9 @@ class Tracker:
         p = self.params
         return self._prev if max(p.mouth.gamma, p.mouth_inner.gamma, p.brows.gamma) > 0 else None
 
-    def _field(self, frame: np.ndarray, knots: np.ndarray,
-               bands: tuple[tuple[np.ndarray, int], ...] | None = None) -> tuple[np.ndarray, tuple[float, float]]:
+    def _field(
+        self, frame: np.ndarray, knots: np.ndarray, bands: tuple[tuple[np.ndarray, int], ...] | None = None
+    ) -> tuple[np.ndarray, tuple[float, float]]:
         """The image field the solver reads around ``knots``: (field, origin of its box). Each of
         ``bands``, (knot indices, solver passes), is the box around those knots that so many
         passes from them can read (default: the mouth's passes and one for the brows). The field
@@ -426,22 +457,35 @@ class Tracker:
         if self._field_buffer.size < size:
             self._field_buffer = np.empty(size + size // 4, np.float32)
         out = self._field_buffer[:size].reshape(box[3] - box[1], box[2] - box[0], _core.FIELD_CHANNELS)
-        return build_field(frame, self._previous(), box, self.params.smoothing, boxes, out), (float(box[0]), float(box[1]))
+        return build_field(frame, self._previous(), box, self.params.smoothing, boxes, out), (
+            float(box[0]),
+            float(box[1]),
+        )
 
-    def _responses(self, frame: np.ndarray, start: np.ndarray, rest: np.ndarray, down: np.ndarray, targets: np.ndarray) -> np.ndarray:
+    def _responses(
+        self, frame: np.ndarray, start: np.ndarray, rest: np.ndarray, down: np.ndarray, targets: np.ndarray
+    ) -> np.ndarray:
         fld, origin = self._field(frame, start)
         _, resp = self._solver.evaluate(fld, origin, (self.width, self.height), start, rest, tuple(down), targets)
         return resp
 
-    def _solve(self, field: tuple[np.ndarray, tuple[float, float]], start: np.ndarray, rest: np.ndarray,
-               down: np.ndarray, targets: np.ndarray, curves: np.ndarray | None = None,
-               held: np.ndarray | None = None) -> tuple[np.ndarray, int, np.ndarray]:
+    def _solve(
+        self,
+        field: tuple[np.ndarray, tuple[float, float]],
+        start: np.ndarray,
+        rest: np.ndarray,
+        down: np.ndarray,
+        targets: np.ndarray,
+        curves: np.ndarray | None = None,
+        held: np.ndarray | None = None,
+    ) -> tuple[np.ndarray, int, np.ndarray]:
         """One solver pass from ``start`` on ``field`` (:meth:`_field`); with ``curves``, a mask
         over CONTOUR_NAMES, for the features of those curves only (the others stay at ``start``,
         their responses NaN); with ``held``, a mask over the knots, those knots stay at ``start``
         (their curves still read the image and pull on the others through the couplings)."""
-        knots, iters, _, resp = self._solver.solve(*field, (self.width, self.height), start, rest, tuple(down),
-                                                   targets, curves, held)
+        knots, iters, _, resp = self._solver.solve(
+            *field, (self.width, self.height), start, rest, tuple(down), targets, curves, held
+        )
         return knots, iters, resp
 
     def _confidences(self, resp: np.ndarray) -> dict[str, float]:
@@ -460,8 +504,9 @@ class Tracker:
         self.frame_index += 1
         step, ok, flow = motion.IDENTITY, True, None
         if self._motion is not None:
-            step, ok, flow = self._motion.update(frame, self._reported.take(self._brow_knots, axis=0),
-                                                 self._knots if p.knot_flow else None)
+            step, ok, flow = self._motion.update(
+                frame, self._reported.take(self._brow_knots, axis=0), self._knots if p.knot_flow else None
+            )
         total = self._motion.total if self._motion is not None else motion.IDENTITY
         # Where the flow followed a knot, else where the head's step carries it; the head's
         # scale, and the mouth's downward normal turned with the head.
@@ -477,9 +522,21 @@ class Tracker:
         carried, rest, targets = self._plan.settle(start, total, scale)
         # The field around the start, a solver pass, then more for the mouth while a mouth knot
         # moved FAST of a pass's reach in the last.
-        knots, iters, resp = self._solver.track(frame, self._previous(), start, rest, tuple(down), targets,
-                                                (self.width, self.height), p.smoothing, self._frame_bands,
-                                                self._mouth_uintp, self._mouth_curves, p.mouth_passes, FAST * reach)
+        knots, iters, resp = self._solver.track(
+            frame,
+            self._previous(),
+            start,
+            rest,
+            tuple(down),
+            targets,
+            (self.width, self.height),
+            p.smoothing,
+            self._frame_bands,
+            self._mouth_uintp,
+            self._mouth_curves,
+            p.mouth_passes,
+            FAST * reach,
+        )
         # The inner mouth centred (:meth:`_centre_inner`), the confidences and shape checks.
         ratio, confs, shapes = self._plan.assess(knots, rest, tuple(down), resp, carried)
         ratio, confidence, lost = ratio.tolist(), dict(zip(FEATURES, confs)), []
@@ -487,10 +544,12 @@ class Tracker:
         for feature, shape_ok in zip(FEATURES, shapes):
             conf, fallback = confidence[feature], carried
             search = self._brow_search.get(feature)
-            if search is not None and (min(ratio[r] for r in self._feature_rows[feature]) < p.brow_search
-                                       or not shape_ok):
-                conf, shape_ok, fallback, more = self._search_brow(frame, feature, search, knots, start, rest, down,
-                                                                   targets, carried, scale, conf, shape_ok)
+            if search is not None and (
+                min(ratio[r] for r in self._feature_rows[feature]) < p.brow_search or not shape_ok
+            ):
+                conf, shape_ok, fallback, more = self._search_brow(
+                    frame, feature, search, knots, start, rest, down, targets, carried, scale, conf, shape_ok
+                )
                 iters += more
                 confidence[feature] = conf
             if conf < p.lost_response or not shape_ok:
@@ -518,8 +577,9 @@ class Tracker:
         self._prev = frame
         # The head motion reads the brows' reported knots next frame.
         self._reported = self._reported_knots()
-        return FrameResult(self.frame_index, self._named(self._scale.to_frame(self._reported)), confidence, lost,
-                           iters, ok)
+        return FrameResult(
+            self.frame_index, self._named(self._scale.to_frame(self._reported)), confidence, lost, iters, ok
+        )
 
     def reseat(self, contours: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
         """Move the contours of the frame last tracked to ``contours`` (all eight, (x, y) pixels
@@ -562,9 +622,21 @@ class Tracker:
             raise InvalidInputError(f"contours give {len(knots)} knots, the tracker has {len(self._knots)}")
         return knots
 
-    def _search_brow(self, frame: np.ndarray, feature: str, search: BrowSearch, knots: np.ndarray, start: np.ndarray,
-                     rest: np.ndarray, down: np.ndarray, targets: np.ndarray, carried: np.ndarray, scale: float,
-                     conf: float, shape_ok: bool) -> tuple[float, bool, np.ndarray, int]:
+    def _search_brow(
+        self,
+        frame: np.ndarray,
+        feature: str,
+        search: BrowSearch,
+        knots: np.ndarray,
+        start: np.ndarray,
+        rest: np.ndarray,
+        down: np.ndarray,
+        targets: np.ndarray,
+        carried: np.ndarray,
+        scale: float,
+        conf: float,
+        shape_ok: bool,
+    ) -> tuple[float, bool, np.ndarray, int]:
         """Look for a brow whose edge or shape was lost (``brow_search``) around where the head
         motion put it (``start``): when the match moves its knots at least :data:`AGREE` solver
         reaches, the brow is settled there by a solver pass and kept (in ``knots``, in place)
@@ -578,16 +650,29 @@ class Tracker:
             fallback = knots.copy()
             fallback[idx] = found
             if np.abs(found - knots[idx]).max() >= AGREE * p.reach:
-                again, iters, again_resp = self._solve(self._field(frame, fallback, ((idx, 1),)), fallback, rest,
-                                                       down, targets, self._feature_curves[feature])
+                again, iters, again_resp = self._solve(
+                    self._field(frame, fallback, ((idx, 1),)),
+                    fallback,
+                    rest,
+                    down,
+                    targets,
+                    self._feature_curves[feature],
+                )
                 conf_again = self._confidences(again_resp)[feature]
                 if conf_again > conf or not shape_ok:
                     knots[idx], conf = again[idx], conf_again
                     shape_ok = self._shape_ok(knots, carried, feature)
         return conf, shape_ok, fallback, iters
 
-    def _mouth_sideways(self, frame: np.ndarray, start: np.ndarray, followed: np.ndarray, step: np.ndarray,
-                        down: np.ndarray, reach: float) -> None:
+    def _mouth_sideways(
+        self,
+        frame: np.ndarray,
+        start: np.ndarray,
+        followed: np.ndarray,
+        step: np.ndarray,
+        down: np.ndarray,
+        reach: float,
+    ) -> None:
         """Move the mouth knots the flow lost (``followed`` False) along the mouth line by how far
         the previous frame's mouth region moved that way beyond the head's ``step``, when that is
         at least :data:`AGREE` × ``reach`` px (in place; the mouth's motion up and down, an
@@ -601,8 +686,16 @@ class Tracker:
         if abs(sideways) >= AGREE * reach:
             start[mouth[~followed[mouth]]] += sideways * along
 
-    def _search_inner(self, frame: np.ndarray, knots: np.ndarray, rest: np.ndarray, down: np.ndarray,
-                      targets: np.ndarray, carried: np.ndarray, conf: float) -> tuple[float | None, int]:
+    def _search_inner(
+        self,
+        frame: np.ndarray,
+        knots: np.ndarray,
+        rest: np.ndarray,
+        down: np.ndarray,
+        targets: np.ndarray,
+        carried: np.ndarray,
+        conf: float,
+    ) -> tuple[float | None, int]:
         """Look for a lost inner mouth (``inner_search``): each inner curve in turn, upper first, is
         moved along ``down`` by ±1 to ±``inner_search`` solver reaches and the inner mouth settled
         from there by a solver pass in which the outer mouth stays; the placement that gives the
@@ -637,8 +730,9 @@ class Tracker:
             return best, iters
         return None, iters
 
-    def _relocate_mouth(self, frame: np.ndarray, knots: np.ndarray, carried: np.ndarray, down: np.ndarray,
-                        targets: np.ndarray) -> tuple[dict[str, float] | None, int]:
+    def _relocate_mouth(
+        self, frame: np.ndarray, knots: np.ndarray, carried: np.ndarray, down: np.ndarray, targets: np.ndarray
+    ) -> tuple[dict[str, float] | None, int]:
         """Look for the mouth, lost for ``mouth_relocate`` frames, where its lip colour is found
         near where the brows put the first frame's mouth, in that mouth's shape, and let one
         solver pass (the frame's ``down`` and gap ``targets``) settle it there. The settled mouth
@@ -656,13 +750,13 @@ class Tracker:
         placed = knots.copy()
         placed[mouth] = found.apply(expected[mouth], polygon.mean(axis=0))
         rest = self._mouth_rest(carried, placed)
-        settled, iters, resp = self._solve(self._field(frame, placed, ((mouth, 1),)), placed, rest, down, targets,
-                                           self._mouth_curves)
+        settled, iters, resp = self._solve(
+            self._field(frame, placed, ((mouth, 1),)), placed, rest, down, targets, self._mouth_curves
+        )
         self._centre_inner(settled, rest, down)
         features = ("mouth_outer", "mouth_inner")
         confidence = {f: c for f, c in self._confidences(resp).items() if f in features}
-        if all(confidence[f] >= self.params.lost_response and self._shape_ok(settled, carried, f)
-               for f in features):
+        if all(confidence[f] >= self.params.lost_response and self._shape_ok(settled, carried, f) for f in features):
             knots[mouth] = settled[mouth]
             self._mouth_lost_for = 0
             return confidence, iters

@@ -36,9 +36,15 @@ class TrackRun:
     warnings: list[str]
 
 
-def track_video(video: str | Path, init: str | Path | None, out: str | Path, overlay: str | Path | None = None,
-                force: bool = False, params: TrackerParams | None = None,
-                redetection: Redetection | None = None) -> TrackRun:
+def track_video(
+    video: str | Path,
+    init: str | Path | None,
+    out: str | Path,
+    overlay: str | Path | None = None,
+    force: bool = False,
+    params: TrackerParams | None = None,
+    redetection: Redetection | None = None,
+) -> TrackRun:
     """Track ``video`` from the contours in ``init`` (``facemime.init/1``) and write ``out``
     (``facemime.track/1``) and, if given, the ``overlay`` video. Existing outputs are refused
     unless ``force``. Without ``init`` the largest face's landmarks on the first frame that shows
@@ -73,31 +79,44 @@ def track_video(video: str | Path, init: str | Path | None, out: str | Path, ove
                             writer.write(frame)
                         continue
                     start = index
-                    result = FrameResult(index, tracker.contours, {f: 1.0 for f in FEATURES})
+                    result = FrameResult(index, tracker.contours, dict.fromkeys(FEATURES, 1.0))
                     start_seconds = time.perf_counter() - t0
                 else:
                     result = tracker.update(frame)
                     seconds += time.perf_counter() - t0
                 lost_frames += bool(result.lost)
-                frames.append({"index": index, "contours": result.contours, "confidence": result.confidence,
-                               "lost": result.lost, "redetected": result.redetected})
+                frames.append(
+                    {
+                        "index": index,
+                        "contours": result.contours,
+                        "confidence": result.confidence,
+                        "lost": result.lost,
+                        "redetected": result.redetected,
+                    }
+                )
                 if writer is not None:
                     writer.write(draw_contours(frame, result.contours, result.lost))
             if decoded == 0:
                 raise InputFileError(f"video {video} has no frames")
             if tracker is None and init is None:
-                raise NoFaceError(f"no face found in any of the {decoded} frames of {video}; "
-                                  "pass the contours with --init INIT.json")
+                raise NoFaceError(
+                    f"no face found in any of the {decoded} frames of {video}; pass the contours with --init INIT.json"
+                )
             if tracker is None:
                 raise InvalidInputError(f"init frame {start} is beyond the last frame ({decoded - 1}) of {video}")
         info = {"width": reader.width, "height": reader.height, "fps": reader.fps, "frames": decoded}
-        write_json(outputs.stage(out), track_document(info, frames, {"processing_seconds": round(start_seconds + seconds, 4), "frames_processed": len(frames)}))
+        write_json(
+            outputs.stage(out),
+            track_document(
+                info, frames, {"processing_seconds": round(start_seconds + seconds, 4), "frames_processed": len(frames)}
+            ),
+        )
     first = "the first frame" if start == 0 else f"frame {start}"
     warnings = list(reader.warnings)
     if tracker.faces > 1:
         warnings.append(f"{tracker.faces} faces found in {first} of {video}; tracking the largest")
     if init is None and start > 0:
         warnings.append(f"no face in frames 0-{start - 1} of {video}; tracking from frame {start}")
-    return TrackRun(len(frames), start_seconds, seconds, lost_frames, [f["index"] for f in frames if f["redetected"]],
-                    warnings)
-
+    return TrackRun(
+        len(frames), start_seconds, seconds, lost_frames, [f["index"] for f in frames if f["redetected"]], warnings
+    )
