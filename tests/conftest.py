@@ -1,4 +1,6 @@
-"""Shared fixtures. Tests that need real data use ../shared next to the repository (CI has it).
+"""Shared fixtures. Tests that need real data use ../shared next to the repository, through the
+``shared`` fixture: without it they are skipped, or fail when the environment variable CI is set
+(CI has it, and a missing folder there must not turn the real-data tests into silent skips).
 Browser tests use ``browser``, a headless Chromium (Debian's ``chromium``, driven by Playwright's
 Python client; no browser is downloaded): without it they are skipped, or fail when the
 environment variable CI is set (CI installs it: see the README's test command)."""
@@ -10,27 +12,35 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from facemime.face.mesh import reference_points as face_mesh_points
 from facemime.fit import fit_model
 from facemime.fit.actor import smear_texture
 from facemime.io.video import VideoReader
 from facemime.model import generic_head
-from facemime.face.mesh import reference_points as face_mesh_points
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT.parent / "shared"
 
 
+def unavailable(message: str) -> None:
+    """Skip the test for want of ``message``'s thing, or fail it when the environment variable CI
+    is set (CI provides everything the tests need)."""
+    if os.environ.get("CI"):
+        pytest.fail(message)
+    pytest.skip(message)
+
+
 @pytest.fixture(scope="session")
 def shared() -> Path:
+    """The shared real data (``../shared/data``)."""
     if not (SHARED / "data").is_dir():
-        pytest.skip(f"shared data folder not found at {SHARED}")
+        unavailable(f"shared data folder not found at {SHARED}")
     return SHARED / "data"
 
 
 @pytest.fixture(scope="session")
 def candide_path(shared: Path) -> Path:
     return shared / "models" / "candide3.wfm"
-
 
 
 def reference_points(landmarks: np.ndarray) -> dict[str, np.ndarray]:
@@ -58,14 +68,17 @@ def actor(lp_d0):
     """The generic head fitted to lp_d0's first frame on its reference points."""
     frame, points, _ = lp_d0
     model = generic_head()
-    return smear_texture(model, frame, fit_model(model, points), points, {"file": "lp_d0.mp4", "frame": 0, "width": 512, "height": 512})
+    return smear_texture(
+        model, frame, fit_model(model, points), points, {"file": "lp_d0.mp4", "frame": 0, "width": 512, "height": 512}
+    )
 
 
 @pytest.fixture(scope="session")
 def astronaut(tmp_path_factory) -> Path:
     """The astronaut photo the package ships (NASA, public domain), as a PNG file."""
-    import cv2
     from importlib import resources
+
+    import cv2
 
     path = tmp_path_factory.mktemp("photo") / "astronaut.png"
     jpg = np.frombuffer(resources.files("facemime.data").joinpath("astronaut.jpg").read_bytes(), np.uint8)
@@ -74,14 +87,19 @@ def astronaut(tmp_path_factory) -> Path:
 
 
 #: Chromium's flags for a closed network: no background connections, no sandbox as root.
-CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
-                 "--disable-component-update", "--disable-sync"]
+CHROMIUM_ARGS = [
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
 
 
 def _unavailable(what: str) -> None:
-    if os.environ.get("CI"):
-        pytest.fail(f"the browser tests need {what}")
-    pytest.skip(f"the browser tests need {what}")
+    unavailable(f"the browser tests need {what}")
 
 
 @pytest.fixture(scope="session")
@@ -109,10 +127,13 @@ def node() -> str:
     """The ``node`` executable, with ``web/node_modules`` installed (``npm ci`` in web/): without
     them the tests that run Node are skipped, or fail when the environment variable CI is set."""
     node, npm = shutil.which("node"), shutil.which("npm")
-    missing = ("node and npm" if node is None or npm is None else
-               "web/node_modules (run `npm ci` in web/)" if not (WEB / "node_modules").is_dir() else None)
+    missing = (
+        "node and npm"
+        if node is None or npm is None
+        else "web/node_modules (run `npm ci` in web/)"
+        if not (WEB / "node_modules").is_dir()
+        else None
+    )
     if missing:
-        if os.environ.get("CI"):
-            pytest.fail(f"these tests need {missing}")
-        pytest.skip(f"these tests need {missing}")
+        unavailable(f"these tests need {missing}")
     return node

@@ -28,7 +28,7 @@ def test_fit_a_photo_writes_an_actor_and_a_preview(tmp_path, capsys, astronaut):
     preview = cv2.imread(str(tmp_path / "eileen.preview.png"))
     assert preview.shape == (360, 1440, 3)
     for k in range(1, 4):  # each render shows a textured face, not an empty background
-        panel = preview[:, 360 * k:360 * (k + 1)]
+        panel = preview[:, 360 * k : 360 * (k + 1)]
         assert (np.abs(panel.astype(int) - panel[0, 0]).sum(axis=2) > 30).mean() > 0.3
 
 
@@ -36,8 +36,17 @@ def test_fit_a_video_frame_with_points_from_a_file(tmp_path, capsys, shared, poi
     z = np.load(shared / "video" / "lp_d3.landmarks.npz")
     points = {k: v.tolist() for k, v in points_of(z["landmarks"][5]).items()}
     (tmp_path / "p.json").write_text(json.dumps({"format": "facemime.points/1", "points": points}))
-    code, _, err = run(capsys, "fit", str(shared / "video" / "lp_d3.mp4"), "--frame", "5",
-                       "--points", str(tmp_path / "p.json"), "--out", str(tmp_path / "a.actor"))
+    code, _, err = run(
+        capsys,
+        "fit",
+        str(shared / "video" / "lp_d3.mp4"),
+        "--frame",
+        "5",
+        "--points",
+        str(tmp_path / "p.json"),
+        "--out",
+        str(tmp_path / "a.actor"),
+    )
     assert code == 0, err
     actor = load_actor(tmp_path / "a.actor")
     assert actor.source["frame"] == 5
@@ -52,38 +61,52 @@ def test_track_without_init_starts_from_automatic_points(tmp_path, capsys, share
     frames = json.loads((tmp_path / "t.json").read_text())["frames"]
     assert [f["index"] for f in frames] == list(range(20))
     assert all(f["redetected"] is False for f in frames)  # nothing went astray on these frames
-    errors = [group_nme(f["contours"], from_face_mesh(z["landmarks"][f["index"]]), names, float(z["iod"][f["index"]]))
-              for f in frames for names in GROUPS.values()]
-    assert np.mean(errors) < 0.04 and max(errors) < 0.08
+    errors = [
+        group_nme(f["contours"], from_face_mesh(z["landmarks"][f["index"]]), names, float(z["iod"][f["index"]]))
+        for f in frames
+        for names in GROUPS.values()
+    ]
+    # Measured: mean 0.011, max 0.022 (thresholds at about 1.5x).
+    assert np.mean(errors) < 0.017 and max(errors) < 0.034
 
 
 @pytest.mark.parametrize("animal", ["lp_s22", "lp_s25", "lp_s39"])  # a monkey, a dog, a cat
 def test_an_animal_photo_has_no_face_to_fit(tmp_path, capsys, shared, animal):
     code, stdout, err = run(capsys, "fit", str(shared / "photos" / f"{animal}.jpg"), "--out", str(tmp_path / "a.actor"))
     assert code == 1 and stdout == ""
-    assert err.startswith(f"facemime: error: no face found in {shared / 'photos' / animal}.jpg") and err.count("\n") == 1
+    assert (
+        err.startswith(f"facemime: error: no face found in {shared / 'photos' / animal}.jpg") and err.count("\n") == 1
+    )
     assert list(tmp_path.iterdir()) == []
 
 
-@pytest.mark.parametrize(("setup", "message"), [
-    ("missing", "missing.png does not exist"),
-    ("not-an-image", "cannot read junk.png: not an image"),
-    ("not-a-video", "cannot read video junk.mp4"),
-    ("no-face", "no face found in blank.png; mark the face by hand and pass the points with --points"),
-    ("too-small", "tiny.png is 20x20 pixels; at least 64 a side is needed"),
-    ("bad-points", "p.json is not valid JSON"),
-    ("points-missing", "missing eye_left_outer"),
-    ("points-format", "expected format 'facemime.points/1'"),
-    ("bad-name", "the actor file name must end in .actor"),
-    ("exists", "a.actor already exists; use --force"),
-    ("frame-of-image", "--frame applies to videos only"),
-])
+@pytest.mark.parametrize(
+    ("setup", "message"),
+    [
+        ("missing", "missing.png does not exist"),
+        ("not-an-image", "cannot read junk.png: not an image"),
+        ("not-a-video", "cannot read video junk.mp4"),
+        ("no-face", "no face found in blank.png; mark the face by hand and pass the points with --points"),
+        ("too-small", "tiny.png is 20x20 pixels; at least 64 a side is needed"),
+        ("bad-points", "p.json is not valid JSON"),
+        ("points-missing", "missing eye_left_outer"),
+        ("points-format", "expected format 'facemime.points/1'"),
+        ("bad-name", "the actor file name must end in .actor"),
+        ("exists", "a.actor already exists; use --force"),
+        ("frame-of-image", "--frame applies to videos only"),
+    ],
+)
 def test_bad_input_gives_one_line(tmp_path, capsys, monkeypatch, astronaut, setup, message):
     monkeypatch.chdir(tmp_path)
     args = ["fit", str(astronaut), "--out", "a.actor"]
-    good = {"eye_right_outer": [200, 100], "eye_right_inner": [215, 100], "eye_left_inner": [235, 100],
-            "eye_left_outer": [250, 100], "mouth_outer_upper": [[205, 150], [245, 150]],
-            "mouth_outer_lower": [[205, 150], [245, 152]]}
+    good = {
+        "eye_right_outer": [200, 100],
+        "eye_right_inner": [215, 100],
+        "eye_left_inner": [235, 100],
+        "eye_left_outer": [250, 100],
+        "mouth_outer_upper": [[205, 150], [245, 150]],
+        "mouth_outer_lower": [[205, 150], [245, 152]],
+    }
     if setup == "missing":
         args[1] = "missing.png"
     elif setup in ("not-an-image", "not-a-video"):

@@ -7,10 +7,10 @@ import av
 import numpy as np
 import pytest
 
+from facemime.animate.look import NAMES
 from facemime.animate.run import SideBySide
 from facemime.animate.synth import BACKGROUND
 from facemime.errors import InputFileError
-from facemime.animate.look import NAMES
 from facemime.io.contours_json import read_motion
 from facemime.io.video import VideoReader, VideoWriter
 from facemime.metrics import group_nme
@@ -41,7 +41,7 @@ def own(clip, tmp_path_factory):
 
 def face_half(path):
     frames = list(VideoReader(path))
-    return np.array([f[:, f.shape[1] // 2:] for f in frames])
+    return np.array([f[:, f.shape[1] // 2 :] for f in frames])
 
 
 def test_run_writes_a_side_by_side_video_and_the_motion(own, shared):
@@ -56,9 +56,17 @@ def test_run_writes_a_side_by_side_video_and_the_motion(own, shared):
     assert all(f["face"] for f in doc["frames"])
     # The contours follow the face; the pose of this almost still head stays near frontal.
     z = np.load(shared / "video" / "lp_d0.landmarks.npz")
-    nme = [group_nme({k: np.array(v) for k, v in f["contours"].items()}, from_face_mesh(z["landmarks"][f["index"]]),
-                     names, float(z["iod"][f["index"]])) for f in doc["frames"][1:] for names in GROUPS.values()]
-    assert np.mean(nme) < 0.04
+    nme = [
+        group_nme(
+            {k: np.array(v) for k, v in f["contours"].items()},
+            from_face_mesh(z["landmarks"][f["index"]]),
+            names,
+            float(z["iod"][f["index"]]),
+        )
+        for f in doc["frames"][1:]
+        for names in GROUPS.values()
+    ]
+    assert np.mean(nme) < 0.033  # measured: 0.022 (max 0.062)
     _, _, motion = read_motion(folder / "out.json")
     poses = np.array([[m["pose"][k] for k in ("yaw", "pitch", "roll")] for m in motion])
     assert np.abs(poses).max() < 8
@@ -91,15 +99,26 @@ def test_the_per_frame_work_composes_every_frame_without_encoding(clip):
 def test_the_per_frame_work_of_no_frames_says_so():
     work = SideBySide([], "empty.mp4")
     assert list(work) == []
-    with pytest.raises(InputFileError, match="video empty.mp4 has no frames"):
+    with pytest.raises(InputFileError, match=r"video empty.mp4 has no frames"):
         work.result([])
 
 
 def test_run_drives_another_actor(own, clip, astronaut, tmp_path, capsys):
     code, _, err = run(capsys, "fit", str(astronaut), "--out", str(tmp_path / "eileen.actor"))
     assert code == 0, err
-    code, out, err = run(capsys, "run", str(clip), "--actor", str(tmp_path / "eileen.actor"), "--out",
-                         str(tmp_path / "o.webm"), "--track", str(tmp_path / "motion.json"), "--yaw", "15")
+    code, out, err = run(
+        capsys,
+        "run",
+        str(clip),
+        "--actor",
+        str(tmp_path / "eileen.actor"),
+        "--out",
+        str(tmp_path / "o.webm"),
+        "--track",
+        str(tmp_path / "motion.json"),
+        "--yaw",
+        "15",
+    )
     assert code == 0, err
     assert out.split() == [str(tmp_path / "o.webm"), str(tmp_path / "motion.json")]
     assert "frames/s" in err and "track" in err
@@ -124,9 +143,13 @@ def test_a_face_that_leaves_the_frame_is_marked_and_found_again(shared, tmp_path
     assert [f["face"] for f in doc["frames"]] == [True] * 20 + [False] * 10 + [True] * 14
     z = np.load(shared / "video" / "lp_d0.landmarks.npz")
     last = doc["frames"][-1]
-    brows = group_nme({k: np.array(v) for k, v in last["contours"].items()}, from_face_mesh(z["landmarks"][43]),
-                      GROUPS["brows"], float(z["iod"][43]))
-    assert brows < 0.04
+    brows = group_nme(
+        {k: np.array(v) for k, v in last["contours"].items()},
+        from_face_mesh(z["landmarks"][43]),
+        GROUPS["brows"],
+        float(z["iod"][43]),
+    )
+    assert brows < 0.01  # measured: 0.0065
 
 
 @pytest.mark.parametrize(
@@ -158,8 +181,12 @@ def test_bad_input_gives_one_line_and_leaves_nothing(clip, tmp_path, capsys, mon
         assert (tmp_path / "o.mp4").read_bytes() == b"mine"
 
 
-CORNERS = [(slice(0, 24), slice(0, 24)), (slice(0, 24), slice(-24, None)), (slice(-24, None), slice(0, 24)),
-           (slice(-24, None), slice(-24, None))]
+CORNERS = [
+    (slice(0, 24), slice(0, 24)),
+    (slice(0, 24), slice(-24, None)),
+    (slice(-24, None), slice(0, 24)),
+    (slice(-24, None), slice(-24, None)),
+]
 
 
 def test_run_synthesises_the_face_in_its_scene_and_measures_each_frame_against_it(own, clip):
@@ -177,7 +204,7 @@ def test_run_synthesises_the_face_in_its_scene_and_measures_each_frame_against_i
 
 
 def test_mask_only_shows_the_face_alone_and_measures_nothing(clip, tmp_path, capsys):
-    code, out, err = run(capsys, "run", str(clip), "--out", str(tmp_path / "m.mp4"), "--mask-only")
+    code, _out, err = run(capsys, "run", str(clip), "--out", str(tmp_path / "m.mp4"), "--mask-only")
     assert code == 0, err
     doc = json.loads((tmp_path / "m.json").read_text())
     assert len(doc["frames"]) == FRAMES and all(f["face"] for f in doc["frames"])

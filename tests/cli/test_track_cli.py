@@ -29,23 +29,37 @@ def synthetic_video(tmp_path):
 def test_track_writes_every_frame_and_an_overlay(tmp_path, capsys, synthetic_video):
     video, init = synthetic_video
     out, overlay = tmp_path / "t.json", tmp_path / "o.mp4"
-    code, stdout, err = run(capsys, "track", str(video), "--init", str(init), "--out", str(out), "--overlay", str(overlay))
+    code, stdout, err = run(
+        capsys, "track", str(video), "--init", str(init), "--out", str(out), "--overlay", str(overlay)
+    )
     assert code == 0, err
     assert stdout.split() == [str(out), str(overlay)] and "tracked 12 frames" in err
     doc = json.loads(out.read_text())
     assert doc["format"] == "facemime.track/1" and doc["video"]["frames"] == 12
     assert [f["index"] for f in doc["frames"]] == list(range(12))
-    assert all(len(f["contours"]) == 8 and set(f["confidence"]) == set(GROUPS) - {"brows"} | {"brow_left", "brow_right"}
-               for f in doc["frames"])
+    assert all(
+        len(f["contours"]) == 8 and set(f["confidence"]) == set(GROUPS) - {"brows"} | {"brow_left", "brow_right"}
+        for f in doc["frames"]
+    )
     last = {n: np.array(c) for n, c in doc["frames"][-1]["contours"].items()}
     truth = band_face(shift=(5.5, 0.0), opening=3.3)[1]
     assert max(group_nme(last, truth, names, 100.0) for names in GROUPS.values()) < 0.01
     with av.open(str(overlay)) as c:
         assert c.streams.video[0].codec_context.name == "h264"
         assert sum(1 for _ in c.decode(video=0)) == 12
-    # Running again refuses to overwrite both outputs.
+    # Running again refuses to overwrite both outputs, and leaves them as they were.
+    out.write_text("earlier")
+    overlay.write_bytes(b"earlier")
     code, _, err = run(capsys, "track", str(video), "--init", str(init), "--out", str(out), "--overlay", str(overlay))
     assert code == 1 and "already exist" in err and "--force" in err
+    assert out.read_text() == "earlier" and overlay.read_bytes() == b"earlier"
+    # With --force it overwrites both.
+    args = ["track", str(video), "--init", str(init), "--out", str(out), "--overlay", str(overlay), "--force"]
+    code, stdout, err = run(capsys, *args)
+    assert code == 0 and stdout.split() == [str(out), str(overlay)], err
+    assert json.loads(out.read_text())["video"]["frames"] == 12
+    with av.open(str(overlay)) as c:
+        assert sum(1 for _ in c.decode(video=0)) == 12
 
 
 def test_track_a_real_video_clip(tmp_path, capsys, shared):
@@ -56,9 +70,13 @@ def test_track_a_real_video_clip(tmp_path, capsys, shared):
     code, _, err = run(capsys, "track", str(clip), "--init", str(init), "--out", str(tmp_path / "t.json"))
     assert code == 0, err
     frames = json.loads((tmp_path / "t.json").read_text())["frames"]
-    errors = [group_nme(f["contours"], from_face_mesh(z["landmarks"][f["index"]]), names, float(z["iod"][f["index"]]))
-              for f in frames[1:] for names in GROUPS.values()]
-    assert np.mean(errors) < 0.04 and max(errors) < 0.1
+    errors = [
+        group_nme(f["contours"], from_face_mesh(z["landmarks"][f["index"]]), names, float(z["iod"][f["index"]]))
+        for f in frames[1:]
+        for names in GROUPS.values()
+    ]
+    # Measured: mean 0.0082, max 0.030 (thresholds at about 1.5x).
+    assert np.mean(errors) < 0.012 and max(errors) < 0.045
 
 
 @pytest.mark.parametrize(
@@ -134,6 +152,10 @@ def test_without_init_tracking_starts_on_the_first_frame_with_a_face(tmp_path, c
     assert f"facemime: warning: no face in frames 0-4 of {tmp_path / 'late.mp4'}; tracking from frame 5" in err
     frames = json.loads((tmp_path / "t.json").read_text())["frames"]
     assert [f["index"] for f in frames] == list(range(5, 15))
-    errors = [group_nme(f["contours"], from_face_mesh(z["landmarks"][f["index"]]), names, float(z["iod"][f["index"]]))
-              for f in frames for names in GROUPS.values()]
-    assert max(errors) < 0.05
+    errors = [
+        group_nme(f["contours"], from_face_mesh(z["landmarks"][f["index"]]), names, float(z["iod"][f["index"]]))
+        for f in frames
+        for names in GROUPS.values()
+    ]
+    # Measured: mean 0.013, max 0.019 (thresholds at about 1.5x).
+    assert np.mean(errors) < 0.02 and max(errors) < 0.028

@@ -14,7 +14,8 @@ from facemime.io import VideoWriter
 from facemime.io.video import VideoReader
 
 SHARED = Path(__file__).resolve().parents[3] / "shared" / "data" / "video" / "lp_d0.mp4"
-needs_shared = pytest.mark.skipif(not SHARED.exists(), reason="shared test videos not present")
+#: Skipped without the shared data, failed without it when CI is set (the ``shared`` fixture).
+needs_shared = pytest.mark.usefixtures("shared")
 
 
 def _shared_frames(count: int) -> list[np.ndarray]:
@@ -23,8 +24,9 @@ def _shared_frames(count: int) -> list[np.ndarray]:
         return [f.to_ndarray(format="rgb24")[64:448] for _, f in zip(range(count), c.decode(video=0))]
 
 
-def _encode(path: Path, frames: list[np.ndarray], fmt: str = "mp4", metadata: dict | None = None,
-            options: dict | None = None) -> None:
+def _encode(
+    path: Path, frames: list[np.ndarray], fmt: str = "mp4", metadata: dict | None = None, options: dict | None = None
+) -> None:
     """H.264 (x264 defaults) in ``fmt``, 25 fps, with ``metadata`` tags on the video stream."""
     with av.open(str(path), "w", format=fmt, options=options or {}) as out:
         stream = out.add_stream("libx264", rate=25)
@@ -44,7 +46,7 @@ def _set_track_rotation(path: Path, clockwise: int) -> None:
     assert data[at] == 0  # version 0: 32-bit times
     matrix = at + 4 + 5 * 4 + 8 + 8  # after version/flags, times, track, duration; layer .. volume
     c, s = {90: (0, 1), 180: (-1, 0), 270: (0, -1)}[clockwise]
-    data[matrix:matrix + 36] = struct.pack(">9i", c << 16, s << 16, 0, -s << 16, c << 16, 0, 0, 0, 1 << 30)
+    data[matrix : matrix + 36] = struct.pack(">9i", c << 16, s << 16, 0, -s << 16, c << 16, 0, 0, 0, 1 << 30)
     path.write_bytes(data)
 
 
@@ -103,8 +105,11 @@ def test_a_frame_rate_that_is_not_positive_and_finite_is_refused(tmp_path, fps):
 
 def _clip(path: Path, count: int) -> bytes:
     """A ``count``-frame faststart MP4 of a shared video's frames (of noise without it); its bytes."""
-    frames = _shared_frames(count) if SHARED.exists() else \
-        list(np.random.default_rng(0).integers(0, 255, (count, 384, 512, 3), np.uint8))
+    frames = (
+        _shared_frames(count)
+        if SHARED.exists()
+        else list(np.random.default_rng(0).integers(0, 255, (count, 384, 512, 3), np.uint8))
+    )
     _encode(path, frames, options={"movflags": "+faststart"})
     return path.read_bytes()
 
@@ -125,7 +130,7 @@ def test_a_stream_header_without_frames_is_refused_as_such(tmp_path):
         for i in range(5):
             out.mux(stream.encode(av.VideoFrame.from_ndarray(np.full((64, 64, 3), 40 * i, np.uint8), format="rgb24")))
         out.mux(stream.encode())
-    (tmp_path / "head.ts").write_bytes((tmp_path / "c.ts").read_bytes()[:3 * 188])
+    (tmp_path / "head.ts").write_bytes((tmp_path / "c.ts").read_bytes()[: 3 * 188])
     with pytest.raises(InputFileError, match=r"^video .*head\.ts has no decodable frames$"):
         VideoReader(tmp_path / "head.ts")
 
@@ -133,15 +138,17 @@ def test_a_stream_header_without_frames_is_refused_as_such(tmp_path):
 def test_a_truncated_video_is_read_with_a_warning(tmp_path):
     data = _clip(tmp_path / "full.mp4", 60)
     payload = data.index(b"mdat")
-    (tmp_path / "cut.mp4").write_bytes(data[:payload + (len(data) - payload) // 3])
+    (tmp_path / "cut.mp4").write_bytes(data[: payload + (len(data) - payload) // 3])
     with VideoReader(tmp_path / "full.mp4") as r:
         assert len(list(r)) == 60 and r.decoded == 60 and r.warnings == []
     with VideoReader(tmp_path / "cut.mp4") as r:
         assert r.frames == 60 and r.warnings == []
         frames = list(r)
     assert 0 < len(frames) == r.decoded < 40
-    assert r.warnings[0] == f"video {tmp_path / 'cut.mp4'} ended after {len(frames)} of the 60 frames its " \
-                            "container declares (a truncated file?)"
+    assert (
+        r.warnings[0] == f"video {tmp_path / 'cut.mp4'} ended after {len(frames)} of the 60 frames its "
+        "container declares (a truncated file?)"
+    )
     assert all("\n" not in w for w in r.warnings)
 
 

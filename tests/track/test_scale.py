@@ -11,8 +11,9 @@ from facemime.track.contours import GROUPS, from_face_mesh
 from facemime.track.scale import FrameScale
 
 
-@pytest.mark.parametrize("size, face, work, tol", [((400, 300), 400.0, (200, 150), 1e-9),
-                                                  ((1023, 1024), 470.0, (435, 436), 0.15)])
+@pytest.mark.parametrize(
+    "size, face, work, tol", [((400, 300), 400.0, (200, 150), 1e-9), ((1023, 1024), 470.0, (435, 436), 0.15)]
+)
 def test_points_map_to_where_the_resized_frame_shows_them(size, face, work, tol):
     scale = FrameScale(*size, face_width=face, limit=200.0)
     assert scale.active and scale.work == work
@@ -59,8 +60,8 @@ def track_errors(enlarged, params):
 
 def test_a_large_face_tracks_as_well_as_at_the_size_the_settings_were_tuned_on(enlarged):
     errors, lost, tracker = track_errors(enlarged, TrackerParams())
-    # Measured: mean 0.014, max 0.033 (lp_d3 at its own size: mean 0.016).
-    assert errors.mean() < 0.025 and errors.max() < 0.05 and lost == 0
+    # Measured: mean 0.014, max 0.033 (lp_d3 at its own size: mean 0.016); thresholds at 1.5x.
+    assert errors.mean() < 0.021 and errors.max() < 0.05 and lost == 0
     # The head's rigid points (nose and forehead) come back in the frame's pixels: centred
     # between the brows (measured: 0.07 IOD off; in the shrunk frame's pixels 0.63 IOD), above
     # the mouth and below the brows' height above them.

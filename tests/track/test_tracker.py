@@ -13,8 +13,11 @@ from facemime.track.synthetic import band_face
 def sequence(steps, **per_step):
     """Frames t = 1..steps of a face moving by per_step * t, with noise."""
     for t in range(1, steps + 1):
-        yield band_face(noise=2.0, seed=t, **{k: tuple(x * t for x in v) if isinstance(v, tuple) else v * t
-                                                for k, v in per_step.items()})
+        yield band_face(
+            noise=2.0,
+            seed=t,
+            **{k: tuple(x * t for x in v) if isinstance(v, tuple) else v * t for k, v in per_step.items()},
+        )
 
 
 def test_follows_a_translated_bent_and_opening_face_within_half_a_pixel():
@@ -34,8 +37,11 @@ def test_follows_a_translated_bent_and_opening_face_within_half_a_pixel():
 def lip_thickness(contours):
     """Thickness of the upper and of the lower lip and the mouth opening at the middle (px)."""
     y = {n: c[len(c) // 2, 1] for n, c in contours.items() if n.startswith("mouth")}
-    return (y["mouth_inner_upper"] - y["mouth_outer_upper"], y["mouth_outer_lower"] - y["mouth_inner_lower"],
-            y["mouth_inner_lower"] - y["mouth_inner_upper"])
+    return (
+        y["mouth_inner_upper"] - y["mouth_outer_upper"],
+        y["mouth_outer_lower"] - y["mouth_inner_lower"],
+        y["mouth_inner_lower"] - y["mouth_inner_upper"],
+    )
 
 
 @pytest.mark.parametrize("repulsion", [True, False])
@@ -48,7 +54,9 @@ def test_repulsion_keeps_thinning_lips_from_merging_onto_one_edge(repulsion):
     start_upper, start_lower, _ = lip_thickness(truth0)
     tracker = Tracker(frame0, truth0, params)
     for t in range(1, 17):
-        upper, lower, opening = lip_thickness(tracker.update(band_face(opening=6.0, lips=1.0 - 0.05 * t, noise=2.0, seed=t)[0]).contours)
+        upper, lower, opening = lip_thickness(
+            tracker.update(band_face(opening=6.0, lips=1.0 - 0.05 * t, noise=2.0, seed=t)[0]).contours
+        )
     if repulsion:
         assert upper >= 0.5 * start_upper - 0.5 and lower >= 0.5 * start_lower - 0.5 and opening > -0.5
     else:
@@ -62,8 +70,15 @@ def test_no_coordinate_moves_more_than_the_solver_bound_per_pass_in_a_frame(mout
     # A brow that this fast motion loses jumps back to its rest shape instead (not a pass); the
     # wide searches for a brow, a mouth or an inner mouth lost, which are not solver passes
     # either, are off.
-    params = TrackerParams(motion=False, delta0=1.0, sigma=0.6, mouth_passes=mouth_passes, brow_search=0.0,
-                           mouth_relocate=0, inner_search=0)
+    params = TrackerParams(
+        motion=False,
+        delta0=1.0,
+        sigma=0.6,
+        mouth_passes=mouth_passes,
+        brow_search=0.0,
+        mouth_relocate=0,
+        inner_search=0,
+    )
     bound = params.delta0 / (1.0 - params.sigma)
     frame0, truth0 = band_face()
     tracker = Tracker(frame0, truth0, params)
@@ -131,6 +146,7 @@ def test_editing_a_result_does_not_change_the_track():
         for name in CONTOUR_NAMES:
             np.testing.assert_array_equal(got[name], want[name])
             got[name] += 40.0  # a caller drawing or smoothing in place
+
 
 def test_a_lost_inner_mouth_is_looked_for_up_and_down_the_face():
     # The line where thick lips meet drops 20 px in the middle within a frame, more than a
@@ -201,6 +217,13 @@ def test_bad_frames_are_refused():
         Tracker(frame0, truth0, TrackerParams(operator="laplace"))
 
 
+#: Per group, the mean and the largest NME allowed on either video: about 1.5x the measured
+#: values (mean, max; vr_2 / lp_d0): mouth outer 0.0145 / 0.0155, 0.042 / 0.035; mouth inner
+#: 0.0179 / 0.0174, 0.056 / 0.033 (its max kept at the earlier 0.06); brows 0.0054 / 0.0053,
+#: 0.0080 / 0.0081.
+LIMITS = {"mouth_outer": (0.023, 0.06), "mouth_inner": (0.027, 0.06), "brows": (0.008, 0.012)}
+
+
 @pytest.mark.parametrize(("name", "count"), [("vr_2", 40), ("lp_d0", 78)])
 def test_tracks_a_real_talking_face(shared, name, count):
     # lp_d0 opens her mouth wide and closes it again: with a rest shape that could not change
@@ -216,9 +239,12 @@ def test_tracks_a_real_talking_face(shared, name, count):
     for i in range(1, len(frames)):
         result = tracker.update(frames[i])
         for g, names in GROUPS.items():
-            errors[g].append(group_nme(result.contours, reference_contours(z["landmarks"][i]), names, float(z["iod"][i])))
+            errors[g].append(
+                group_nme(result.contours, reference_contours(z["landmarks"][i]), names, float(z["iod"][i]))
+            )
     for g, e in errors.items():
-        assert np.mean(e) < 0.03 and max(e) < 0.06, g
+        mean, most = LIMITS[g]
+        assert np.mean(e) < mean and max(e) < most, (g, np.mean(e), max(e))
 
 
 @pytest.mark.parametrize("fast", [0.0, 1e9])
@@ -230,15 +256,27 @@ def test_the_frame_call_solves_as_building_the_field_and_solving_pass_by_pass(fa
     tracker = Tracker(frame0, truth0)
     frame = band_face(noise=2.0, seed=5, shift=(1.5, 1.0), opening=1.5)[0]
     t, p = tracker, tracker.params
-    start, rest, down, targets = t._knots + [1.0, -0.5], t._knots0, t._down0, t._targets0  # noqa: SLF001
-    knots, iters, resp = t._solver.track(frame, None, start, rest, tuple(down), targets, (t.width, t.height),  # noqa: SLF001
-                                         p.smoothing, t._frame_bands, t._mouth_uintp, t._mouth_curves,  # noqa: SLF001
-                                         p.mouth_passes, fast)
-    field = t._field(frame, start)  # noqa: SLF001
-    want, want_iters, want_resp = t._solve(field, start, rest, down, targets)  # noqa: SLF001
+    start, rest, down, targets = t._knots + [1.0, -0.5], t._knots0, t._down0, t._targets0
+    knots, iters, resp = t._solver.track(
+        frame,
+        None,
+        start,
+        rest,
+        tuple(down),
+        targets,
+        (t.width, t.height),
+        p.smoothing,
+        t._frame_bands,
+        t._mouth_uintp,
+        t._mouth_curves,
+        p.mouth_passes,
+        fast,
+    )
+    field = t._field(frame, start)
+    want, want_iters, want_resp = t._solve(field, start, rest, down, targets)
     if fast == 0.0:
-        mouth, curves = t._mouth_knots, t._mouth_curves  # noqa: SLF001
-        again, more, again_resp = t._solve(field, want.copy(), rest, down, targets, curves)  # noqa: SLF001
+        mouth, curves = t._mouth_knots, t._mouth_curves
+        again, more, again_resp = t._solve(field, want.copy(), rest, down, targets, curves)
         want[mouth], want_resp[curves], want_iters = again[mouth], again_resp[curves], want_iters + more
     np.testing.assert_array_equal(knots, want)
     np.testing.assert_array_equal(resp, want_resp)

@@ -383,6 +383,10 @@ mod tests {
     #[test]
     fn avx2_kernels_equal_the_portable_ones_bit_for_bit() {
         if !has_avx2_fma() {
+            crate::cpu::simd_missing(
+                "avx2_kernels_equal_the_portable_ones_bit_for_bit",
+                "AVX2 and FMA",
+            );
             return;
         }
         for win in [5, 15, 21] {

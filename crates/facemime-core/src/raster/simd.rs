@@ -346,7 +346,12 @@ mod tests {
             v,
         });
         if !unsafe { bilinear_spans::<C>(&tex, du, dv, &spans, &mut out, kernel) } {
-            return; // no SIMD here
+            // No SIMD here: `this_cpu_runs_the_simd_spans` says so once.
+            assert!(
+                !std::arch::is_x86_feature_detected!("avx2"),
+                "no SIMD spans though the CPU has AVX2"
+            );
+            return;
         }
         for guard in [0, n + 1, 2 * n + 2] {
             assert!(
@@ -360,6 +365,22 @@ mod tests {
                 let at = s.at + k * C;
                 assert_eq!(&out[at..at + C], &want[..], "pixel {k} of {n}");
             }
+        }
+    }
+
+    /// The proptest below checks only the kernels this CPU has: say which it could not check
+    /// (or fail, with FACEMIME_REQUIRE_SIMD set).
+    #[test]
+    fn this_cpu_runs_the_simd_spans() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            crate::cpu::simd_missing("simd_spans_match_scalar_lookups", "AVX2");
+        } else if !(std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512bw"))
+        {
+            crate::cpu::simd_missing(
+                "simd_spans_match_scalar_lookups (its AVX-512 kernel)",
+                "AVX-512 BW",
+            );
         }
     }
 
