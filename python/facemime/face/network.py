@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from functools import cache
 from importlib import resources
+from typing import Any
 
 import cv2
 
@@ -24,9 +25,10 @@ def load_network(name: str) -> cv2.dnn.Net:
             raise FacemimeError(f"the face model {name} is missing from the installed package; reinstall facemime")
         try:
             if hasattr(cv2.dnn, "ENGINE_CLASSIC"):
-                # OpenCV 5's new engine gives only one of each model's two outputs (5.0.0)
-                # (OpenCV 4's annotations, which mypy reads, lack the argument)
-                return cv2.dnn.readNetFromTFLite(str(path), engine=cv2.dnn.ENGINE_CLASSIC)  # type: ignore[call-overload]
+                # OpenCV 5's new engine gives only one of each model's two outputs (5.0.0); called
+                # through Any, as OpenCV 4's annotations lack the argument and OpenCV 5's have it
+                dnn: Any = cv2.dnn
+                return dnn.readNetFromTFLite(str(path), engine=cv2.dnn.ENGINE_CLASSIC)
             return cv2.dnn.readNetFromTFLite(str(path))
         except cv2.error as e:
             raise FacemimeError(
