@@ -9,13 +9,17 @@ from facemime.animate.look import Look
 from facemime.errors import InputFileError
 from facemime.io.contours_json import (
     ContourFileError,
+    TrackWriter,
     init_document,
     read_init,
     read_motion,
     read_track,
     track_document,
+    track_entry,
     write_json,
 )
+from facemime.io.outputs import OutputFileError
+from facemime.track.contours import CONTOUR_NAMES
 from facemime.track.synthetic import band_face
 
 
@@ -37,6 +41,63 @@ def test_track_json_round_trips(tmp_path):
     assert doc["frames"][1]["lost"] == ["brow_left"] and doc["frames"][1]["confidence"] == {"mouth_outer": 0.5}
 
 
+def test_the_streaming_writer_writes_what_track_document_makes(tmp_path):
+    _, contours = band_face(shift=(0.123456, -7.5))
+    frames = [
+        {"index": i, "contours": contours, "pose": {"yaw": 0.1 * i}, "offsets": np.full((3, 2), 0.5 * i)}
+        for i in range(3)
+    ]
+    video = {"width": 256, "height": 256, "fps": 25.0, "frames": 3, "path": "not kept"}
+    timing, model = {"fps": 10.0}, {"unit": "mm", "knots": [1, 2, 3]}
+    for count in (0, 1, 3):
+        with TrackWriter(tmp_path / "w.json") as writer:
+            for f in frames[:count]:
+                writer.append(f)
+            writer.close(video, timing, model, extra={"note": 1})
+        assert writer.frames == count
+        expected = {**track_document(video, frames[:count], timing, model), "note": 1}
+        assert expected["timing"] == timing and expected["model"] == model
+        assert json.loads((tmp_path / "w.json").read_text()) == json.loads(json.dumps(expected))
+    with pytest.raises(OutputFileError, match=f"cannot write {tmp_path}"):
+        TrackWriter(tmp_path)
+
+
+def test_a_track_entry_keeps_every_field_under_its_name_rounded_as_the_format_says():
+    line = np.array([[1.23456, 2.0], [3.0, 4.98765]])
+    entry = track_entry(
+        {
+            "index": np.int64(4),
+            "contours": {"mouth_outer_upper": line},
+            "confidence": {"mouth": np.float64(0.123456)},
+            "lost": ("brow_left",),
+            "redetected": 1,
+            "face": 0,
+            "pose": {"yaw": 0.123456},
+            "offsets": line,
+            "look": {"eye_left_closure": 0.987654},
+            "weights": {"smile": 0.333333},
+            "scene_departure": 0.55556,
+            "scene_departs": 1,
+        }
+    )
+    rounded = [[1.235, 2.0], [3.0, 4.988]]
+    assert json.loads(json.dumps(entry)) == {
+        "index": 4,
+        "contours": {"mouth_outer_upper": rounded},
+        "confidence": {"mouth": 0.1235},
+        "lost": ["brow_left"],
+        "redetected": True,
+        "face": False,
+        "pose": {"yaw": 0.1235},
+        "offsets": rounded,
+        "look": {"eye_left_closure": 0.9877},
+        "weights": {"smile": 0.3333},
+        "scene_departure": 0.5556,
+        "scene_departs": True,
+    }
+    assert init_document(2, dict.fromkeys(CONTOUR_NAMES, line))["contours"]["brow_left_lower"] == rounded
+
+
 def test_init_json_round_trips(tmp_path):
     _, contours = band_face()
     path = write_json(tmp_path / "i.json", init_document(4, contours))
@@ -49,33 +110,105 @@ def test_init_json_round_trips(tmp_path):
     ("text", "message"),
     [
         ("{", "not valid JSON: Expecting property name"),
-        ('{"format": "facemime.track/1"}', "expected format 'facemime.init/1'"),
+        ('{"format": "facemime.track/1"}', "expected format 'facemime.init/1', found 'facemime.track/1'"),
         ('{"format": "facemime.init/1", "frame": -1, "contours": {}}', "'frame' must be a non-negative integer"),
         ('{"format": "facemime.init/1", "contours": []}', "'contours' must be an object"),
-        ("INCOMPLETE", "missing contour brow_right_lower"),
+        ("INCOMPLETE", "missing contour brow_left_lower, brow_right_lower"),
         ("OUTSIDE", "point (300, 5) is outside the 256x256 image"),
         ("SHORT", "must have at least 2 [x, y] points"),
+        ("TRIPLES", "must have at least 2 [x, y] points"),
+        ("WORDS", "contour brow_left_upper must be a list of [x, y] numbers"),
+        ("INFINITE", "contour brow_left_upper has a non-finite coordinate"),
+        ('{"format": "facemime.init/1", "frame": true, "contours": {}}', "'frame' must be a non-negative integer"),
+        ("[1, 2]", "expected format 'facemime.init/1', found 'list'"),
+        (b"\xff\xfe{}", "is not a JSON text file"),
+        ("[" * 50_000 + "]" * 50_000, "is nested too deeply"),
     ],
 )
 def test_bad_init_files_give_one_line(tmp_path, text, message):
     _, contours = band_face()
     doc = init_document(0, contours)
     if text == "INCOMPLETE":
-        del doc["contours"]["brow_right_lower"]
+        del doc["contours"]["brow_right_lower"], doc["contours"]["brow_left_lower"]
     elif text == "OUTSIDE":
         doc["contours"]["mouth_outer_lower"][3] = [300, 5]
     elif text == "SHORT":
         doc["contours"]["brow_left_upper"] = [[1, 2]]
+    elif text == "TRIPLES":
+        doc["contours"]["brow_left_upper"] = [[1, 2, 3], [4, 5, 6]]
+    elif text == "WORDS":
+        doc["contours"]["brow_left_upper"] = [["a", "b"], ["c", "d"]]
+    elif text == "INFINITE":
+        doc["contours"]["brow_left_upper"][1] = [1e999, 5]
     path = tmp_path / "bad.json"
-    path.write_text(json.dumps(doc) if text in ("INCOMPLETE", "OUTSIDE", "SHORT") else text)
+    if isinstance(text, bytes):
+        path.write_bytes(text)
+    else:
+        path.write_text(json.dumps(doc) if text.isupper() else text)
     with pytest.raises(ContourFileError, match=None) as err:
         read_init(path, size=(256, 256))
-    assert message in str(err.value) and "\n" not in str(err.value)
+    # One line, naming the file (the message is all the user sees).
+    assert message in str(err.value) and str(path) in str(err.value) and "\n" not in str(err.value)
 
 
-def test_missing_init_file(tmp_path):
-    with pytest.raises(InputFileError, match="does not exist"):
-        read_init(tmp_path / "nope.json")
+def test_points_on_the_image_edge_are_inside_and_beyond_it_outside(tmp_path):
+    # Pixel centres run 0..w-1, so the image spans [-0.5, w - 0.5] x [-0.5, h - 0.5].
+    _, contours = band_face()
+    doc = init_document(0, contours)
+    path = tmp_path / "i.json"
+    for corner in ([-0.5, -0.5], [255.5, 255.5]):
+        doc["contours"]["mouth_outer_lower"][3] = corner
+        path.write_text(json.dumps(doc))
+        read_init(path, size=(256, 256))
+    for point in ([-0.6, 5], [255.6, 5], [5, -0.6], [5, 255.6]):
+        doc["contours"]["mouth_outer_lower"][3] = point
+        path.write_text(json.dumps(doc))
+        with pytest.raises(ContourFileError, match="is outside the 256x256 image"):
+            read_init(path, size=(256, 256))
+
+
+def test_init_frame_defaults_to_zero_and_two_points_make_a_contour(tmp_path):
+    _, contours = band_face()
+    doc = init_document(3, contours)
+    del doc["frame"]
+    doc["contours"]["brow_left_upper"] = [[10, 20], [30, 20]]
+    path = tmp_path / "i.json"
+    path.write_text(json.dumps(doc))
+    frame, back = read_init(path)
+    assert frame == 0 and back["brow_left_upper"].shape == (2, 2)
+
+
+def test_a_track_frame_may_hold_some_contours_and_the_video_may_be_absent(tmp_path):
+    path = tmp_path / "t.json"
+    path.write_text(
+        json.dumps({"format": "facemime.track/1", "frames": [{"index": 5, "contours": {"x": [[1, 2]] * 2}}]})
+    )
+    video, frames = read_track(path)
+    assert video == {} and list(frames) == [5] and list(frames[5]) == ["x"]
+
+
+@pytest.mark.parametrize(
+    ("frames", "message"),
+    [
+        ({}, "'frames' must be a list"),
+        ([[1]], "frame entry 0 must be an object with an integer 'index'"),
+        ([{"index": 0, "contours": {}}, {"index": "1"}], "frame entry 1 must be an object with an integer 'index'"),
+        ([{"index": 7, "contours": {"x": [[1, 2]]}}], "frame 7: contour x must have at least 2 [x, y] points"),
+    ],
+)
+def test_bad_track_files_give_one_line_naming_the_file(tmp_path, frames, message):
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps({"format": "facemime.track/1", "frames": frames}))
+    with pytest.raises(ContourFileError) as err:
+        read_track(path)
+    assert str(err.value).startswith(str(path)) and message in str(err.value) and "\n" not in str(err.value)
+
+
+def test_a_missing_file_is_named_with_its_kind(tmp_path):
+    for read, kind in ((read_init, "init"), (read_track, "track"), (read_motion, "track")):
+        with pytest.raises(InputFileError) as err:
+            read(tmp_path / "nope.json")
+        assert str(err.value) == f"{kind} file {tmp_path / 'nope.json'} does not exist"
 
 
 def _motion_file(tmp_path, look):
@@ -117,3 +250,52 @@ def test_the_look_is_read_back_and_a_file_without_it_plays_neutral(tmp_path):
 def test_a_bad_look_is_refused_in_one_line(tmp_path, look, message):
     with pytest.raises(ContourFileError, match=message):
         read_motion(_motion_file(tmp_path, look))
+
+
+def test_motion_frames_default_their_index_face_and_lost(tmp_path):
+    path = _motion_file(tmp_path, None)
+    doc = json.loads(path.read_text())
+    del doc["video"]
+    doc["frames"].append({k: v for k, v in doc["frames"][0].items() if k != "index"})
+    doc["frames"][0].update(index=5, face=False, lost=["mouth"])
+    doc["frames"][1]["pose"] = {**doc["frames"][1]["pose"], "scale": 0.5}
+    path.write_text(json.dumps(doc))
+    video, model, frames = read_motion(path)
+    assert video == {} and model["knots"] == [1, 2, 3]
+    assert [(f["index"], f["face"], f["lost"]) for f in frames] == [(5, False, ["mouth"]), (1, True, [])]
+    assert frames[1]["pose"]["scale"] == 0.5 and frames[0]["offsets"].shape == (3, 2)
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"model": None}, "has no head motion"),
+        ({"model": {"knots": 3, "feature_sizes": [1, 1, 1]}}, "has no head motion"),
+        ({"model": {"knots": [1, 2, 3]}}, "has no head motion"),
+        ({"frames": []}, "'frames' must be a non-empty list"),
+        ({"frames": {}}, "'frames' must be a non-empty list"),
+        ({"frames": [[1]]}, "frame entry 0 needs a 'pose'"),
+        ({"pose": {"yaw": 0}}, "frame entry 0 needs a 'pose' with yaw, pitch, roll, scale, tx, ty and 'offsets'"),
+        ({"offsets": [[0.0, 0.0]] * 2}, "frame entry 0 has malformed 'offsets' or 'pose'"),
+        ({"offsets": [[0.0, 0.0], [0.0, 1e999], [0.0, 0.0]]}, "frame entry 0 has malformed 'offsets' or 'pose'"),
+        ({"scale": 0.0}, "frame entry 0 has malformed 'offsets' or 'pose'"),
+        ({"yaw": 1e999}, "frame entry 0 has malformed 'offsets' or 'pose'"),
+        ({"lost": "mouth"}, "frame entry 0: 'lost' must be a list of feature names"),
+        ({"lost": [1]}, "frame entry 0: 'lost' must be a list of feature names"),
+    ],
+)
+def test_bad_motion_files_give_one_line_naming_the_file(tmp_path, change, message):
+    path = _motion_file(tmp_path, None)
+    doc = json.loads(path.read_text())
+    frame = doc["frames"][0]
+    for key, value in change.items():
+        if key in ("model", "frames"):
+            doc[key] = value
+        elif key in ("scale", "yaw"):
+            frame["pose"][key] = value
+        else:
+            frame[key] = value
+    path.write_text(json.dumps(doc))
+    with pytest.raises(ContourFileError) as err:
+        read_motion(path)
+    assert str(err.value).startswith(f"{path}: ") and message in str(err.value) and "\n" not in str(err.value)

@@ -279,6 +279,34 @@ mod tests {
         }
     }
 
+    /// The weights of eq. 13 and 14 as written: E2 = m·β/(n·Δ²)·Σ|bend|², Et = τ/((m+1)·Δ²)·Σ|K − S|².
+    #[test]
+    fn bending_and_temporal_energies_have_the_papers_weights() {
+        let knots: Vec<P2> = vec![[0.0, 0.0], [2.0, 1.0], [4.0, 0.0]];
+        let start: Vec<P2> = knots.iter().map(|k| [k[0] + 0.5, k[1]]).collect();
+        let (idx, rest) = (vec![0, 1, 2], vec![[0.0; 2]; 3]);
+        let mut g = vec![[0.0; 2]; 3];
+        // m = 2, n = 4, Δ² = 16, |bend of K_1|² = |(0, 2)|² = 4: E2 = 2·8/(4·16)·4 = 1.
+        let e2 = internal(
+            &idx,
+            &knots,
+            &rest,
+            &knots,
+            &params(0.0, 8.0),
+            4,
+            16.0,
+            &mut g,
+        );
+        assert!((e2 - 1.0).abs() < 1e-12, "E2={e2}");
+        // Σ|K − S|² = 3·0.25: Et = 64/(3·16)·0.75 = 1.
+        let p = CurveParams {
+            tau: 64.0,
+            ..params(0.0, 0.0)
+        };
+        let et = internal(&idx, &knots, &rest, &start, &p, 4, 16.0, &mut g);
+        assert!((et - 1.0).abs() < 1e-12, "Et={et}");
+    }
+
     /// The analytic gradient of the internal energies matches finite differences.
     #[test]
     fn internal_gradient_matches_finite_differences() {
@@ -308,6 +336,185 @@ mod tests {
                     g[k][c]
                 );
             }
+        }
+    }
+
+    /// A 16x16 field whose channels are bilinear in (x, y), which bilinear sampling reproduces
+    /// exactly: the image terms can be computed here by hand at any point.
+    fn planes() -> (Vec<f32>, impl Fn(f64, f64) -> [f64; FIELD_CHANNELS]) {
+        let at = |x: f64, y: f64| {
+            [
+                1.0 + 0.1 * x + 0.02 * y,
+                0.5 - 0.03 * x + 0.05 * y,
+                0.2 + 0.04 * y,
+                -0.3 + 0.02 * x,
+                0.3 * x + 0.2 * y + 0.01 * x * y,
+                0.25 * x - 0.1 * y,
+            ]
+        };
+        let mut d = vec![0.0f32; 16 * 16 * FIELD_CHANNELS];
+        for y in 0..16 {
+            for x in 0..16 {
+                let v = at(x as f64, y as f64);
+                for c in 0..FIELD_CHANNELS {
+                    d[(y * 16 + x) * FIELD_CHANNELS + c] = v[c] as f32;
+                }
+            }
+        }
+        (d, at)
+    }
+
+    /// −(Ec + Ev) and the mean H are the means over the m·n+1 curve points of eq. 15 and 16,
+    /// with the normal of each segment turned +90° from its direction.
+    #[test]
+    fn image_energy_is_minus_the_weighted_means_of_h_and_the_temporal_term() {
+        let (data, at) = planes();
+        let field = Field::new(&data, 16, 16, [0.0, 0.0]).unwrap();
+        let knots: Vec<P2> = vec![[2.3, 3.1], [6.7, 4.2], [9.1, 8.6], [12.4, 9.3]];
+        let idx: Vec<usize> = (0..4).collect();
+        let n = 3;
+        // gamma = 0 samples only the derivative channels (the temporal term is off).
+        for (operator, luma, chroma, gamma) in [
+            (Operator::Directional, 1.5, -0.7, 3.0),
+            (Operator::Magnitude, 1.5, 0.7, 3.0),
+            (Operator::Directional, 1.5, -0.7, 0.0),
+        ] {
+            let p = CurveParams {
+                rho: 2.0,
+                gamma,
+                luma,
+                chroma,
+                operator,
+                ..params(0.0, 0.0)
+            };
+            let (mut sum_h, mut sum_v, mut count) = (0.0, 0.0, 0.0);
+            for seg in 0..3 {
+                let (a, b) = (knots[seg], knots[seg + 1]);
+                let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+                let nrm = [-(b[1] - a[1]) / len, (b[0] - a[0]) / len];
+                let points = if seg == 2 { n + 1 } else { n };
+                for s in 0..points {
+                    let t = s as f64 / n as f64;
+                    let v = at(a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]));
+                    sum_h += match operator {
+                        Operator::Directional => {
+                            luma * (nrm[0] * v[LX] + nrm[1] * v[LY])
+                                + chroma * (nrm[0] * v[CX] + nrm[1] * v[CY])
+                        }
+                        Operator::Magnitude => {
+                            luma * v[LX].hypot(v[LY]) + chroma * v[CX].hypot(v[CY])
+                        }
+                    };
+                    sum_v += (v[L] - v[LPREV]).powi(2);
+                    count += 1.0;
+                }
+            }
+            assert_eq!(count, 10.0);
+            let mut g = vec![[0.0; 2]; 4];
+            let (e, mean_h) = image(&idx, &knots, &field, &p, n, [0.0, 1.0], &mut g);
+            let want = -(2.0 * sum_h + gamma * sum_v) / count;
+            assert!(
+                (e - want).abs() < 1e-4 * (1.0 + want.abs()),
+                "{operator:?}: E={e} vs {want}"
+            );
+            assert!(
+                (mean_h - sum_h / count).abs() < 1e-5,
+                "{operator:?}: mean H={mean_h}"
+            );
+        }
+    }
+
+    /// With the gradient-magnitude operator (no normal to hold fixed) the analytic gradient of the
+    /// image energies matches finite differences.
+    #[test]
+    fn image_gradient_matches_finite_differences() {
+        let (data, _) = planes();
+        let field = Field::new(&data, 16, 16, [0.0, 0.0]).unwrap();
+        let knots: Vec<P2> = vec![[2.3, 3.1], [6.7, 4.2], [9.1, 8.6], [12.4, 9.3]];
+        let idx: Vec<usize> = (0..4).collect();
+        let p = CurveParams {
+            rho: 2.0,
+            gamma: 3.0,
+            luma: 1.5,
+            chroma: 0.7,
+            operator: Operator::Magnitude,
+            ..params(0.0, 0.0)
+        };
+        let mut g = vec![[0.0; 2]; 4];
+        image(&idx, &knots, &field, &p, 3, [0.0, 1.0], &mut g);
+        for k in 0..4 {
+            for c in 0..2 {
+                let mut plus = knots.clone();
+                let mut minus = knots.clone();
+                plus[k][c] += 1e-3;
+                minus[k][c] -= 1e-3;
+                let mut scratch = vec![[0.0; 2]; 4];
+                let ep = image(&idx, &plus, &field, &p, 3, [0.0, 1.0], &mut scratch).0;
+                let em = image(&idx, &minus, &field, &p, 3, [0.0, 1.0], &mut scratch).0;
+                let fd = (ep - em) / 2e-3;
+                assert!(
+                    (fd - g[k][c]).abs() < 1e-3 * (1.0 + fd.abs()),
+                    "knot {k} coord {c}: {fd} vs {}",
+                    g[k][c]
+                );
+            }
+        }
+    }
+
+    /// At one point, with the normal held fixed, the gradients of H (either operator) and of
+    /// (L − L')² match finite differences.
+    #[test]
+    fn point_gradients_match_finite_differences() {
+        let (data, _) = planes();
+        let field = Field::new(&data, 16, 16, [0.0, 0.0]).unwrap();
+        let nrm = [0.6, -0.8];
+        for operator in [Operator::Directional, Operator::Magnitude] {
+            let p = CurveParams {
+                gamma: 1.0,
+                luma: 1.5,
+                chroma: -0.7,
+                operator,
+                ..params(0.0, 0.0)
+            };
+            let (x, y) = (7.3, 5.6);
+            let (_, gh, _, gv) = point_terms(&field, x, y, nrm, &p);
+            for c in 0..2 {
+                let e = 1e-3;
+                let (dx, dy) = if c == 0 { (e, 0.0) } else { (0.0, e) };
+                let (hp, _, vp, _) = point_terms(&field, x + dx, y + dy, nrm, &p);
+                let (hm, _, vm, _) = point_terms(&field, x - dx, y - dy, nrm, &p);
+                let (fh, fv) = ((hp - hm) / (2.0 * e), (vp - vm) / (2.0 * e));
+                assert!(
+                    (fh - gh[c]).abs() < 1e-3 * (1.0 + fh.abs()),
+                    "{operator:?} H {c}: {fh} vs {}",
+                    gh[c]
+                );
+                assert!(
+                    (fv - gv[c]).abs() < 1e-3 * (1.0 + fv.abs()),
+                    "{operator:?} V {c}: {fv} vs {}",
+                    gv[c]
+                );
+            }
+        }
+    }
+
+    /// Keep holds the gap g = down·(K_b − K_a) at its target from either side: E = w·(target − g)².
+    #[test]
+    fn keep_holds_the_gap_along_down() {
+        let spec = PairSpec {
+            a: 0,
+            b: 1,
+            kind: PairKind::Keep,
+            weight: 2.0,
+        };
+        let down = [0.6, 0.8];
+        // g = 0.6·1 + 0.8·5 = 4.6, target 3: r = −1.6, E = 2·2.56, dE/dK_b = −2·w·r·down.
+        let mut g = vec![[0.0; 2]; 2];
+        let e = pair(&spec, 3.0, &[[0.0, 0.0], [1.0, 5.0]], down, &mut g);
+        assert!((e - 5.12).abs() < 1e-12, "E={e}");
+        let want = [6.4 * 0.6, 6.4 * 0.8];
+        for c in 0..2 {
+            assert!((g[1][c] - want[c]).abs() < 1e-12 && (g[0][c] + want[c]).abs() < 1e-12);
         }
     }
 
