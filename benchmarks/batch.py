@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import logging
 import os
 import platform
 import resource
@@ -43,18 +42,9 @@ def machine() -> str:
 
 def cluster(workers: int):
     """A local cluster as ``facemime batch`` starts it (one thread a worker, pools pinned to one)."""
-    from distributed import LocalCluster
+    from facemime.batch.cluster import local_cluster
 
-    from facemime.batch.worker import THREAD_VARIABLES
-
-    return LocalCluster(
-        n_workers=workers,
-        threads_per_worker=1,
-        processes=True,
-        dashboard_address=":0",
-        silence_logs=logging.ERROR,
-        env=dict.fromkeys(THREAD_VARIABLES, "1"),
-    )
+    return local_cluster(workers)
 
 
 def warm(client) -> None:

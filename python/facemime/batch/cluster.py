@@ -8,9 +8,13 @@ import re
 from collections.abc import Iterator
 from contextlib import contextmanager
 from importlib.util import find_spec
+from typing import TYPE_CHECKING
 
 from facemime.batch.worker import THREAD_VARIABLES
 from facemime.errors import FacemimeError, InvalidInputError
+
+if TYPE_CHECKING:
+    from distributed import LocalCluster
 
 #: Seconds to wait for an existing scheduler to answer.
 CONNECT_SECONDS = 5
@@ -28,6 +32,21 @@ def check_address(address: str) -> None:
         raise InvalidInputError(f"the scheduler address must look like tcp://HOST:PORT, got {address!r}")
 
 
+def local_cluster(jobs: int) -> LocalCluster:
+    """A new ``distributed.LocalCluster`` of ``jobs`` worker processes, one thread each, their
+    BLAS/OpenMP pools set to one thread, logs below errors silenced, the dashboard on a free port."""
+    from distributed import LocalCluster
+
+    return LocalCluster(
+        n_workers=jobs,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=":0",
+        silence_logs=logging.ERROR,
+        env=dict.fromkeys(THREAD_VARIABLES, "1"),
+    )
+
+
 @contextmanager
 def open_client(jobs: int, scheduler: str | None = None, retries: int = 2) -> Iterator[object]:
     """A ``distributed.Client``: on a new local cluster of ``jobs`` worker processes, each with
@@ -36,7 +55,7 @@ def open_client(jobs: int, scheduler: str | None = None, retries: int = 2) -> It
     ``scheduler`` (its own setting of retries applies). Logs below errors are silenced; the
     dashboard is served only when bokeh is installed."""
     import dask
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
     if scheduler is not None:
         check_address(scheduler)
@@ -53,14 +72,7 @@ def open_client(jobs: int, scheduler: str | None = None, retries: int = 2) -> It
                 yield client
             return
         try:  # the scheduler's web server (the dashboard with bokeh) on a free port
-            cluster = LocalCluster(
-                n_workers=jobs,
-                threads_per_worker=1,
-                processes=True,
-                dashboard_address=":0",
-                silence_logs=logging.ERROR,
-                env=dict.fromkeys(THREAD_VARIABLES, "1"),
-            )
+            cluster = local_cluster(jobs)
         except (OSError, TimeoutError) as e:
             raise ClusterError(f"cannot start a local Dask cluster: {' '.join(str(e).split())}") from None
         with cluster, Client(cluster) as client:
