@@ -11,7 +11,7 @@ import threading
 from pathlib import Path
 from typing import BinaryIO
 
-from facemime.call.sender import KEYFRAME, PACKET_FRAMES, RATE, WARMUP, CameraSource, Sender, open_source
+from facemime.call.sender import KEYFRAME, PACKET_FRAMES, RATE, WARMUP, Sender, open_source
 from facemime.call.server import GOING_AWAY, PORT, Hub, make_server
 from facemime.errors import InvalidInputError
 from facemime.fit.actor import Actor
@@ -104,7 +104,6 @@ class Call:
             if self.server is not None:
                 self.server.shutdown()
             raise
-        self.camera = isinstance(self.source, CameraSource)
 
     @property
     def port(self) -> int:

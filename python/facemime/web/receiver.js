@@ -2850,8 +2850,6 @@ void main() {
       this.actor = actor;
       this.header = header;
       this.mouthCanvas = document.createElement("canvas");
-      /** Seconds spent in the last :meth:`draw`, split by stage. */
-      this.timings = { geometry: 0, mouth: 0, gl: 0 };
       const m = actor.model;
       this.deformer = new Deformer(m);
       if (header.basisLength !== 2 * this.deformer.knots.length) {
@@ -2884,7 +2882,6 @@ void main() {
     }
     /** Draws ``motion`` into the renderer's canvas, letterboxed into ``view`` ([x, y, w, h]). */
     draw(motion, view) {
-      const t0 = performance.now();
       const v2 = motion.values, m = this.actor.model, knots = this.deformer.knots.length;
       const coefficients = this.basis.length / (2 * knots);
       const offsets = new Float64Array(2 * knots);
@@ -2898,13 +2895,11 @@ void main() {
       const pose = shownPose(poseFromValues(v2), this.actor.pose, this.key, this.scene !== null);
       const { points, depth } = project(vertices, pose);
       const [w, h] = this.size;
-      const t1 = performance.now();
       const pick = (name) => Float64Array.from(m.groups[name].flatMap((i2) => [points[2 * i2], points[2 * i2 + 1]]));
       const spread = mouthWidth(m, vertices) / Math.max(this.restWidth, 1e-9);
       const patch = mouthPatch(pick("mouth_inner_upper"), pick("mouth_inner_lower"), teethUncovered(spread), [w, h], this.mouthCanvas);
       const texture = this.painter.texture(look.iris);
       if (texture) this.textureLayer = this.renderer.upload(texture, this.textureLayer);
-      const t2 = performance.now();
       const r = this.renderer;
       r.begin(w, h, BACKGROUND, view);
       if (this.scene && this.sceneLayer && this.sceneUv) {
@@ -2925,8 +2920,6 @@ void main() {
       if (patch) r.mouthPatch(patch);
       r.mesh(this.textureLayer, points, m.uv, paintersOrder(points, depth, m.triangles), true, false);
       if (!motion.face) r.dim(NO_FACE_DIM, w, h);
-      const t3 = performance.now();
-      Object.assign(this.timings, { geometry: t1 - t0, mouth: t2 - t1, gl: t3 - t2 });
     }
     look(v2, first) {
       const at = (kind) => {

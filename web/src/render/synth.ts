@@ -32,8 +32,6 @@ export class Synthesizer {
   private readonly basis: Float64Array;
   private readonly restWidth: number;
   private readonly mouthCanvas = document.createElement('canvas');
-  /** Seconds spent in the last :meth:`draw`, split by stage. */
-  readonly timings = { geometry: 0, mouth: 0, gl: 0 };
 
   constructor(readonly renderer: Renderer, readonly actor: Actor, readonly header: Header) {
     const m = actor.model;
@@ -71,7 +69,6 @@ export class Synthesizer {
 
   /** Draws ``motion`` into the renderer's canvas, letterboxed into ``view`` ([x, y, w, h]). */
   draw(motion: Motion, view?: number[]): void {
-    const t0 = performance.now();
     const v = motion.values, m = this.actor.model, knots = this.deformer.knots.length;
     const coefficients = this.basis.length / (2 * knots);
     const offsets = new Float64Array(2 * knots);
@@ -85,13 +82,11 @@ export class Synthesizer {
     const pose = shownPose(poseFromValues(v), this.actor.pose, this.key, this.scene !== null);
     const { points, depth } = project(vertices, pose);
     const [w, h] = this.size;
-    const t1 = performance.now();
     const pick = (name: string) => Float64Array.from(m.groups[name].flatMap((i) => [points[2 * i], points[2 * i + 1]]));
     const spread = mouthWidth(m, vertices) / Math.max(this.restWidth, 1e-9);
     const patch = mouthPatch(pick('mouth_inner_upper'), pick('mouth_inner_lower'), teethUncovered(spread), [w, h], this.mouthCanvas);
     const texture = this.painter.texture(look.iris);
     if (texture) this.textureLayer = this.renderer.upload(texture, this.textureLayer);
-    const t2 = performance.now();
     const r = this.renderer;
     r.begin(w, h, BACKGROUND, view);
     if (this.scene && this.sceneLayer && this.sceneUv) {
@@ -113,8 +108,6 @@ export class Synthesizer {
     if (patch) r.mouthPatch(patch);
     r.mesh(this.textureLayer, points, m.uv, paintersOrder(points, depth, m.triangles), true, false);
     if (!motion.face) r.dim(NO_FACE_DIM, w, h);
-    const t3 = performance.now();
-    Object.assign(this.timings, { geometry: t1 - t0, mouth: t2 - t1, gl: t3 - t2 });
   }
 
   private look(v: ArrayLike<number>, first: number): { closure: [number, number]; iris: [number, number][] } {
