@@ -5,7 +5,8 @@
 - Irises: the actor's texture is the key frame, iris and all. On it, each eye's iris is found
   (:func:`facemime.track.eyes.find_iris` in the texture's own eye frame); a copy of the eye with
   the iris painted out (``cv2.inpaint``) is kept, and each frame the iris disc is pasted back,
-  shifted by the look, inside the eye's opening.
+  shifted by the look (:mod:`facemime.render.bilinear`, which the browser receiver follows),
+  inside the eye's opening.
 
 Texture pixels: (x, y) with (0, 0) the centre of the top-left texel (uv 0..1 from its corner).
 """
@@ -17,6 +18,7 @@ import numpy as np
 
 from facemime.animate.look import Look
 from facemime.fit.actor import Actor
+from facemime.render.bilinear import shift_offset, shifted
 from facemime.track.eyes import EYES, LID_EDGE, SPAN_U, SPAN_V, EyeFrame, find_iris
 
 #: The ring positions of the upper-lid vertices and of the lower-lid vertices below them.
@@ -98,10 +100,9 @@ class _Eye:
         if np.abs(d).max() < STILL:
             out[y0:y1, x0:x1] = self.iris  # the key frame's eye as it was
             return
-        m = np.float32([[1, 0, d[0]], [0, 1, d[1]]])
-        size = (x1 - x0, y1 - y0)
-        iris = cv2.warpAffine(self.iris, m, size, borderMode=cv2.BORDER_REPLICATE)
-        alpha = cv2.warpAffine(self.disc, m, size) * self.opening
+        offset = shift_offset(d)
+        iris = shifted(self.iris, offset, replicate=True).astype(np.float32)
+        alpha = shifted(self.disc, offset, replicate=False) * self.opening
         out[y0:y1, x0:x1] = np.clip(self.clean + alpha[:, :, None] * (iris - self.clean) + 0.5, 0, 255)
 
 

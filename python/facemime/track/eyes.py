@@ -27,6 +27,7 @@ import numpy as np
 
 from facemime.animate.deform import head_plane
 from facemime.model.head import HeadModel
+from facemime.render.bilinear import sample_affine
 from facemime.render.projection import Pose, project
 
 EYES = ("eye_right", "eye_left")
@@ -77,14 +78,13 @@ class EyeFrame:
 
     def patch(self, frame: np.ndarray) -> np.ndarray:
         """The eye's grey patch of ``frame`` (H, W, 3) RGB uint8, sampled every 1 / :data:`DENSITY` eye widths
-        over :data:`SPAN_U` x :data:`SPAN_V`: float32, rows along v."""
+        over :data:`SPAN_U` x :data:`SPAN_V` (:func:`~facemime.render.bilinear.sample_affine`, then
+        OpenCV's RGB-to-grey): float32, rows along v."""
         rows, cols = _patch_shape()
         step = self.axes / DENSITY
         start = self.to_image(np.array([SPAN_U[0], SPAN_V[0]]))
         m = np.column_stack([step[0], step[1], start])  # patch (col, row) -> image (x, y)
-        rgb = cv2.warpAffine(
-            frame, m, (cols, rows), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE
-        )
+        rgb = sample_affine(frame, m, (cols, rows))
         return cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY).astype(np.float32)
 
 

@@ -1367,7 +1367,9 @@ void main() {
     p[3] = y2;
     return (c1 | c2) === 0;
   }
-  function lineAA(img, w, h, ax0, ay0, ax1, ay1) {
+  function lineAA(cv, ax0, ay0, ax1, ay1) {
+    const { img, w, h, colour } = cv;
+    const ch = colour.length;
     const p = [ax0 - 2 * XY_ONE, ay0 - 2 * XY_ONE, ax1 - 2 * XY_ONE, ay1 - 2 * XY_ONE];
     if (!clipLine((w - 5) * XY_ONE + 1, (h - 5) * XY_ONE + 1, p)) return;
     let [x1, y1, x2, y2] = p;
@@ -1422,7 +1424,9 @@ void main() {
       ep[7] = t2 + t0 >> 8 & 511;
     }
     const put = (at, a) => {
-      for (let n = 0; n < 2; n++) img[at] += (255 - img[at]) * a + 127 >> 8;
+      for (let c = 0; c < ch; c++) {
+        for (let n = 0; n < 2; n++) img[at * ch + c] += (colour[c] - img[at * ch + c]) * a + 127 >> 8;
+      }
     };
     const index = (n) => n >= 2 ? 2 : n;
     let scount = 0;
@@ -1456,14 +1460,20 @@ void main() {
       }
     }
   }
-  function fillPolyAA(img, w, h, pts, shift) {
+  function lineAAShifted(cv, a, b, shift) {
+    const s = 2 ** (XY_SHIFT - shift);
+    lineAA(cv, a[0] * s, a[1] * s, b[0] * s, b[1] * s);
+  }
+  function fillPolyAA(cv, pts, shift) {
+    const { img, w, h, colour } = cv;
+    const ch = colour.length;
     const count = pts.length / 2;
     const delta = 1 << shift >> 1;
     const edges = [];
     let p0x = pts[2 * count - 2] * 2 ** (XY_SHIFT - shift), p0y = sar(pts[2 * count - 1] + delta, shift);
     for (let i3 = 0; i3 < count; i3++) {
       const p1x = pts[2 * i3] * 2 ** (XY_SHIFT - shift), p1y = sar(pts[2 * i3 + 1] + delta, shift);
-      lineAA(img, w, h, p0x, p0y * XY_ONE, p1x, p1y * XY_ONE);
+      lineAA(cv, p0x, p0y * XY_ONE, p1x, p1y * XY_ONE);
       if (p0y !== p1y) {
         const up = p0y < p1y;
         edges.push({
@@ -1527,7 +1537,7 @@ void main() {
             if (x1 < w && x2 >= 0) {
               x1 = Math.max(x1, 0);
               x2 = Math.min(x2, w - 1);
-              if (x2 >= x1) img.fill(255, y * w + x1, y * w + x2 + 1);
+              for (let x3 = x1; x3 <= x2; x3++) for (let c = 0; c < ch; c++) img[(y * w + x3) * ch + c] = colour[c];
             }
           }
           keep.x += keep.dx;
@@ -1725,7 +1735,7 @@ void main() {
       const mask = new Uint8Array(n);
       const pts = [];
       for (let k = 0; k < 8; k++) pts.push(rint((ring[2 * k] - x0) * 16), rint((ring[2 * k + 1] - y0) * 16));
-      if (n) fillPolyAA(mask, w, h, pts, 4);
+      if (n) fillPolyAA({ img: mask, w, h, colour: [255] }, pts, 4);
       this.opening = new Float32Array(n);
       for (let k = 0; k < n; k++) this.opening[k] = Math.fround(mask[k] / 255);
       const inner = erodeEllipse(this.opening, w, h, 2 * Math.max(1, rint(LID_EDGE * ew)) + 1);
@@ -1796,7 +1806,7 @@ void main() {
       }
     }
     /** The warp's offset for an iris shift (u, v) eye widths: texture px (dx, dy) moved, quantised
-     * as cv2.warpAffine does (1/32 px): each pixel samples the key frame at (x + ox / 32, y + oy / 32);
+     * to 1/32 px as facemime.render.bilinear.shift_offset does: each pixel samples the key frame at (x + ox / 32, y + oy / 32);
      * null when the shift is below STILL. */
     offset(shift) {
       const a = this.frame.axes;
@@ -1883,11 +1893,11 @@ void main() {
   var TEETH_FROM = 0.04;
   var TEETH_SPREAD = [0.9, 1.05];
   var UPPER_MIN = 0.5;
+  var SHIFT = 4;
   function teethUncovered(spread) {
     return Math.min(Math.max((spread - TEETH_SPREAD[0]) / (TEETH_SPREAD[1] - TEETH_SPREAD[0]), 0), 1);
   }
-  var css = (c) => `rgb(${c[0]},${c[1]},${c[2]})`;
-  function mouthPatch(upper, lower, uncovered, size, canvas2) {
+  function mouthPatch(upper, lower, uncovered, size) {
     const k = upper.length / 2, kl = lower.length / 2;
     const poly = [];
     for (let i2 = 0; i2 < k; i2++) poly.push(upper[2 * i2], upper[2 * i2 + 1]);
@@ -1903,32 +1913,12 @@ void main() {
     const x1 = Math.min(Math.ceil(maxX) + 2, size[0]), y1 = Math.min(Math.ceil(maxY) + 2, size[1]);
     if (x1 - x0 < 2 || y1 - y0 < 2) return null;
     const w = x1 - x0, h = y1 - y0;
-    canvas2.width = w;
-    canvas2.height = h;
-    const ctx = canvas2.getContext("2d", { willReadFrequently: true });
-    const path = (pts) => {
-      ctx.beginPath();
-      for (let i2 = 0; i2 < pts.length; i2 += 2) {
-        const q = fix(pts[i2], pts[i2 + 1]);
-        if (i2 === 0) ctx.moveTo(q[0], q[1]);
-        else ctx.lineTo(q[0], q[1]);
-      }
-      ctx.closePath();
-    };
-    const fix = (x2, y) => [Math.round((x2 - x0) * 16) / 16 + 0.5, Math.round((y - y0) * 16) / 16 + 0.5];
-    ctx.clearRect(0, 0, w, h);
-    ctx.fillStyle = "#fff";
-    path(poly);
-    ctx.fill();
-    const mask = ctx.getImageData(0, 0, w, h).data;
-    let any = false;
-    for (let i2 = 3; i2 < mask.length; i2 += 4) if (mask[i2]) {
-      any = true;
-      break;
-    }
-    if (!any) return null;
-    ctx.fillStyle = css(CAVITY);
-    ctx.fillRect(0, 0, w, h);
+    const fix = (pts) => Array.from(pts, (v2, i2) => rint((v2 - (i2 % 2 ? y0 : x0)) * (1 << SHIFT)));
+    const mask = new Uint8Array(w * h);
+    fillPolyAA({ img: mask, w, h, colour: [255] }, fix(poly), SHIFT);
+    if (!mask.some((v2) => v2 > 0)) return null;
+    const paint = new Uint8Array(w * h * 3);
+    for (let p = 0; p < w * h; p++) paint.set(CAVITY, 3 * p);
     const ax = upper[2 * (k - 1)] - upper[0], ay = upper[2 * (k - 1) + 1] - upper[1];
     const width = Math.hypot(ax, ay);
     const downX = -ay / Math.max(width, 1e-9), downY = ax / Math.max(width, 1e-9);
@@ -1951,20 +1941,12 @@ void main() {
       const tips = idx.flatMap((_, j) => [edge[2 * j] + sign * reach[j] * downX, edge[2 * j + 1] + sign * reach[j] * downY]);
       const outline = [...edge];
       for (let j = idx.length - 1; j >= 0; j--) outline.push(tips[2 * j], tips[2 * j + 1]);
-      ctx.fillStyle = css(TEETH);
-      path(outline);
-      ctx.fill();
-      ctx.strokeStyle = css(GAPS);
-      ctx.lineWidth = 1;
+      fillPolyAA({ img: paint, w, h, colour: TEETH }, fix(outline), SHIFT);
+      const gaps = { img: paint, w, h, colour: GAPS };
       for (let j = 1; j < idx.length - 1; j++) {
-        const a = fix(edge[2 * j], edge[2 * j + 1]), b = fix(tips[2 * j], tips[2 * j + 1]);
-        ctx.beginPath();
-        ctx.moveTo(a[0], a[1]);
-        ctx.lineTo(b[0], b[1]);
-        ctx.stroke();
+        lineAAShifted(gaps, fix(edge.slice(2 * j, 2 * j + 2)), fix(tips.slice(2 * j, 2 * j + 2)), SHIFT);
       }
     }
-    const paint = ctx.getImageData(0, 0, w, h).data;
     const centre = (upper[0] + upper[2 * (k - 1)]) / 2, half = Math.max(width / 2, 1);
     const rgba = new Uint8Array(w * h * 4);
     for (let x2 = 0; x2 < w; x2++) {
@@ -1972,8 +1954,8 @@ void main() {
       const shade = Math.min(Math.max(1.15 - 0.6 * cx * cx, 0.35), 1);
       for (let y = 0; y < h; y++) {
         const p = 4 * (y * w + x2);
-        for (let c = 0; c < 3; c++) rgba[p + c] = Math.round(paint[p + c] * shade);
-        rgba[p + 3] = mask[p + 3];
+        for (let c = 0; c < 3; c++) rgba[p + c] = Math.round(paint[3 * (y * w + x2) + c] * shade);
+        rgba[p + 3] = mask[y * w + x2];
       }
     }
     return { x0, y0, width: w, height: h, rgba };
@@ -2849,7 +2831,6 @@ void main() {
       this.renderer = renderer2;
       this.actor = actor;
       this.header = header;
-      this.mouthCanvas = document.createElement("canvas");
       const m = actor.model;
       this.deformer = new Deformer(m);
       if (header.basisLength !== 2 * this.deformer.knots.length) {
@@ -2897,7 +2878,7 @@ void main() {
       const [w, h] = this.size;
       const pick = (name) => Float64Array.from(m.groups[name].flatMap((i2) => [points[2 * i2], points[2 * i2 + 1]]));
       const spread = mouthWidth(m, vertices) / Math.max(this.restWidth, 1e-9);
-      const patch = mouthPatch(pick("mouth_inner_upper"), pick("mouth_inner_lower"), teethUncovered(spread), [w, h], this.mouthCanvas);
+      const patch = mouthPatch(pick("mouth_inner_upper"), pick("mouth_inner_lower"), teethUncovered(spread), [w, h]);
       const texture = this.painter.texture(look.iris);
       if (texture) this.textureLayer = this.renderer.upload(texture, this.textureLayer);
       const r = this.renderer;

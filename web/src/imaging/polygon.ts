@@ -1,7 +1,8 @@
 /**
- * OpenCV's anti-aliased polygon fill (cv2.fillPoly with LINE_AA and sub-pixel shift bits), in
- * OpenCV's fixed-point arithmetic, on an 8-bit single-channel image (row-major from the top-left
- * pixel; pixel centres on integer coordinates).
+ * OpenCV's anti-aliased drawing (cv2.fillPoly and cv2.line with LINE_AA and sub-pixel shift bits),
+ * in OpenCV's fixed-point arithmetic, on an 8-bit image of 1 or 3 interleaved channels (row-major
+ * from the top-left pixel; pixel centres on integer coordinates). The same arithmetic in OpenCV
+ * 4.9 to 5.1.
  */
 
 const XY_SHIFT = 16, XY_ONE = 1 << XY_SHIFT;
@@ -53,8 +54,13 @@ function clipLine(width: number, height: number, p: number[]): boolean {
   return (c1 | c2) === 0;
 }
 
-/** OpenCV's LineAA in colour 255 on a w x h 8-bit image; points (x, y) in 16.16 fixed point. */
-function lineAA(img: Uint8Array, w: number, h: number, ax0: number, ay0: number, ax1: number, ay1: number): void {
+/** An 8-bit image: `w` x `h` pixels of `colour.length` interleaved channels, drawn in `colour`. */
+export interface Canvas { img: Uint8Array; w: number; h: number; colour: number[] }
+
+/** OpenCV's LineAA on `cv`; points (x, y) in 16.16 fixed point. */
+function lineAA(cv: Canvas, ax0: number, ay0: number, ax1: number, ay1: number): void {
+  const { img, w, h, colour } = cv;
+  const ch = colour.length;
   const p = [ax0 - 2 * XY_ONE, ay0 - 2 * XY_ONE, ax1 - 2 * XY_ONE, ay1 - 2 * XY_ONE];
   if (!clipLine((w - 5) * XY_ONE + 1, (h - 5) * XY_ONE + 1, p)) return;
   let [x1, y1, x2, y2] = p;
@@ -101,7 +107,9 @@ function lineAA(img: Uint8Array, w: number, h: number, ax0: number, ay0: number,
     ep[7] = ((t2 + t0) >> 8) & 0x1ff;
   }
   const put = (at: number, a: number) => {
-    for (let n = 0; n < 2; n++) img[at] += ((255 - img[at]) * a + 127) >> 8;
+    for (let c = 0; c < ch; c++) {
+      for (let n = 0; n < 2; n++) img[at * ch + c] += ((colour[c] - img[at * ch + c]) * a + 127) >> 8;
+    }
   };
   const index = (n: number) => (n >= 2 ? 2 : n);
   let scount = 0;
@@ -139,16 +147,25 @@ function lineAA(img: Uint8Array, w: number, h: number, ax0: number, ay0: number,
 
 interface PolyEdge { y0: number; y1: number; x: number; dx: number; next: PolyEdge | null }
 
-/** cv2.fillPoly(img, [pts], 255, cv2.LINE_AA, shift) on a w x h 8-bit image: `pts` (x, y) pairs,
- * integers in units of 2^-shift px (OpenCV's CollectPolyEdges and FillEdgeCollection). */
-export function fillPolyAA(img: Uint8Array, w: number, h: number, pts: number[], shift: number): void {
+/** cv2.line(img, a, b, colour, 1, cv2.LINE_AA, shift) on `cv`: `a`, `b` (x, y), integers in
+ * units of 2^-shift px. */
+export function lineAAShifted(cv: Canvas, a: number[], b: number[], shift: number): void {
+  const s = 2 ** (XY_SHIFT - shift);
+  lineAA(cv, a[0] * s, a[1] * s, b[0] * s, b[1] * s);
+}
+
+/** cv2.fillPoly(img, [pts], colour, cv2.LINE_AA, shift) on `cv`: `pts` (x, y) pairs, integers in
+ * units of 2^-shift px (OpenCV's CollectPolyEdges and FillEdgeCollection). */
+export function fillPolyAA(cv: Canvas, pts: number[], shift: number): void {
+  const { img, w, h, colour } = cv;
+  const ch = colour.length;
   const count = pts.length / 2;
   const delta = (1 << shift) >> 1;
   const edges: PolyEdge[] = [];
   let p0x = pts[2 * count - 2] * 2 ** (XY_SHIFT - shift), p0y = sar(pts[2 * count - 1] + delta, shift);
   for (let i = 0; i < count; i++) {
     const p1x = pts[2 * i] * 2 ** (XY_SHIFT - shift), p1y = sar(pts[2 * i + 1] + delta, shift);
-    lineAA(img, w, h, p0x, p0y * XY_ONE, p1x, p1y * XY_ONE);
+    lineAA(cv, p0x, p0y * XY_ONE, p1x, p1y * XY_ONE);
     if (p0y !== p1y) {
       const up = p0y < p1y;
       edges.push({ y0: up ? p0y : p1y, y1: up ? p1y : p0y, x: up ? p0x : p1x,
@@ -207,7 +224,7 @@ export function fillPolyAA(img: Uint8Array, w: number, h: number, pts: number[],
           if (x1 < w && x2 >= 0) {
             x1 = Math.max(x1, 0);
             x2 = Math.min(x2, w - 1);
-            if (x2 >= x1) img.fill(255, y * w + x1, y * w + x2 + 1);
+            for (let x = x1; x <= x2; x++) for (let c = 0; c < ch; c++) img[(y * w + x) * ch + c] = colour[c];
           }
         }
         keep.x += keep.dx;

@@ -5,9 +5,10 @@
  * inpainting) is kept, and each frame the iris disc is pasted back, shifted by the look, inside
  * the eye's opening. The lids are closed by the geometry (closeLids), not here.
  *
- * The OpenCV operations the Python code uses are reimplemented here as OpenCV computes them
- * (fixed-point warps, RGB to grey, the anti-aliased polygon, the elliptic erosion, Gaussian
- * kernels and borders, Telea's fast marching), so that the texture matches `facemime decode`'s.
+ * The Python code's warps are facemime.render.bilinear's fixed arithmetic, followed here step for
+ * step; the OpenCV operations it uses are reimplemented as OpenCV computes them (RGB to grey, the
+ * anti-aliased polygon, the elliptic erosion, Gaussian kernels and borders, Telea's fast
+ * marching), so that the texture matches `facemime decode`'s.
  *
  * Texture pixels: (x, y), x right, y down, (0, 0) the centre of the top-left texel (uv 0..1 from
  * its corner). Eye coordinates (u, v): units of the eye's width from the middle of its corners,
@@ -67,8 +68,8 @@ const vOf = (row: number) => SPAN_V[0] + row / DENSITY;
 const colOf = (u: number) => rint((u - SPAN_U[0]) * DENSITY);
 const rowOf = (v: number) => rint((v - SPAN_V[0]) * DENSITY);
 
-/** The eye's grey patch of an RGBA texture (EyeFrame.patch: cv2.warpAffine with WARP_INVERSE_MAP,
- * bilinear in OpenCV's fixed point (1/32 px, weights of 1/1024), BORDER_REPLICATE, then
+/** The eye's grey patch of an RGBA texture (EyeFrame.patch: facemime.render.bilinear.sample_affine,
+ * bilinear in fixed point (1/32 px, weights of 1/1024), the border replicated, then
  * cv2.COLOR_RGB2GRAY): PATCH_ROWS x PATCH_COLS, rows along v. */
 function eyePatch(tex: Picture, frame: EyeFrame): Float64Array {
   const a = frame.axes;
@@ -214,7 +215,7 @@ class Eye {
     const mask = new Uint8Array(n);
     const pts: number[] = [];
     for (let k = 0; k < 8; k++) pts.push(rint((ring[2 * k] - x0) * 16), rint((ring[2 * k + 1] - y0) * 16));
-    if (n) fillPolyAA(mask, w, h, pts, 4);
+    if (n) fillPolyAA({ img: mask, w, h, colour: [255] }, pts, 4);
     this.opening = new Float32Array(n);
     for (let k = 0; k < n; k++) this.opening[k] = Math.fround(mask[k] / 255);
     // only what the key frame's opening showed of the iris moves, not the lid's edge
@@ -285,7 +286,7 @@ class Eye {
   }
 
   /** The warp's offset for an iris shift (u, v) eye widths: texture px (dx, dy) moved, quantised
-   * as cv2.warpAffine does (1/32 px): each pixel samples the key frame at (x + ox / 32, y + oy / 32);
+   * to 1/32 px as facemime.render.bilinear.shift_offset does: each pixel samples the key frame at (x + ox / 32, y + oy / 32);
    * null when the shift is below STILL. */
   offset(shift: [number, number]): [number, number] | null {
     const a = this.frame.axes;

@@ -1,11 +1,12 @@
 /**
  * The mouth interior (facemime.animate.synth.draw_mouth_interior): a dark cavity with upper and
- * lower teeth, painted behind the lips, drawn here with a 2-D canvas into an RGBA patch (colour
- * already shaded, alpha the opening's anti-aliased mask) that the renderer blends in.
+ * lower teeth, painted behind the lips, drawn into an RGBA patch (colour already shaded, alpha the
+ * opening's anti-aliased mask) that the renderer blends in.
  *
- * Points: image pixels, x right, y down, (0, 0) the centre of the top-left pixel (a canvas puts
- * pixel centres at +0.5, hence the shift below).
+ * Points: image pixels, x right, y down, (0, 0) the centre of the top-left pixel.
  */
+import { rint } from '../imaging/filters';
+import { fillPolyAA, lineAAShifted } from '../imaging/polygon';
 
 const CAVITY = [52, 18, 22];
 const TEETH = [185, 165, 150];
@@ -18,6 +19,8 @@ const LOWER_SHARE = 0.4;
 const TEETH_FROM = 0.04;
 const TEETH_SPREAD = [0.9, 1.05];
 const UPPER_MIN = 0.5;
+/** Sub-pixel bits of the drawn points. */
+const SHIFT = 4;
 
 /** How much of the teeth the lips uncover, 0..1, for corners ``spread`` times their rest
  * distance apart. */
@@ -32,13 +35,12 @@ export interface MouthPatch {
   rgba: Uint8Array;
 }
 
-const css = (c: number[]) => `rgb(${c[0]},${c[1]},${c[2]})`;
-
 /** The interior of the opening bounded by the inner lips ``upper`` and ``lower`` (K*2 px each,
  * corner to corner), ``uncovered`` of the teeth shown, in a picture of ``size``; null when the
- * opening is empty or off the picture. */
+ * opening is empty or off the picture. Drawn as the Python code draws it, with OpenCV's
+ * anti-aliased polygons and lines (imaging/polygon) on points rounded to 1/16 px. */
 export function mouthPatch(upper: Float64Array, lower: Float64Array, uncovered: number,
-  size: [number, number], canvas: HTMLCanvasElement): MouthPatch | null {
+  size: [number, number]): MouthPatch | null {
   const k = upper.length / 2, kl = lower.length / 2;
   const poly: number[] = [];
   for (let i = 0; i < k; i++) poly.push(upper[2 * i], upper[2 * i + 1]);
@@ -52,31 +54,15 @@ export function mouthPatch(upper: Float64Array, lower: Float64Array, uncovered: 
   const x1 = Math.min(Math.ceil(maxX) + 2, size[0]), y1 = Math.min(Math.ceil(maxY) + 2, size[1]);
   if (x1 - x0 < 2 || y1 - y0 < 2) return null;
   const w = x1 - x0, h = y1 - y0;
-  canvas.width = w;
-  canvas.height = h;
-  const ctx = canvas.getContext('2d', { willReadFrequently: true }) as CanvasRenderingContext2D;
-  const path = (pts: number[]) => {
-    ctx.beginPath();
-    for (let i = 0; i < pts.length; i += 2) {
-      const q = fix(pts[i], pts[i + 1]);
-      if (i === 0) ctx.moveTo(q[0], q[1]); else ctx.lineTo(q[0], q[1]);
-    }
-    ctx.closePath();
-  };
-  // points to 1/16 px, as the Python drawing does, then to canvas coordinates
-  const fix = (x: number, y: number) => [Math.round((x - x0) * 16) / 16 + 0.5, Math.round((y - y0) * 16) / 16 + 0.5];
+  // points to 1/16 px in the patch (numpy's rounding, half to even)
+  const fix = (pts: ArrayLike<number>) => Array.from(pts, (v, i) => rint((v - (i % 2 ? y0 : x0)) * (1 << SHIFT)));
   // the mask first
-  ctx.clearRect(0, 0, w, h);
-  ctx.fillStyle = '#fff';
-  path(poly);
-  ctx.fill();
-  const mask = ctx.getImageData(0, 0, w, h).data;
-  let any = false;
-  for (let i = 3; i < mask.length; i += 4) if (mask[i]) { any = true; break; }
-  if (!any) return null;
+  const mask = new Uint8Array(w * h);
+  fillPolyAA({ img: mask, w, h, colour: [255] }, fix(poly), SHIFT);
+  if (!mask.some((v) => v > 0)) return null;
   // the paint: cavity, teeth, the gaps between them
-  ctx.fillStyle = css(CAVITY);
-  ctx.fillRect(0, 0, w, h);
+  const paint = new Uint8Array(w * h * 3);
+  for (let p = 0; p < w * h; p++) paint.set(CAVITY, 3 * p);
   const ax = upper[2 * (k - 1)] - upper[0], ay = upper[2 * (k - 1) + 1] - upper[1];
   const width = Math.hypot(ax, ay);
   const downX = -ay / Math.max(width, 1e-9), downY = ax / Math.max(width, 1e-9);
@@ -99,20 +85,12 @@ export function mouthPatch(upper: Float64Array, lower: Float64Array, uncovered: 
     const tips = idx.flatMap((_, j) => [edge[2 * j] + sign * reach[j] * downX, edge[2 * j + 1] + sign * reach[j] * downY]);
     const outline = [...edge];
     for (let j = idx.length - 1; j >= 0; j--) outline.push(tips[2 * j], tips[2 * j + 1]);
-    ctx.fillStyle = css(TEETH);
-    path(outline);
-    ctx.fill();
-    ctx.strokeStyle = css(GAPS);
-    ctx.lineWidth = 1;
+    fillPolyAA({ img: paint, w, h, colour: TEETH }, fix(outline), SHIFT);
+    const gaps = { img: paint, w, h, colour: GAPS };
     for (let j = 1; j < idx.length - 1; j++) {
-      const a = fix(edge[2 * j], edge[2 * j + 1]), b = fix(tips[2 * j], tips[2 * j + 1]);
-      ctx.beginPath();
-      ctx.moveTo(a[0], a[1]);
-      ctx.lineTo(b[0], b[1]);
-      ctx.stroke();
+      lineAAShifted(gaps, fix(edge.slice(2 * j, 2 * j + 2)), fix(tips.slice(2 * j, 2 * j + 2)), SHIFT);
     }
   }
-  const paint = ctx.getImageData(0, 0, w, h).data;
   const centre = (upper[0] + upper[2 * (k - 1)]) / 2, half = Math.max(width / 2, 1);
   const rgba = new Uint8Array(w * h * 4);
   for (let x = 0; x < w; x++) {
@@ -120,8 +98,8 @@ export function mouthPatch(upper: Float64Array, lower: Float64Array, uncovered: 
     const shade = Math.min(Math.max(1.15 - 0.6 * cx * cx, 0.35), 1);
     for (let y = 0; y < h; y++) {
       const p = 4 * (y * w + x);
-      for (let c = 0; c < 3; c++) rgba[p + c] = Math.round(paint[p + c] * shade);
-      rgba[p + 3] = mask[p + 3];
+      for (let c = 0; c < 3; c++) rgba[p + c] = Math.round(paint[3 * (y * w + x) + c] * shade);
+      rgba[p + 3] = mask[y * w + x];
     }
   }
   return { x0, y0, width: w, height: h, rgba };

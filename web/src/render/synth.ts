@@ -31,7 +31,6 @@ export class Synthesizer {
   private readonly key: Pose;
   private readonly basis: Float64Array;
   private readonly restWidth: number;
-  private readonly mouthCanvas = document.createElement('canvas');
 
   constructor(readonly renderer: Renderer, readonly actor: Actor, readonly header: Header) {
     const m = actor.model;
@@ -84,7 +83,7 @@ export class Synthesizer {
     const [w, h] = this.size;
     const pick = (name: string) => Float64Array.from(m.groups[name].flatMap((i) => [points[2 * i], points[2 * i + 1]]));
     const spread = mouthWidth(m, vertices) / Math.max(this.restWidth, 1e-9);
-    const patch = mouthPatch(pick('mouth_inner_upper'), pick('mouth_inner_lower'), teethUncovered(spread), [w, h], this.mouthCanvas);
+    const patch = mouthPatch(pick('mouth_inner_upper'), pick('mouth_inner_lower'), teethUncovered(spread), [w, h]);
     const texture = this.painter.texture(look.iris);
     if (texture) this.textureLayer = this.renderer.upload(texture, this.textureLayer);
     const r = this.renderer;

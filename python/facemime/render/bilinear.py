@@ -1,0 +1,100 @@
+"""Bilinear resampling in a fixed arithmetic of facemime's own, for the eyes.
+
+The eye painter runs in Python (``facemime decode``) and in the browser receiver
+(``web/src/render/eyes.ts``), which must give the same pixels. ``cv2.warpAffine`` cannot be
+that shared definition: its rounding changed between OpenCV 4.x, 5.0 and 5.1 (the same call
+differs by up to 5 grey levels between 4.14 and 5.0 and by 1 between 5.0 and 5.1). These
+functions compute what OpenCV 4 computed, written down here once; the TypeScript side follows
+them step for step.
+
+Positions are quantised to 1/:data:`SUB` px. Images: pixel (x, y), x right, y down, (0, 0) the
+centre of the top-left pixel.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: Sub-pixel steps per pixel of a sampling position.
+SUB = 32
+#: The fixed-point scale of an affine map's coefficients (1/1024 px).
+SCALE = 1024
+
+
+def sample_affine(image: np.ndarray, m: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """``image`` (H, W, C) uint8 sampled at ``m @ (col, row, 1)`` for each pixel (col, row) of
+    an output of ``size`` (cols, rows): bilinear, the position in 1/32 px (each coordinate
+    ``rint(m · (col, row, 1) · 1024) + 16`` shifted down 5 bits, the row and column parts
+    rounded apart), integer weights that sum to 1024, the sum rounded; the border replicated.
+    Returns (rows, cols, C) uint8.
+
+    >>> img = np.arange(12, dtype=np.uint8).reshape(2, 2, 3) * 20
+    >>> sample_affine(img, np.array([[1.0, 0, 0.5], [0, 1, 0]]), (1, 1))[0, 0].tolist()
+    [30, 50, 70]
+    """
+    cols, rows = size
+    m = np.asarray(m, np.float64)
+    c, r = np.arange(cols, dtype=np.float64), np.arange(rows, dtype=np.float64)
+    half = SCALE // SUB // 2
+    x = (np.rint((m[0, 1] * r + m[0, 2]) * SCALE).astype(np.int64) + half)[:, None]
+    y = (np.rint((m[1, 1] * r + m[1, 2]) * SCALE).astype(np.int64) + half)[:, None]
+    x = (x + np.rint(m[0, 0] * c * SCALE).astype(np.int64)[None, :]) >> 5
+    y = (y + np.rint(m[1, 0] * c * SCALE).astype(np.int64)[None, :]) >> 5
+    sx, sy, fx, fy = x >> 5, y >> 5, (x & 31)[..., None], (y & 31)[..., None]
+    h, w = image.shape[:2]
+    xa, xb = np.clip(sx, 0, w - 1), np.clip(sx + 1, 0, w - 1)
+    ya, yb = np.clip(sy, 0, h - 1), np.clip(sy + 1, 0, h - 1)
+    src = image.astype(np.int64)
+    s = (
+        (SUB - fx) * (SUB - fy) * src[ya, xa]
+        + fx * (SUB - fy) * src[ya, xb]
+        + (SUB - fx) * fy * src[yb, xa]
+        + fx * fy * src[yb, xb]
+    )
+    return ((s + SCALE // 2) >> 10).astype(np.uint8)
+
+
+def shift_offset(d: np.ndarray) -> tuple[int, int]:
+    """The sampling offset, 1/32 px, that moves a picture by ``d`` (dx, dy) px: each pixel then
+    samples the picture at (x + ox / 32, y + oy / 32). ``d`` is taken to float32 first, as the
+    receiver sends it.
+
+    >>> shift_offset(np.array([1.0, -0.5]))
+    (-32, 16)
+    """
+    d32 = np.asarray(d, np.float32).astype(np.float64)
+    ox, oy = ((int(np.rint(-v * SCALE)) + SCALE // SUB // 2) >> 5 for v in d32)
+    return ox, oy
+
+
+def shifted(image: np.ndarray, offset: tuple[int, int], replicate: bool) -> np.ndarray:
+    """``image`` (H, W) or (H, W, C) float sampled at (x + ox / 32, y + oy / 32): bilinear, the
+    weights float32, the sum in float64, in the order top-left, top-right, bottom-left,
+    bottom-right; outside the picture its border replicated (``replicate``) or 0. Returns float64
+    of ``image``'s shape."""
+    ox, oy = offset
+    sx, sy = ox >> 5, oy >> 5
+    fx, fy = (ox & 31) / SUB, (oy & 31) / SUB
+    weights = [float(np.float32(v)) for v in ((1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy)]
+    h, w = image.shape[:2]
+    src = image.astype(np.float64)
+    xs, ys = np.arange(w) + sx, np.arange(h) + sy
+
+    def taps(idx: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+        return np.clip(idx, 0, n - 1), (idx >= 0) & (idx < n)
+
+    (xa, in_xa), (xb, in_xb) = taps(xs, w), taps(xs + 1, w)
+    (ya, in_ya), (yb, in_yb) = taps(ys, h), taps(ys + 1, h)
+    out = np.zeros_like(src)
+    for wt, yy, in_y, xx, in_x in (
+        (weights[0], ya, in_ya, xa, in_xa),
+        (weights[1], ya, in_ya, xb, in_xb),
+        (weights[2], yb, in_yb, xa, in_xa),
+        (weights[3], yb, in_yb, xb, in_xb),
+    ):
+        tap = src[np.ix_(yy, xx)]
+        if not replicate:
+            inside = in_y[:, None] & in_x[None, :]
+            tap = tap * (inside[..., None] if tap.ndim == 3 else inside)
+        out = out + wt * tap
+    return out
