@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import json
 import re
+import socket
 import sys
 import textwrap
 import threading
@@ -330,12 +331,18 @@ class _Head:
 
 class ViewerServer(ThreadingHTTPServer):
     """The viewer's web server (see :func:`make_server`): at most ``max_clients`` connections at
-    once, more are answered 503; closing it stops the broadcast."""
+    once, more are answered 503. Closing it stops the broadcast, cuts every open connection and
+    waits for their threads: no thread of the server outlives it (a process that exits right
+    after, as ``facemime view`` on Ctrl-C, has none left writing to a socket or to stderr)."""
+
+    daemon_threads = False  # joined by server_close (ThreadingMixIn), once their connections are cut
 
     def __init__(self, port: int, handler: type[BaseHTTPRequestHandler], broadcast: Broadcast, max_clients: int):
         super().__init__(("127.0.0.1", port), handler)
         self.broadcast = broadcast
         self._slots = threading.BoundedSemaphore(max_clients)
+        self._open: set[socket.socket] = set()  # the connections being served
+        self._open_lock = threading.Lock()
 
     def process_request(self, request: Any, client_address: Any) -> None:
         if not self._slots.acquire(blocking=False):
@@ -346,12 +353,16 @@ class ViewerServer(ThreadingHTTPServer):
                 )
             self.shutdown_request(request)
             return
+        with self._open_lock:
+            self._open.add(request)
         super().process_request(request, client_address)
 
     def process_request_thread(self, request: Any, client_address: Any) -> None:
         try:
             super().process_request_thread(request, client_address)
         finally:
+            with self._open_lock:
+                self._open.discard(request)
             self._slots.release()
 
     def handle_error(self, request: Any, client_address: Any) -> None:
@@ -361,8 +372,15 @@ class ViewerServer(ThreadingHTTPServer):
             report(e)
 
     def server_close(self) -> None:
-        super().server_close()
+        """Stop listening and playing, cut the open connections (a client that reads nothing, or
+        sends nothing, would otherwise hold its thread up to ``timeout``) and join their threads."""
+        self.socket.close()
         self.broadcast.close()
+        with self._open_lock:
+            for connection in self._open:
+                with suppress(OSError):
+                    connection.shutdown(socket.SHUT_RDWR)
+        super().server_close()
 
 
 def make_server(viewer: Viewer, port: int = 8765, timeout: float = 10.0, max_clients: int = 16) -> ViewerServer:

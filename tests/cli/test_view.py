@@ -320,6 +320,22 @@ def test_stopping_the_server_ends_its_streams_cleanly(serve, capsys):
     assert capsys.readouterr().err == ""
 
 
+def test_closing_the_server_cuts_stalled_clients_and_leaves_no_thread_of_its_own(serve):
+    port = serve(timeout=30.0)
+    c, response = stream(port)  # reads three frames, then nothing more
+    assert len(list(itertools.islice(parts(response), 3))) == 3
+    silent = socket.create_connection(("127.0.0.1", port))  # sends nothing
+    time.sleep(0.3)  # the stream's thread blocks on the client's full socket, the other on the request
+    server, _ = serve.started[0]
+    start = time.monotonic()
+    server.server_close()
+    assert time.monotonic() - start < 5  # not the 30 s timeout of either client
+    alive = [t.name for t in threading.enumerate() if "process_request" in t.name or t.name == "viewer player"]
+    assert alive == []
+    c.close()
+    silent.close()
+
+
 def test_ctrl_c_stops_a_streaming_view_cleanly(recorded):
     proc = subprocess.Popen(
         [sys.executable, "-m", "facemime", "view", "--no-browser", "--port", "0", str(recorded[1])],
