@@ -336,9 +336,13 @@ def test_closing_the_server_cuts_stalled_clients_and_leaves_no_thread_of_its_own
     silent.close()
 
 
-def test_ctrl_c_stops_a_streaming_view_cleanly(recorded):
+@pytest.mark.parametrize("trap", ["-", '""'], ids=["SIGINT as from a terminal", "SIGINT ignored"])
+def test_ctrl_c_stops_a_streaming_view_cleanly(recorded, trap):
+    # a shell script's background job starts with SIGINT ignored (and so does a test run started
+    # as one, whose children inherit it): facemime must stop on it all the same
+    command = [sys.executable, "-m", "facemime", "view", "--no-browser", "--port", "0", str(recorded[1])]
     proc = subprocess.Popen(
-        [sys.executable, "-m", "facemime", "view", "--no-browser", "--port", "0", str(recorded[1])],
+        ["sh", "-c", f'trap {trap} INT; exec "$@"', "sh", *command],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,

@@ -643,11 +643,14 @@ def _terminate(signum: int, frame: object) -> None:
 
 def main(argv: list[str] | None = None) -> None:
     """Entry point: run the CLI, turning expected errors into one line on stderr; SIGTERM and
-    SIGHUP stop it cleanly (exit status 128 + the signal's number)."""
+    SIGHUP stop it cleanly (exit status 128 + the signal's number), and so does SIGINT (Ctrl-C,
+    status 130) even where the process was started with SIGINT ignored, as a shell script's
+    background job is: a command that says "Ctrl-C stops" stops on it."""
     argv = sys.argv[1:] if argv is None else argv
     handlers = {}
     if threading.current_thread() is threading.main_thread():
         handlers = {sig: signal.signal(sig, _terminate) for sig in (signal.SIGTERM, signal.SIGHUP)}
+        handlers[signal.SIGINT] = signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
         _run(argv)
     finally:
