@@ -2,6 +2,7 @@
 and its absence refuses, ``--traceback`` shows the trace that is otherwise one line, a usage
 error exits 2, an interrupt 130 and a termination 128 + the signal's number."""
 
+import re
 import signal
 import subprocess
 import sys
@@ -68,14 +69,15 @@ def test_the_installed_command_prints_the_trace_with_traceback(tmp_path):
         (["no-such-command"], "No such command 'no-such-command'"),
         (["track"], "Missing argument 'VIDEO'"),
         (["model-preview"], "Missing option '--out'"),
-        (["model-preview", "--out", "x.png", "--no-such-flag"], "No such option '--no-such-flag'"),
+        (["model-preview", "--out", "x.png", "--no-such-flag"], "No such option(: | ')--no-such-flag"),
         (["view", "x.json", "--port", "many"], "'many' is not a valid integer"),
     ],
 )
 def test_a_usage_error_exits_2_with_the_usage(tmp_path, capsys, monkeypatch, args, message):
     monkeypatch.chdir(tmp_path)
     code, stdout, err = run(capsys, *args)
-    assert code == 2 and stdout == "" and "Usage: facemime" in err and message in err, err
+    # the message in click's words (8.1 and 8.2 write "No such option: --x", later ones "No such option '--x'")
+    assert code == 2 and stdout == "" and "Usage: facemime" in err and re.search(message, err), err
     assert "Traceback" not in err and not any(tmp_path.iterdir())
 
 
