@@ -1,9 +1,11 @@
 """The face models shipped with facemime (``facemime/face/models``, see its README for their
-origin, licence and checksums), loaded once per process by OpenCV's ``cv2.dnn``."""
+origin, licence and checksums), loaded by OpenCV's ``cv2.dnn`` once per thread: a network holds
+its input and its layers' buffers, so two threads running one network at once corrupt each
+other's pass (OpenCV 5.1 stops with an assertion about a buffer's shape)."""
 
 from __future__ import annotations
 
-from functools import cache
+import threading
 from importlib import resources
 from typing import Any
 
@@ -13,11 +15,20 @@ from facemime.errors import FacemimeError
 
 #: The shipped model files.
 MODELS = ("face_detection_short_range.tflite", "face_landmark.tflite")
+_loaded = threading.local()
 
 
-@cache
 def load_network(name: str) -> cv2.dnn.Net:
-    """The shipped TFLite model ``name`` (one of :data:`MODELS`) as an OpenCV network."""
+    """The shipped TFLite model ``name`` (one of :data:`MODELS`) as an OpenCV network of this
+    thread's own (loaded on the thread's first call)."""
+    nets: dict[str, cv2.dnn.Net] = _loaded.__dict__.setdefault("nets", {})
+    if name not in nets:
+        nets[name] = _read(name)
+    return nets[name]
+
+
+def _read(name: str) -> cv2.dnn.Net:
+    """Load the shipped model ``name``; a :class:`FacemimeError` in one line where it cannot be."""
     if name not in MODELS:
         raise FacemimeError(f"unknown face model {name!r}; shipped: {', '.join(MODELS)}")
     with resources.as_file(resources.files("facemime.face") / "models" / name) as path:
