@@ -21,6 +21,7 @@ count line is read, before the rest of the file is split into lines.
 from __future__ import annotations
 
 import io
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -76,8 +77,12 @@ class _Lines:
         chunk = [line for _, line in self.lines[self.pos : self.pos + rows]]
         if rows and len(chunk) == rows:
             try:
-                table = np.loadtxt(io.StringIO("\n".join(chunk)), dtype=dtype, comments=None, ndmin=2)
-            except (ValueError, OverflowError):
+                with warnings.catch_warnings():
+                    # older numpy (2.0.0 among them) reads an integer written as a float ("2.0")
+                    # with a DeprecationWarning, newer ones refuse it: refused here by any
+                    warnings.simplefilter("error", DeprecationWarning)
+                    table = np.loadtxt(io.StringIO("\n".join(chunk)), dtype=dtype, comments=None, ndmin=2)
+            except (ValueError, OverflowError, DeprecationWarning):
                 table = None
             if table is not None and table.shape == (rows, columns):
                 self.pos += rows
