@@ -201,7 +201,7 @@ def one_pass(path: Path, mask_only: bool) -> dict[str, float]:
     """One run of ``run``'s per-frame work on ``path`` (:class:`SideBySide`, no encoding):
     frames/s and the share of each stage."""
     with VideoReader(path) as reader:
-        work = SideBySide(reader, path.name, mask_only=mask_only)
+        work = SideBySide(reader, path.name, mask_only=mask_only, fps=reader.fps)
         for _ in work:
             pass
     result = work.result([])

@@ -167,7 +167,7 @@ def _demo(files: list[Path], paths: list[Path], seconds: float) -> DemoResult:
 
     # 3. Track it back.
     t0 = time.perf_counter()
-    analysis = Analysis(frames[0], "the performance")
+    analysis = Analysis(frames[0], "the performance", fps=FPS)
     motions = [analysis.last] + [analysis.update(f) for f in track(frames[1:], count - 1, "tracking")]
     timing["analyse (fit, track, pose)"] = time.perf_counter() - t0
     nme = {}

@@ -125,7 +125,7 @@ class Viewer:
                         )
                     if analysis is None:
                         try:
-                            analysis = Analysis(frame, str(self.source))
+                            analysis = Analysis(frame, str(self.source), fps=self.fps)
                         except NoFaceError as e:
                             raise NoFaceError(f"{e}; the video must start with a frontal face") from None
                         puppet = Puppet(

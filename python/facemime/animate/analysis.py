@@ -2,6 +2,13 @@
 brow contours tracked, the head pose followed, and the local motion (knot offsets in the head's
 own frame, see :mod:`facemime.animate.deform`) measured.
 
+The head pose comes from the Face Mesh landmarks: one landmark pass a frame, on the crop the last
+frame's landmarks frame (no detection), aligned to the key frame's
+(:class:`facemime.animate.landmark_pose.LandmarkPose`) and smoothed
+(:class:`~facemime.animate.landmark_pose.PoseFilter`), which measures the head's turn and nod as
+well as its roll. Where the pass finds no face in its crop, the pose is measured on the rigid
+points the optical flow follows (:class:`facemime.animate.pose.PoseTracker`), as below.
+
 The contours are tracked by :class:`facemime.track.redetect.FaceTracker`: where they went astray
 the face landmark model puts them right. When the face is lost (it leaves the frame or turns
 away: the head's step can no longer be measured, or every feature collapsed), frames are marked
@@ -21,11 +28,14 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from facemime.animate.deform import Deformer
+from facemime.animate.landmark_pose import LandmarkPose, PoseFilter
 from facemime.animate.look import Look
 from facemime.animate.pose import PoseTracker
 from facemime.errors import NoFaceError
+from facemime.face.finder import follow_face
 from facemime.face.mesh import reference_points
 from facemime.fit.actor import Actor
+from facemime.fit.auto import auto_points
 from facemime.fit.placement import fit_model, model_iod
 from facemime.fit.run import fit_actor, init_contours
 from facemime.render.projection import Pose
@@ -82,16 +92,38 @@ class Analysis:
     The first frame must show the face roughly frontal; an actor is fitted on it (raises
     :class:`~facemime.errors.NoFaceError` when there is none), or, given ``actor`` (the same
     person's, fitted before), only that actor's model is placed on it, so that the motion is
-    measured on the actor a receiver already holds. ``name`` names the video in messages.
+    measured on the actor a receiver already holds. ``name`` names the video in messages;
+    ``fps`` is its frame rate (frames a second), which sets the pose filter's time step.
     """
 
-    def __init__(self, frame: np.ndarray, name: str, params: TrackerParams | None = None, actor: Actor | None = None):
+    def __init__(
+        self,
+        frame: np.ndarray,
+        name: str,
+        params: TrackerParams | None = None,
+        actor: Actor | None = None,
+        fps: float = 25.0,
+    ):
         self.params = params
         self.timings = Timings()
         t0 = time.perf_counter()
-        self.actor, self.warnings, _ = fit_actor(frame, name, model=None if actor is None else actor.model)
+        try:
+            found = auto_points(frame)
+        except NoFaceError:
+            raise NoFaceError(f"no face found in {name}") from None
+        self.actor, _, _ = fit_actor(frame, name, found.points, model=None if actor is None else actor.model)
+        faces = found.face.faces
+        self.warnings = [f"{faces} faces found in {name}; fitting the largest"] if faces > 1 else []
         if actor is not None:  # placed on this frame, in this frame's scene
             self.actor = replace(actor, pose=self.actor.pose, source=self.actor.source, scene=self.actor.scene)
+        model = self.actor.model
+        # the reference measured as every later frame's is (one pass on the crop the landmarks
+        # frame), not as the fit's (two passes averaged): the two differ by a constant offset
+        key = follow_face(frame, found.face.landmarks)
+        self._landmarks: np.ndarray | None = found.face.landmarks if key is None else key
+        self._landmark_pose = LandmarkPose(self._landmarks, self.actor.pose, model.vertices, model.triangles)
+        self._smooth = PoseFilter(max(float(fps), 1.0))
+        self._smooth(self.actor.pose)
         self.timings.fit += time.perf_counter() - t0
         self.deformer = Deformer(self.actor.model)
         contours = init_contours(self.actor)
@@ -128,13 +160,20 @@ class Analysis:
         elsewhere = 0.0  # seconds after t1 that are counted as fitting or look, not as the pose's
         measured = True
         if self.tracker.tracker is not follower:  # restarted on a face found anew: new rigid points
+            self._landmarks = self.tracker.landmarks
             self._follow_pose(fit_model(self.actor.model, reference_points(self.tracker.landmarks)).pose)
             fitting = time.perf_counter() - t1
             self.timings.fit += fitting
             elsewhere += fitting
         elif self.last.face:
-            # The pose is measured on the rigid points, or moved by the head's step without them.
-            measured = self.pose.update(self.tracker.motion)
+            # The pose is measured on the landmarks, or, where the crop shows no face, on the rigid
+            # points the flow follows, or moved by the head's step without them.
+            found = None if self._landmarks is None else follow_face(frame, self._landmarks)
+            if found is not None:
+                self._landmarks = found
+                self.pose.follow(self._smooth(self._landmark_pose.measure(found)), self.tracker.motion)
+            else:
+                measured = self.pose.update(self.tracker.motion)
         face = result.motion_ok and len(result.lost) < len(FEATURES)
         self._since_anchor += 1
         if face and not measured and self._since_anchor >= ANCHOR_EVERY:

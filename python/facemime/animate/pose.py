@@ -1,6 +1,8 @@
-"""Head pose per frame: the orthographic pose (yaw, pitch, roll, scale, translation; see
-:class:`facemime.render.projection.Pose`) that best maps rigid 3D points of the actor's model
-onto where the optical flow followed them.
+"""Head pose per frame from the optical flow: the orthographic pose (yaw, pitch, roll, scale,
+translation; see :class:`facemime.render.projection.Pose`) that best maps rigid 3D points of the
+actor's model onto where the optical flow followed them. The analysis measures the pose on the
+Face Mesh landmarks (:mod:`facemime.animate.landmark_pose`) and falls back to this on frames
+whose landmark pass finds no face.
 
 The rigid points are the tracker's head-motion points (nose, nose bridge, forehead). When a point
 is first seen, it is lifted onto the model: the front-most model triangle under it, at the pose
@@ -156,10 +158,20 @@ class PoseTracker:
             )
         else:
             self.pose = moved(self.pose, motion.step)
+        self._keep(motion)
+        return ok
+
+    def follow(self, pose: Pose, motion: HeadMotion) -> None:
+        """Take ``pose``, measured otherwise (the landmarks), as the current frame's; the points
+        ``motion`` follows are kept and new ones lifted at it, for the frames the flow measures."""
+        self.pose = pose
+        self._keep(motion)
+
+    def _keep(self, motion: HeadMotion) -> None:
+        """Forget the points ``motion`` no longer follows; lift its new ones at the current pose."""
         current = set(motion.ids.tolist())
         self._known = {i: p for i, p in self._known.items() if i in current}
         self._lift(np.asarray(motion.points, np.float64), motion.ids)
-        return ok
 
     def reset(self, pose: Pose, motion: HeadMotion) -> None:
         """Start again from ``pose`` on a new first frame (after the face was lost)."""

@@ -92,7 +92,8 @@ class SideBySide:
     measured when the video's own face is synthesised in its own scene), and ``seconds`` the
     time per stage (``decode``: waiting for the next frame; ``track``, ``pose``, ``fit``;
     ``synth``, the departure measure included; ``compose``). ``analysis`` is None until the
-    first frame. ``mask_only``: show the face alone on a plain backdrop, not in its scene."""
+    first frame. ``mask_only``: show the face alone on a plain backdrop, not in its scene.
+    ``fps``: the video's frame rate (frames a second), for the pose filter."""
 
     def __init__(
         self,
@@ -103,8 +104,10 @@ class SideBySide:
         params: TrackerParams | None = None,
         records: list[dict] | TrackWriter | None = None,
         mask_only: bool = False,
+        fps: float = 25.0,
     ):
         self._frames, self._name, self._target, self._user, self._params = frames, name, target, user, params
+        self._fps = fps
         self._mask_only = mask_only
         self.records = [] if records is None else records
         self.departs: list[list[int]] = []
@@ -126,7 +129,7 @@ class SideBySide:
             h, w = frame.shape[:2]
             if self.analysis is None:
                 try:
-                    self.analysis = Analysis(frame, f"the first frame of {self._name}", self._params)
+                    self.analysis = Analysis(frame, f"the first frame of {self._name}", self._params, fps=self._fps)
                 except NoFaceError as e:
                     raise NoFaceError(f"{e}; the video must start with a frontal face") from None
                 actor = self.analysis.actor
@@ -262,7 +265,14 @@ def run_video(
             TrackWriter(outputs.stage(track)) as records,
         ):
             work = SideBySide(
-                progress(reader, reader.frames or None, "running"), str(video), target, user, params, records, mask_only
+                progress(reader, reader.frames or None, "running"),
+                str(video),
+                target,
+                user,
+                params,
+                records,
+                mask_only,
+                reader.fps,
             )
             encode = write_frames(writer, work)
             result = work.result([out, track] + ([csv] if csv else []), encode)

@@ -209,7 +209,7 @@ class Sender(threading.Thread):
         if first is None:
             raise InputFileError(f"{source.name} has no frames")
         try:
-            self.analysis = Analysis(first, f"the first frame of {source.name}", actor=actor)
+            self.analysis = Analysis(first, f"the first frame of {source.name}", actor=actor, fps=source.fps)
         except NoFaceError as e:
             raise NoFaceError(f"{e}; the video must start with a frontal face") from None
         self.actor = actor or self.analysis.actor

@@ -100,7 +100,7 @@ def analyse(video: str | Path, actor: Actor | None = None) -> Clip:
         for frame in progress(reader, reader.frames or None, "analysing"):
             if analysis is None:
                 try:
-                    analysis = Analysis(frame, f"the first frame of {video}", actor=actor)
+                    analysis = Analysis(frame, f"the first frame of {video}", actor=actor, fps=reader.fps)
                 except NoFaceError as e:
                     raise NoFaceError(f"{e}; the video must start with a frontal face") from None
                 motion.append(analysis.last)
