@@ -128,11 +128,9 @@ def run_demo(out_dir: Path, force: bool = False, seconds: float = 6.0) -> DemoRe
         raise
 
 
-def _demo(files: list[Path], paths: list[Path], seconds: float) -> DemoResult:
-    """The demo's work: ``files`` are the outputs' names, ``paths`` where to write them."""
-    timing: dict[str, float] = {}
-
-    # 1. The actor.
+def astronaut_photo() -> np.ndarray:
+    """The demo's photo: the astronaut the package ships, framed by :data:`FRAMING` and scaled to
+    :data:`SIZE`, (H, W, 3) uint8 RGB."""
     photo = cv2.cvtColor(
         cv2.imdecode(
             np.frombuffer(resources.files("facemime.data").joinpath("astronaut.jpg").read_bytes(), np.uint8),
@@ -141,7 +139,15 @@ def _demo(files: list[Path], paths: list[Path], seconds: float) -> DemoResult:
         cv2.COLOR_BGR2RGB,
     )
     x0, y0, side = FRAMING
-    photo = cv2.resize(photo[y0 : y0 + side, x0 : x0 + side], SIZE, interpolation=cv2.INTER_CUBIC)
+    return cv2.resize(photo[y0 : y0 + side, x0 : x0 + side], SIZE, interpolation=cv2.INTER_CUBIC)
+
+
+def _demo(files: list[Path], paths: list[Path], seconds: float) -> DemoResult:
+    """The demo's work: ``files`` are the outputs' names, ``paths`` where to write them."""
+    timing: dict[str, float] = {}
+
+    # 1. The actor.
+    photo = astronaut_photo()
     t0 = time.perf_counter()
     actor = fit_actor(photo, "astronaut.jpg")[0]
     timing["fit"] = time.perf_counter() - t0

@@ -1,12 +1,10 @@
 from dataclasses import replace
-from importlib import resources
 
-import cv2
 import numpy as np
 
 from facemime.animate.analysis import Analysis
 from facemime.animate.synth import key_frame, scene_mesh, synthesize
-from facemime.demo import FRAMING, SIZE
+from facemime.demo import SIZE, astronaut_photo
 from facemime.fit.run import fit_actor
 from facemime.io.video import VideoReader
 from facemime.metrics import group_nme
@@ -46,16 +44,7 @@ def test_the_face_is_kept_through_a_fast_hand_held_head_motion(shared):
 def _rendered_turn(yaws, pitches):
     """The astronaut (the demo's actor) rendered in her scene at her fitted pose turned by
     ``yaws`` and ``pitches`` (degrees, one pair a frame), 512 x 512."""
-    photo = cv2.cvtColor(
-        cv2.imdecode(
-            np.frombuffer(resources.files("facemime.data").joinpath("astronaut.jpg").read_bytes(), np.uint8),
-            cv2.IMREAD_COLOR,
-        ),
-        cv2.COLOR_BGR2RGB,
-    )
-    x0, y0, side = FRAMING
-    photo = cv2.resize(photo[y0 : y0 + side, x0 : x0 + side], SIZE, interpolation=cv2.INTER_CUBIC)
-    actor = fit_actor(photo, "astronaut.jpg")[0]
+    actor = fit_actor(astronaut_photo(), "astronaut.jpg")[0]
     scene = scene_mesh(actor)
     key = key_frame(actor, scene)
     rest = actor.pose
