@@ -9,13 +9,15 @@ own first frame the same way (R_t R_0^T), as yaw, pitch and roll (degrees,
 - **run**: the pose of ``facemime run``'s analysis (:class:`facemime.animate.analysis.Analysis`);
 - **landmarks**: :class:`facemime.animate.landmark_pose.LandmarkPose` on one landmark pass a frame
   (:func:`facemime.face.finder.follow_face`: the crop the last frame's landmarks frame, no
-  detection), unfiltered.
+  detection), unfiltered, then through :class:`~facemime.animate.landmark_pose.PoseFilter`
+  (One-Euro) and a constant-velocity Kalman filter at the settings asked for.
 
 Per video and axis: the mean absolute error (degrees), that of reporting no rotation at all, and
 the slope of the estimate on the truth (least squares through the origin; 1 = fully measured).
 Also the landmark pass's and the alignment's milliseconds a frame (this machine, one thread).
 
     python benchmarks/pose.py [--data ../shared/data] [--videos lp_d0,vr_1] [--frames N]
+                              [--filters C:B,...] [--kalman Q:R,...]
 
 Prints a table per video, the means over the videos, and one JSON line with every figure.
 """
@@ -78,6 +80,42 @@ def figures(estimate: np.ndarray, truth: np.ndarray) -> dict[str, dict[str, floa
     }
 
 
+class ConstantVelocity:
+    """A constant-velocity Kalman filter of a pose's six values, each on its own, in the units of
+    :class:`~facemime.animate.landmark_pose.PoseFilter` (degrees, percent of scale, model units):
+    process noise ``q`` (units² a second³, white acceleration), measurement noise ``r`` (units²).
+    The issue's other candidate beside the One-Euro filter, measured here only."""
+
+    def __init__(self, fps: float, q: float, r: float):
+        dt = 1.0 / fps
+        self.f = np.array([[1.0, dt], [0.0, 1.0]])
+        self.q = q * np.array([[dt**3 / 3, dt**2 / 2], [dt**2 / 2, dt]])
+        self.r = r
+        self.x: np.ndarray | None = None  # (6, 2) value and speed
+        self.p = np.zeros((6, 2, 2))
+        self.unit = 1.0
+
+    def __call__(self, pose: Pose) -> Pose:
+        if self.x is None:
+            self.unit = pose.scale
+        u = self.unit
+        z = np.array([pose.yaw, pose.pitch, pose.roll, 100.0 * np.log(pose.scale), pose.tx / u, pose.ty / u])
+        if self.x is None:
+            self.x = np.column_stack([z, np.zeros(6)])
+            self.p[:] = np.diag([self.r, 1e3])
+        else:
+            self.x = self.x @ self.f.T
+            self.p = self.f @ self.p @ self.f.T + self.q
+            gain = self.p[:, :, 0] / (self.p[:, 0, 0] + self.r)[:, None]  # (6, 2)
+            self.x = self.x + gain * (z - self.x[:, 0])[:, None]
+            self.p = self.p - gain[:, :, None] * self.p[:, None, 0, :]
+        v = self.x[:, 0]
+        return Pose(
+            yaw=float(v[0]), pitch=float(v[1]), roll=float(v[2]), scale=float(np.exp(v[3] / 100.0)),
+            tx=float(v[4] * u), ty=float(v[5] * u),
+        )  # fmt: skip
+
+
 def jitter(estimate: np.ndarray, truth: np.ndarray, fps: float) -> tuple[float, float]:
     """The mean frame-to-frame change of the rotation (degrees, the three angles' changes
     summed) over the stillest second of the reference: the estimate's and the reference's."""
@@ -91,7 +129,13 @@ def jitter(estimate: np.ndarray, truth: np.ndarray, fps: float) -> tuple[float, 
     return float(est[i : i + n].mean()), float(step[i : i + n].mean())
 
 
-def measure(video: Path, reference: Path, frames: int | None, settings: list[tuple[float, float]]) -> dict:
+def measure(
+    video: Path,
+    reference: Path,
+    frames: int | None,
+    settings: list[tuple[float, float]],
+    kalman: list[tuple[float, float]] = (),
+) -> dict:
     ref = np.load(reference)
     run_poses, landmark_poses = [], []
     passes, aligns = [], []
@@ -127,6 +171,9 @@ def measure(video: Path, reference: Path, frames: int | None, settings: list[tup
     for cutoff, beta in settings:
         smooth = PoseFilter(fps, cutoff, beta)
         estimates[f"filtered {cutoff:g}/{beta:g}"] = relative([smooth(p) for p in landmark_poses])
+    for q, r in kalman:
+        smooth = ConstantVelocity(fps, q, r)
+        estimates[f"kalman {q:g}/{r:g}"] = relative([smooth(p) for p in landmark_poses])
     out = {}
     for method, estimate in estimates.items():
         out[method] = figures(estimate, truth)
@@ -147,13 +194,17 @@ def main() -> None:
     parser.add_argument(
         "--filters", default="1:0.3", help="PoseFilter settings to compare, MIN_CUTOFF:BETA,... (Hz, Hz per unit/s)"
     )
+    parser.add_argument(
+        "--kalman", default="100:0.1,1000:0.1", help="constant-velocity Kalman settings to compare, Q:R,... (units)"
+    )
     args = parser.parse_args()
     cv2.setNumThreads(1)
     settings = [tuple(float(v) for v in f.split(":")) for f in args.filters.split(",") if f]
+    kalman = [tuple(float(v) for v in f.split(":")) for f in args.kalman.split(",") if f]
     results = {}
     for name in args.videos.split(","):
         data = args.data / "video"
-        r = measure(data / f"{name}.mp4", data / f"{name}.landmarks.npz", args.frames, settings)
+        r = measure(data / f"{name}.mp4", data / f"{name}.landmarks.npz", args.frames, settings, kalman)
         results[name] = r
         print(
             f"{name} ({r['frames']} frames; landmark pass {r['pass_ms']:.1f} ms, alignment {r['align_ms']:.2f} ms; "
