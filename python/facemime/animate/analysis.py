@@ -35,9 +35,8 @@ from facemime.errors import NoFaceError
 from facemime.face.finder import follow_face
 from facemime.face.mesh import reference_points
 from facemime.fit.actor import Actor
-from facemime.fit.auto import auto_points
 from facemime.fit.placement import fit_model, model_iod
-from facemime.fit.run import fit_actor, init_contours
+from facemime.fit.run import find_points, fit_actor, init_contours
 from facemime.render.projection import Pose
 from facemime.track.contours import FEATURES
 from facemime.track.eyes import EyeTracker
@@ -107,13 +106,8 @@ class Analysis:
         self.params = params
         self.timings = Timings()
         t0 = time.perf_counter()
-        try:
-            found = auto_points(frame)
-        except NoFaceError:
-            raise NoFaceError(f"no face found in {name}") from None
+        found, self.warnings = find_points(frame, name)
         self.actor, _, _ = fit_actor(frame, name, found.points, model=None if actor is None else actor.model)
-        faces = found.face.faces
-        self.warnings = [f"{faces} faces found in {name}; fitting the largest"] if faces > 1 else []
         if actor is not None:  # placed on this frame, in this frame's scene
             self.actor = replace(actor, pose=self.actor.pose, source=self.actor.source, scene=self.actor.scene)
         model = self.actor.model
@@ -122,7 +116,8 @@ class Analysis:
         key = follow_face(frame, found.face.landmarks)
         self._landmarks: np.ndarray | None = found.face.landmarks if key is None else key
         self._landmark_pose = LandmarkPose(self._landmarks, self.actor.pose, model.vertices, model.triangles)
-        self._smooth = PoseFilter(max(float(fps), 1.0))
+        self._fps = max(float(fps), 1.0)
+        self._smooth = PoseFilter(self._fps)
         self._smooth(self.actor.pose)
         self.timings.fit += time.perf_counter() - t0
         self.deformer = Deformer(self.actor.model)
@@ -162,6 +157,8 @@ class Analysis:
         if self.tracker.tracker is not follower:  # restarted on a face found anew: new rigid points
             self._landmarks = self.tracker.landmarks
             self._follow_pose(fit_model(self.actor.model, reference_points(self.tracker.landmarks)).pose)
+            self._smooth = PoseFilter(self._fps)  # the face came back: no smoothing across the gap
+            self._smooth(self.pose.pose)
             fitting = time.perf_counter() - t1
             self.timings.fit += fitting
             elsewhere += fitting

@@ -10,7 +10,7 @@ import numpy as np
 
 from facemime.errors import InvalidInputError, NoFaceError
 from facemime.fit.actor import Actor, smear_texture
-from facemime.fit.auto import auto_points
+from facemime.fit.auto import AutoPoints, auto_points
 from facemime.fit.placement import fit_model
 from facemime.fit.preview import preview_sheet
 from facemime.io.actor_file import actor_bytes
@@ -35,6 +35,18 @@ class FitRun:
     residual: float = 0.0
 
 
+def find_points(photo: np.ndarray, name: str) -> tuple[AutoPoints, list[str]]:
+    """The reference points of the largest face of ``photo`` ((H, W, 3) uint8 RGB) and warnings
+    (several faces); ``name`` names the photo in them and in the
+    :class:`~facemime.errors.NoFaceError` raised where there is no face."""
+    try:
+        found = auto_points(photo)
+    except NoFaceError:
+        raise NoFaceError(f"no face found in {name}") from None
+    faces = found.face.faces
+    return found, [f"{faces} faces found in {name}; fitting the largest"] if faces > 1 else []
+
+
 def fit_actor(
     photo: np.ndarray, name: str, points: dict | None = None, frame: int = 0, model: HeadModel | None = None
 ) -> tuple[Actor, list[str], float]:
@@ -45,13 +57,8 @@ def fit_actor(
     model = model or generic_head()
     warnings: list[str] = []
     if points is None:
-        try:
-            found = auto_points(photo)
-        except NoFaceError:
-            raise NoFaceError(f"no face found in {name}") from None
+        found, warnings = find_points(photo, name)
         points = found.points
-        if found.face.faces > 1:
-            warnings.append(f"{found.face.faces} faces found in {name}; fitting the largest")
     fit = fit_model(model, points)
     source = {"file": Path(name).name, "frame": int(frame), "width": int(photo.shape[1]), "height": int(photo.shape[0])}
     return smear_texture(model, photo, fit, points, source), warnings, float(fit.residuals[-1])
