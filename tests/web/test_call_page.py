@@ -1,15 +1,23 @@
 """``facemime call`` with the receiver page in headless Chromium: two pages join a live call of a
 shared video, one receiving every packet, one dropping a share of them on purpose (``?drop=``);
 both decode what the Python decoder decodes from the call's recording, and the lossy one
-conceals, asks for intra packets and resynchronises."""
+conceals, asks for intra packets and resynchronises; a page that has lost a packet keeps asking
+while the stream stalls, and stops once in sync."""
 
 import subprocess
 import sys
+import threading
+import time
 
 import numpy as np
 
+from facemime.call.sender import FileSource, Sender
+from facemime.call.server import Hub, make_server
 from facemime.codec.params import pose_from_vector
 from facemime.codec.stream import MotionDecoder
+from facemime.io.video import VideoReader
+
+INTRA, INTER = 3, 4  # packet kinds
 
 
 def test_two_pages_receive_a_live_call_one_of_them_losing_packets(browser, shared, tmp_path):
@@ -82,3 +90,99 @@ def test_two_pages_receive_a_live_call_one_of_them_losing_packets(browser, share
     decoded = [s for s in frames if not s["concealed"]]
     assert all(same(s, by_index[s["index"]]) for s in decoded), brief
     assert len(decoded) + stats["concealed"] == len(frames) and decoded[-1]["index"] >= 200, brief
+
+
+class SteppedSource:
+    """lp_d0's frames, each one given to the sender only once the test releases it (a camera
+    that stalls when the test says)."""
+
+    def __init__(self, path):
+        self._file = FileSource(path)
+        self.name, self.fps, self.size = self._file.name, self._file.fps, self._file.size
+        self._frames = list(VideoReader(path))
+        self._released = threading.Semaphore(0)
+
+    def release(self, count: int) -> None:
+        for _ in range(count):
+            self._released.release()
+
+    def frames(self, stop):
+        for frame in self._frames:
+            while not self._released.acquire(timeout=0.1):
+                if stop.is_set():
+                    return
+            yield frame, time.time() * 1000
+
+    def close(self) -> None:
+        self._file.close()
+
+
+class LossySink:
+    """The sender's sink: every chunk to the hub, except the packets numbered in ``drop`` (lost
+    on the way); ``made`` counts the packets and keeps their kinds."""
+
+    def __init__(self):
+        self.hub, self.drop, self.kinds = None, set(), []
+        self.made = threading.Condition()
+
+    def start_stream(self, header, actor):
+        self.hub.start(header, actor)
+
+    def packet(self, first, arrived, data):
+        with self.made:
+            self.kinds.append(data[0] >> 5)
+            self.made.notify_all()
+        if len(self.kinds) - 1 not in self.drop:
+            self.hub.packet(first, arrived, data)
+
+    def end(self, error):
+        self.hub.end(error)
+
+    def wait_packets(self, count: int) -> None:
+        with self.made:
+            assert self.made.wait_for(lambda: len(self.kinds) >= count, 30), self.kinds
+
+
+def test_a_page_out_of_sync_keeps_asking_for_an_intra_packet_while_the_stream_stalls(browser, shared):
+    source, sink = SteppedSource(shared / "video" / "lp_d0.mp4"), LossySink()
+    source.release(1)  # the actor's frame
+    sender = Sender(source, sink)  # 2 frames a packet, 50 frames of warm-up
+    asked: list[float] = []
+
+    def on_intra():
+        asked.append(time.monotonic())
+        sender.request_intra()
+
+    sink.hub = Hub({"source": source.name, "fps": source.fps, "width": 0, "height": 0}, on_intra)
+    server = make_server(sink.hub, 0)
+    serving = threading.Thread(target=server.serve_forever, daemon=True)
+    serving.start()
+    page = browser.new_page()
+    try:
+        page.goto(f"http://127.0.0.1:{server.socket.getsockname()[1]}/")
+        sender.start()
+        source.release(49 + 8)  # the warm-up, then packets 0-3
+        page.wait_for_function("() => window.facemime.frames.length === 8", timeout=30000)
+        sink.drop = {4}
+        source.release(4)  # packet 4, lost, and packet 5: frames 8-11 concealed
+        sink.wait_packets(6)
+        page.wait_for_function("() => window.facemime.frames.length === 12", timeout=10000)
+        first = len(asked)
+        time.sleep(1.5)  # the stream stalls: no packet comes, and the page asks on
+        assert len(asked) - first >= 3, asked
+        source.release(4)  # the packets after the stall: the first intra, the page in sync again
+        sink.wait_packets(8)
+        page.wait_for_function("() => window.facemime.frames.length === 16", timeout=10000)
+        frames = page.evaluate("() => window.facemime.frames")
+        assert [f["concealed"] for f in frames] == [False] * 8 + [True] * 4 + [False] * 4
+        assert sink.kinds[:8] == [INTRA, INTER, INTER, INTER, INTER, INTER, INTRA, INTER]
+        settled = len(asked)
+        time.sleep(1.0)
+        assert len(asked) == settled, "the page asked for intra packets while in sync"
+    finally:
+        sender.stop()
+        sender.finished.wait(5)
+        sink.hub.close_all()
+        server.shutdown()
+        serving.join(5)
+        page.close()

@@ -1,8 +1,8 @@
 /**
  * The facemime receiver page: decodes a facemime stream (docs/bitstream.md) and draws each frame
  * on the stream's actor with WebGL2. Served by ``facemime call``, it receives a live stream over
- * a WebSocket (``/stream``) and asks the sender for an intra packet when it joins and when it
- * loses a packet; anywhere, a saved ``.fmstream`` file dropped on it (or chosen) plays.
+ * a WebSocket (``/stream``) and asks the sender for an intra packet when it joins and as soon as
+ * it decodes a loss (again, at most every ``INTRA_EVERY_MS``, until it is back in sync); anywhere, a saved ``.fmstream`` file dropped on it (or chosen) plays.
  *
  * For tests and measurements the page exposes ``window.facemime`` (see ``Api``). ``?drop=P``
  * drops each received packet with probability P (a seeded generator, ``&seed=N``), to test
@@ -151,6 +151,10 @@ const bytesAt: [number, number][] = [];
 const arrived = new Map<number, number>();
 let session: Session | null = null;
 let lastRequest = -Infinity;
+/** The live stream is out of sync (its last frame decoded was concealed): an intra packet is wanted. */
+let outOfSync = false;
+/** The pending check, ``INTRA_EVERY_MS`` after a request, of whether to ask again. */
+let retry: ReturnType<typeof setTimeout> | null = null;
 let socket: WebSocket | null = null;
 
 function present(frame: Frame, position: number): void {
@@ -191,17 +195,25 @@ function fail(text: string): void {
 }
 
 // --- live: a WebSocket from facemime call ----------------------------------------------------------
+/** Asks the sender for an intra packet (at most every ``INTRA_EVERY_MS``), and again every
+ * ``INTRA_EVERY_MS`` while the stream stays out of sync: a request, or the intra packet answering
+ * it, can be lost, and packets can come in a burst after a stall and then none (a request only
+ * on a packet's arrival would leave the page concealing to the end). */
 function requestIntra(): void {
-  const t = performance.now();
-  if (!socket || socket.readyState !== WebSocket.OPEN || t - lastRequest < INTRA_EVERY_MS) return;
-  lastRequest = t;
-  counts.intraRequests += 1;
-  socket.send(JSON.stringify({ type: 'intra' }));
+  if (!socket || socket.readyState !== WebSocket.OPEN || retry !== null) return;
+  const wait = lastRequest + INTRA_EVERY_MS - performance.now();
+  if (wait <= 0) {
+    lastRequest = performance.now();
+    counts.intraRequests += 1;
+    socket.send(JSON.stringify({ type: 'intra' }));
+  }
+  retry = setTimeout(() => { retry = null; if (outOfSync) requestIntra(); }, wait > 0 ? wait : INTRA_EVERY_MS);
 }
 
 function connect(): void {
   const live = new Session(true);
   session = live;
+  outOfSync = false;
   const ws = new WebSocket(`${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/stream`);
   ws.binaryType = 'arraybuffer';
   socket = ws;
@@ -222,8 +234,10 @@ function connect(): void {
       bytesAt.push([performance.now(), bytes.length]);
     }
     const events = live.decoder.push(bytes);
+    // asked now, as decoded, not when drawn: drawing can lag behind the stream
+    for (const e of events) if (e.kind === 'frame') outOfSync = e.frame.concealed;
+    if (outOfSync) requestIntra();
     live.take(events, (f) => {
-      if (f.concealed) requestIntra();
       api.frames.push(shown(f));
       present(f, live.frames.length - 1);
     }).catch((e) => fail(`cannot play the call: ${(e as Error).message}`));

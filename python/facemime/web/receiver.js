@@ -3724,6 +3724,8 @@ void main() {
   var arrived = /* @__PURE__ */ new Map();
   var session = null;
   var lastRequest = -Infinity;
+  var outOfSync = false;
+  var retry = null;
   var socket = null;
   function present(frame, position) {
     if (!session) return;
@@ -3758,15 +3760,22 @@ void main() {
     message.hidden = false;
   }
   function requestIntra() {
-    const t = performance.now();
-    if (!socket || socket.readyState !== WebSocket.OPEN || t - lastRequest < INTRA_EVERY_MS) return;
-    lastRequest = t;
-    counts.intraRequests += 1;
-    socket.send(JSON.stringify({ type: "intra" }));
+    if (!socket || socket.readyState !== WebSocket.OPEN || retry !== null) return;
+    const wait = lastRequest + INTRA_EVERY_MS - performance.now();
+    if (wait <= 0) {
+      lastRequest = performance.now();
+      counts.intraRequests += 1;
+      socket.send(JSON.stringify({ type: "intra" }));
+    }
+    retry = setTimeout(() => {
+      retry = null;
+      if (outOfSync) requestIntra();
+    }, wait > 0 ? wait : INTRA_EVERY_MS);
   }
   function connect() {
     const live = new Session(true);
     session = live;
+    outOfSync = false;
     const ws = new WebSocket(`${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/stream`);
     ws.binaryType = "arraybuffer";
     socket = ws;
@@ -3793,8 +3802,9 @@ void main() {
         bytesAt.push([performance.now(), bytes.length]);
       }
       const events = live.decoder.push(bytes);
+      for (const e of events) if (e.kind === "frame") outOfSync = e.frame.concealed;
+      if (outOfSync) requestIntra();
       live.take(events, (f) => {
-        if (f.concealed) requestIntra();
         api.frames.push(shown(f));
         present(f, live.frames.length - 1);
       }).catch((e) => fail(`cannot play the call: ${e.message}`));
