@@ -8,8 +8,8 @@ motion, as the paper's keyboard did: arrows turn and tilt the head, ``q``/``e`` 
 
 The page shows an MJPEG stream (``/stream``); ``/key?k=NAME`` applies a key and answers the new
 state as JSON; ``/frame.jpg`` is the next frame. The server listens on 127.0.0.1 only, answers
-only requests addressed to this machine by name (``Host``, and ``Origin`` where sent: 403
-otherwise, against DNS rebinding), of at most :data:`MAX_HEAD` bytes and without a body, and
+only requests addressed to this machine and from its own pages
+(:func:`facemime.local_only.addressed_here`: 403 otherwise), of at most :data:`MAX_HEAD` bytes and without a body, and
 serves at most ``max_clients`` connections at once (503 beyond), each dropped after ``timeout``
 seconds without progress.
 
@@ -24,7 +24,6 @@ stream ends with an image of the message.
 from __future__ import annotations
 
 import json
-import re
 import socket
 import sys
 import textwrap
@@ -50,6 +49,7 @@ from facemime.errors import FacemimeError, InputFileError, InvalidInputError, No
 from facemime.fit.actor import Actor
 from facemime.fit.placement import model_iod
 from facemime.io.video import VideoReader
+from facemime.local_only import addressed_here
 from facemime.render.projection import Pose
 from facemime.render.texture_map import fill
 from facemime.track.overlay import draw_contours
@@ -71,10 +71,6 @@ KEYS = {
 HELP = "arrows: turn and tilt · q/e: roll · +/-: zoom · x/z: more/less motion · r: reset · space: pause"
 #: The most bytes of a request's line and headers together.
 MAX_HEAD = 8192
-#: ``Host`` values (any port) and ``Origin`` values the server answers: this machine's own names.
-LOOPBACK = r"(?:127\.0\.0\.1|localhost|\[::1\])(?::\d{1,5})?"
-LOOPBACK_HOST = re.compile(LOOPBACK, re.IGNORECASE)
-LOOPBACK_ORIGIN = re.compile(rf"https?://{LOOPBACK}", re.IGNORECASE)
 
 
 class Viewer:
@@ -411,12 +407,8 @@ def make_server(viewer: Viewer, port: int = 8765, timeout: float = 10.0, max_cli
             """Refuse requests not addressed to this machine by name (403) and requests with a body (413)."""
             if not super().parse_request():
                 return False
-            hosts, origin = self.headers.get_all("Host", []), self.headers.get("Origin")
-            if (
-                len(hosts) != 1
-                or not LOOPBACK_HOST.fullmatch(hosts[0])
-                or (origin is not None and not LOOPBACK_ORIGIN.fullmatch(origin))
-            ):
+            hosts, origins = self.headers.get_all("Host", []), self.headers.get_all("Origin", [])
+            if not addressed_here(hosts, origins, self.server.server_address[1]):
                 self.send_error(HTTPStatus.FORBIDDEN, "only pages of this machine may use the viewer")
                 return False
             if self.headers.get("Content-Length", "0").strip() != "0" or "Transfer-Encoding" in self.headers:

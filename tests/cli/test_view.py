@@ -209,20 +209,23 @@ def test_a_track_with_wrong_fields_gives_one_line(recorded, tmp_path, capsys, mo
     [
         ({}, 200),
         ({"Host": "localhost"}, 200),
-        ({"Host": "LOCALHOST:9"}, 200),
-        ({"Host": "[::1]:8765"}, 200),
-        ({"Origin": "http://127.0.0.1:8765"}, 200),
+        ({"Host": "LOCALHOST:{port}"}, 200),
+        ({"Origin": "http://127.0.0.1:{port}"}, 200),
+        ({"Host": "localhost:1"}, 403),  # another port: a server of its own
+        ({"Host": "[::1]:{port}"}, 403),  # the viewer listens on 127.0.0.1 only
         ({"Host": "evil.example"}, 403),
-        ({"Host": "evil.example:8765"}, 403),
+        ({"Host": "evil.example:{port}"}, 403),
         ({"Host": "127.0.0.1.evil.example"}, 403),
         ({"Origin": "http://evil.example"}, 403),
+        ({"Origin": "http://localhost:1"}, 403),  # a page served on another port of this machine
+        ({"Origin": "https://127.0.0.1:{port}"}, 403),
         ({"Origin": "null"}, 403),
         ({"X-Pad": "a" * 9000}, 431),
     ],
 )
 def test_requests_not_addressed_to_this_machine_are_forbidden(serve, headers, status):
     port = serve()
-    assert get(port, "/", headers)[0] == status
+    assert get(port, "/", {k: v.format(port=port) for k, v in headers.items()})[0] == status
 
 
 def test_oversized_requests_and_bodies_are_refused(serve):

@@ -2,8 +2,8 @@
 ``/receiver.js``, from the package's ``web`` folder) and the live stream as a WebSocket
 (``/stream``).
 
-Requests must be addressed to this machine by name and port (``Host``, and ``Origin`` where sent,
-``127.0.0.1`` or ``localhost`` with this server's port: 403 otherwise, against DNS rebinding).
+Requests must be addressed to this machine and come from the server's own pages
+(:func:`facemime.local_only.addressed_here`: 403 otherwise).
 
 The WebSocket protocol (server → client; every chunk of the stream is one binary message):
 
@@ -31,7 +31,6 @@ import contextlib
 import email.utils
 import json
 import logging
-import re
 import socket
 import threading
 import time
@@ -48,6 +47,7 @@ from websockets.http11 import Request, Response
 from websockets.sync.server import Server, ServerConnection, serve
 
 from facemime.errors import InvalidInputError
+from facemime.local_only import addressed_here
 
 #: The port ``facemime call`` listens on unless told (0: any free port).
 PORT = 8766
@@ -273,14 +273,7 @@ def make_server(hub: Hub, port: int = PORT, web: Path | Traversable | None = Non
     bound: list[int] = []
 
     def process_request(connection: ServerConnection, request: Request) -> Response | None:
-        names = rf"(?:127\.0\.0\.1|localhost):{bound[0]}"
-        hosts, origins = request.headers.get_all("Host"), request.headers.get_all("Origin")
-        if (
-            len(hosts) != 1
-            or not re.fullmatch(names, hosts[0], re.IGNORECASE)
-            or len(origins) > 1
-            or (origins and not re.fullmatch(rf"http://{names}", origins[0], re.IGNORECASE))
-        ):
+        if not addressed_here(request.headers.get_all("Host"), request.headers.get_all("Origin"), bound[0]):
             return _response(403, "Forbidden", b"only pages of this machine may use the call", "text/plain")
         path = urlsplit(request.path).path
         if path == "/stream":
