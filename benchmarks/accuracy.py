@@ -1,10 +1,14 @@
 """Tracking accuracy on the ten shared videos (NME of the shared data README), initialised from
-the reference contours of the first frame, against two baselines measured in the same run:
+the reference contours of the first frame, against three baselines measured in the same run:
 
 - static: the first frame's contours held;
 - LK: OpenCV's pyramidal Lucas-Kanade (calcOpticalFlowPyrLK, 21×21 window, 3 levels) tracking the
   same points frame to frame, with a forward-backward check (a point whose back-tracked position
-  lands more than 1 px from where it started keeps its previous position).
+  lands more than 1 px from where it started keeps its previous position);
+- landmarks alone: the package's face landmark model read every frame (one pass on the crop the
+  last landmarks frame, as the analysis runs it for the head pose), no snakes. The references
+  are a Face Mesh's too (MediaPipe's, with its iris refinement): this baseline shares their
+  convention, and its figures flatter it against the snakes, which settle on the image's edges.
 
 Next to the NME, **mouth opening**: per frame, the error of the inner lips' opening (the
 distance from the inner upper to the inner lower lip along the mouth's normal, mean over the
@@ -39,6 +43,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from facemime.face.finder import follow_face
 from facemime.io.video import VideoReader
 from facemime.metrics import group_nme, pooled_summary, resample, summarize
 from facemime.track import TrackerParams
@@ -107,6 +112,19 @@ def run_lk(frames: list[np.ndarray], init: dict) -> list[dict]:
     return out
 
 
+def run_landmarks(frames: list[np.ndarray], first: np.ndarray) -> list[dict]:
+    """The contours of frames 1.. read from the package's face landmark model alone: one pass a
+    frame on the crop the last landmarks frame (from the reference's on the first frame), as the
+    analysis runs it for the pose; where the crop shows no face the last contours stay."""
+    out, last = [], first
+    for frame in frames[1:]:
+        found = follow_face(frame, last)
+        if found is not None:
+            last = found
+        out.append(from_face_mesh(last))
+    return out
+
+
 def score(tracks: list[dict], landmarks: np.ndarray, valid: np.ndarray, iod: np.ndarray) -> dict[str, np.ndarray]:
     """Per-frame NME of each group and mouth-opening error over IOD, over the scored frames
     (1..T-1 with a reference face)."""
@@ -141,7 +159,7 @@ def main() -> None:
     args = ap.parse_args()
     cv2.setNumThreads(1)
     methods = variants() if args.variants else dict(list(variants().items())[:2])
-    names = ["static", "LK + FB"] + list(methods)
+    names = ["static", "LK + FB", "landmarks alone"] + list(methods)
     series: dict[str, dict[str, list[np.ndarray]]] = {m: {g: [] for g in SCORED} for m in names}
     lost: dict[str, dict[str, int]] = {m: {} for m in methods}
     redetected: dict[str, dict[str, list[int]]] = {m: {} for m in methods}
@@ -159,7 +177,11 @@ def main() -> None:
         start = int(np.flatnonzero(valid)[0])
         frames, lm, valid, iod = frames[start:], lm[start:], valid[start:], iod[start:]
         init = from_face_mesh(lm[0])
-        runs = {"static": [init] * (len(frames) - 1), "LK + FB": run_lk(frames, init)}
+        runs = {
+            "static": [init] * (len(frames) - 1),
+            "LK + FB": run_lk(frames, init),
+            "landmarks alone": run_landmarks(frames, lm[0].astype(np.float64)),
+        }
         for m, method in methods.items():
             t0 = time.perf_counter()
             runs[m], lost[m][video], redetected[m][video], checks = run_tracker(frames, init, method)

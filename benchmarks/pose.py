@@ -12,12 +12,19 @@ own first frame the same way (R_t R_0^T), as yaw, pitch and roll (degrees,
   detection), unfiltered, then through :class:`~facemime.animate.landmark_pose.PoseFilter`
   (One-Euro) and a constant-velocity Kalman filter at the settings asked for.
 
+- **openseeface** (with ``--openseeface DIR``): the peer, OpenSeeFace's tracker (BSD-2,
+  github.com/emilianavt/OpenSeeFace; a checkout at DIR with its ``models`` folder, and
+  ``onnxruntime`` installed apart: neither is a facemime dependency), landmark model
+  ``--openseeface-model`` (0 by default: the only one its repository snapshot here holds whole),
+  one thread: its head rotation, OpenCV's ``solvePnP`` of its 3-D face model, in this frame.
+
 Per video and axis: the mean absolute error (degrees), that of reporting no rotation at all, and
 the slope of the estimate on the truth (least squares through the origin; 1 = fully measured).
-Also the landmark pass's and the alignment's milliseconds a frame (this machine, one thread).
+Also milliseconds a frame (this machine, one thread): the landmark pass and the alignment, the
+whole of ``run``'s analysis (contours, pose, eyes), and the peer's tracker.
 
     python benchmarks/pose.py [--data ../shared/data] [--videos lp_d0,vr_1] [--frames N]
-                              [--filters C:B,...] [--kalman Q:R,...]
+                              [--filters C:B,...] [--kalman Q:R,...] [--openseeface DIR]
 
 Prints a table per video, the means over the videos, and one JSON line with every figure.
 """
@@ -30,8 +37,10 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import argparse
 import json
+import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import cv2
 import numpy as np
@@ -116,6 +125,44 @@ class ConstantVelocity:
         )  # fmt: skip
 
 
+#: OpenSeeFace's camera frame to this benchmark's (x right, y up, z back): its landmarks are (row,
+#: column), so its solvePnP sees the picture transposed; after the swap, OpenCV's frame (x right,
+#: y down, z forward) turned half a turn about the optical axis is the one in which the signs of
+#: its yaw, pitch and roll agree with the reference's (found on lp_d3, st_aoc and st_kh: each
+#: other choice reversed one or two of them on all three).
+PEER_FRAME = np.diag([-1.0, 1.0, -1.0]) @ np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+
+
+class OpenSeeFace:
+    """The peer: OpenSeeFace's tracker from a checkout at ``folder``, for frames of ``size``
+    (width, height), landmark model ``model``, one thread."""
+
+    def __init__(self, folder: Path, size: tuple[int, int], model: int):
+        sys.path.insert(0, str(folder))
+        import tracker as osf  # the peer's module, from its checkout
+
+        def flat_pnp(*args, **kwargs):
+            # its code turns solvePnP's (3, 1) vectors into rows and adds them to 3-vectors, which
+            # numpy 2 refuses; flat vectors give it what it expects (its own arithmetic unchanged)
+            ok, rvec, tvec = cv2.solvePnP(*args, **kwargs)
+            return ok, rvec.reshape(3), tvec.reshape(3)
+
+        names = {n: getattr(cv2, n) for n in dir(cv2) if not n.startswith("__") and n != "solvePnP"}
+        osf.cv2 = SimpleNamespace(**names, solvePnP=flat_pnp)
+        self._tracker = osf.Tracker(
+            *size, model_type=model, max_threads=1, silent=True, model_dir=str(folder / "models"), max_faces=1
+        )
+        self._rotation = np.eye(3)
+
+    def rotation(self, rgb: np.ndarray) -> np.ndarray:
+        """The head's rotation in ``rgb`` (the last one where it finds no face)."""
+        faces = self._tracker.predict(cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+        if faces and faces[0].success:
+            seen = cv2.Rodrigues(np.asarray(faces[0].rotation, np.float64))[0]
+            self._rotation = PEER_FRAME @ seen @ PEER_FRAME.T
+        return self._rotation
+
+
 def jitter(estimate: np.ndarray, truth: np.ndarray, fps: float) -> tuple[float, float]:
     """The mean frame-to-frame change of the rotation (degrees, the three angles' changes
     summed) over the stillest second of the reference: the estimate's and the reference's."""
@@ -135,14 +182,21 @@ def measure(
     frames: int | None,
     settings: list[tuple[float, float]],
     kalman: list[tuple[float, float]] = (),
+    peer: tuple[Path, int] | None = None,
 ) -> dict:
     ref = np.load(reference)
-    run_poses, landmark_poses = [], []
-    passes, aligns = [], []
+    run_poses, landmark_poses, peer_rotations = [], [], []
+    passes, aligns, runs, peer_times = [], [], [], []
     with VideoReader(video) as reader:
         for n, frame in enumerate(reader):
             if frames is not None and n >= frames:
                 break
+            if peer is not None:
+                if n == 0:
+                    other = OpenSeeFace(peer[0], (frame.shape[1], frame.shape[0]), peer[1])
+                t0 = time.perf_counter()
+                peer_rotations.append(other.rotation(frame))
+                peer_times.append(time.perf_counter() - t0)
             if n == 0:
                 analysis = Analysis(frame, video.name)
                 key = find_face(frame).landmarks
@@ -153,7 +207,9 @@ def measure(
                 landmark_poses.append(estimator.measure(key))
                 last = key
                 continue
+            t0 = time.perf_counter()
             run_poses.append(analysis.update(frame).pose)
+            runs.append(time.perf_counter() - t0)
             t0 = time.perf_counter()
             found = follow_face(frame, last)
             t1 = time.perf_counter()
@@ -168,6 +224,8 @@ def measure(
     truth = reference_angles(ref["landmarks"][:count].astype(np.float64), ref["valid"][:count])
     fps = float(ref["fps"])
     estimates = {"run": relative(run_poses), "landmarks": relative(landmark_poses)}
+    if peer_rotations:
+        estimates["openseeface"] = np.array([angles(r @ peer_rotations[0].T) for r in peer_rotations])
     for cutoff, beta in settings:
         smooth = PoseFilter(fps, cutoff, beta)
         estimates[f"filtered {cutoff:g}/{beta:g}"] = relative([smooth(p) for p in landmark_poses])
@@ -183,6 +241,8 @@ def measure(
         **out,
         "pass_ms": 1000 * float(np.mean(passes)) if passes else float("nan"),
         "align_ms": 1000 * float(np.mean(aligns)) if aligns else float("nan"),
+        "run_ms": 1000 * float(np.mean(runs)) if runs else float("nan"),
+        "peer_ms": 1000 * float(np.mean(peer_times)) if peer_times else float("nan"),
     }
 
 
@@ -197,17 +257,21 @@ def main() -> None:
     parser.add_argument(
         "--kalman", default="100:0.1,1000:0.1", help="constant-velocity Kalman settings to compare, Q:R,... (units)"
     )
+    parser.add_argument("--openseeface", type=Path, default=None, help="an OpenSeeFace checkout: run the peer too")
+    parser.add_argument("--openseeface-model", type=int, default=0, help="the peer's landmark model (0-4)")
     args = parser.parse_args()
     cv2.setNumThreads(1)
+    peer = None if args.openseeface is None else (args.openseeface, args.openseeface_model)
     settings = [tuple(float(v) for v in f.split(":")) for f in args.filters.split(",") if f]
     kalman = [tuple(float(v) for v in f.split(":")) for f in args.kalman.split(",") if f]
     results = {}
     for name in args.videos.split(","):
         data = args.data / "video"
-        r = measure(data / f"{name}.mp4", data / f"{name}.landmarks.npz", args.frames, settings, kalman)
+        r = measure(data / f"{name}.mp4", data / f"{name}.landmarks.npz", args.frames, settings, kalman, peer)
         results[name] = r
         print(
-            f"{name} ({r['frames']} frames; landmark pass {r['pass_ms']:.1f} ms, alignment {r['align_ms']:.2f} ms; "
+            f"{name} ({r['frames']} frames; landmark pass {r['pass_ms']:.1f} ms, alignment {r['align_ms']:.2f} ms, "
+            f"run's analysis {r['run_ms']:.1f} ms, peer {r['peer_ms']:.1f} ms; "
             f"reference jitter {r['reference jitter']:.3f}°)"
         )
         for method in (k for k in r if isinstance(r[k], dict)):
@@ -227,6 +291,8 @@ def main() -> None:
             for a in AXES
         )
         print(f"  {method:18s} {cells}  jitter {np.mean([r['jitter'] for r in rs]):.3f}° ({reference_jitter:.3f}°)")
+    for key, what in (("pass_ms", "landmark pass"), ("run_ms", "run's analysis"), ("peer_ms", "peer")):
+        print(f"  {what}: {np.mean([r[key] for r in results.values()]):.1f} ms a frame")
     print(json.dumps(results))
 
 
