@@ -44,7 +44,7 @@ import numpy as np
 
 from facemime.animate.analysis import Analysis
 from facemime.animate.replay import FPS_RANGE, load_replay
-from facemime.animate.synth import BACKGROUND, Puppet, UserMotion
+from facemime.animate.synth import Puppet, UserMotion
 from facemime.errors import FacemimeError, InputFileError, InvalidInputError, NoFaceError
 from facemime.fit.actor import Actor
 from facemime.fit.placement import model_iod
@@ -52,6 +52,7 @@ from facemime.io.video import VideoReader
 from facemime.local_only import addressed_here
 from facemime.render.projection import Pose
 from facemime.render.texture_map import fill
+from facemime.shared_constants import BACKGROUND
 from facemime.track.overlay import draw_contours
 
 #: Key -> the change it makes to the user motion.

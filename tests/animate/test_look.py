@@ -11,7 +11,7 @@ from facemime.animate.synth import Puppet
 from facemime.fit.actor import generic_actor
 from facemime.fit.placement import model_iod
 from facemime.render.projection import project
-from facemime.track.eyes import EYES
+from facemime.shared_constants import EYES
 
 
 @pytest.fixture(scope="module")

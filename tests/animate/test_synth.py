@@ -1,10 +1,11 @@
 import numpy as np
 import pytest
 
-from facemime.animate.synth import SEAL, Puppet, UserMotion, draw_mouth_interior, synthesize, teeth_uncovered
+from facemime.animate.synth import Puppet, UserMotion, draw_mouth_interior, synthesize, teeth_uncovered
 from facemime.errors import InvalidInputError
 from facemime.fit.placement import model_iod
 from facemime.render.projection import project
+from facemime.shared_constants import SEAL
 
 GREEN = (0, 255, 0)
 
@@ -161,9 +162,9 @@ def test_another_actor_plays_in_its_own_picture_moved_as_the_source_moves(actor,
 
     import cv2
 
-    from facemime.animate.synth import BACKGROUND
     from facemime.fit.actor import smear_texture
     from facemime.fit.placement import fit_model
+    from facemime.shared_constants import BACKGROUND
 
     frame, points, _ = lp_d0
     tall = np.zeros((768, 512, 3), np.uint8)

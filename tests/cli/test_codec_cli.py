@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from codec.reference_decoder import chunks
-from facemime.animate.synth import BACKGROUND
 from facemime.io.actor_file import save_actor
 from facemime.io.video import VideoReader
+from facemime.shared_constants import BACKGROUND
 
 from .test_cli import first_frames, run
 

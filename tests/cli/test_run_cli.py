@@ -9,11 +9,11 @@ import pytest
 
 from facemime.animate.look import NAMES
 from facemime.animate.run import SideBySide
-from facemime.animate.synth import BACKGROUND
 from facemime.errors import InputFileError
 from facemime.io.contours_json import read_motion
 from facemime.io.video import VideoReader, VideoWriter
 from facemime.metrics import group_nme
+from facemime.shared_constants import BACKGROUND
 from facemime.track.contours import GROUPS, from_face_mesh
 from facemime.track.overlay import draw_contours
 

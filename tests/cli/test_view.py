@@ -19,9 +19,9 @@ import numpy as np
 import pytest
 
 from facemime.animate.run import run_video
-from facemime.animate.synth import BACKGROUND
 from facemime.errors import InvalidInputError
 from facemime.io.video import VideoReader
+from facemime.shared_constants import BACKGROUND
 from facemime.viewer import HELP, Viewer, make_server
 
 from .test_cli import first_frames, run

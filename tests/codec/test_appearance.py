@@ -14,7 +14,7 @@ from facemime.codec.appearance import BLEND, CHECK, WINDOW, Appearance, Appearan
 from facemime.fit.actor import generic_actor
 from facemime.fit.placement import model_iod
 from facemime.render.projection import project
-from facemime.track.eyes import EYES
+from facemime.shared_constants import EYES
 
 
 def test_an_update_inside_the_texture_fades_in_over_its_edges():

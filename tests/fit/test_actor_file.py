@@ -131,8 +131,9 @@ def test_the_scene_round_trips_and_is_the_whole_source_picture(tmp_path, actor, 
 def test_a_file_without_a_scene_loads_and_shows_the_face_alone(tmp_path, actor):
     from dataclasses import replace
 
-    from facemime.animate.synth import BACKGROUND, Puppet
+    from facemime.animate.synth import Puppet
     from facemime.fit.placement import model_iod
+    from facemime.shared_constants import BACKGROUND
 
     path = save_actor(tmp_path / "old.actor", replace(actor, scene=None))
     with zipfile.ZipFile(path) as z:

@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 
 from facemime.errors import InputFileError, ModelFormatError
-from facemime.model import CONTOUR_GROUPS, REQUIRED_GROUPS, generic_head, load_head
+from facemime.model import REQUIRED_GROUPS, generic_head, load_head
 from facemime.model.head import HEAD_FORMAT
+from facemime.shared_constants import CONTOUR_GROUPS
 
 SNAKE_KNOTS = {
     "mouth_outer_upper": 11,

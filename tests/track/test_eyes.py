@@ -11,7 +11,8 @@ from facemime.animate.synth import Puppet
 from facemime.fit.actor import generic_actor
 from facemime.fit.placement import model_iod
 from facemime.io.video import VideoReader
-from facemime.track.eyes import DENSITY, SPAN_U, SPAN_V, EyeFrame, EyeTracker, find_iris
+from facemime.shared_constants import DENSITY, SPAN_U, SPAN_V
+from facemime.track.eyes import EyeFrame, EyeTracker, find_iris
 
 
 def drawn_eye(iris_uv: tuple[float, float]) -> np.ndarray:

@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 
 from facemime.animate.deform import Deformer
-from facemime.animate.run import NO_FACE_DIM
 from facemime.animate.synth import Puppet
 from facemime.codec.appearance import Appearance
 from facemime.codec.files import encode_video
 from facemime.codec.params import look_from_extras, pose_from_vector
 from facemime.codec.stream import MotionDecoder, Settings
 from facemime.fit.placement import model_iod
+from facemime.shared_constants import NO_FACE_DIM
 
 
 @pytest.fixture(scope="module")

@@ -22,13 +22,9 @@ import numpy as np
 from facemime.errors import InvalidInputError
 from facemime.fit.placement import model_iod
 from facemime.metrics import resample
-from facemime.model.head import CONTOUR_GROUPS, HeadModel
+from facemime.model.head import HeadModel
 from facemime.render.projection import Pose, rotation_matrix
-
-#: Softening of the Shepard weights and reach of the far-field anchor, fractions of the
-#: distance between the outer eye corners.
-SOFTEN = 0.02
-REACH = 0.45
+from facemime.shared_constants import CONTOUR_GROUPS, REACH, SOFTEN
 
 UPPER = ("mouth_outer_upper", "mouth_inner_upper")
 LOWER = ("mouth_outer_lower", "mouth_inner_lower")

@@ -38,7 +38,7 @@ from facemime.animate.deform import Deformer
 from facemime.animate.eyes import close_lids
 from facemime.errors import InvalidInputError
 from facemime.model.head import HeadModel
-from facemime.track.eyes import EYES
+from facemime.shared_constants import EYES
 
 #: The controls, in the order of every weight vector.
 NAMES: tuple[str, ...] = (

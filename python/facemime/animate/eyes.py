@@ -19,15 +19,18 @@ import numpy as np
 from facemime.animate.look import Look
 from facemime.fit.actor import Actor
 from facemime.render.bilinear import shift_offset, shifted
-from facemime.track.eyes import EYES, LID_EDGE, SPAN_U, SPAN_V, EyeFrame, find_iris
-
-#: The ring positions of the upper-lid vertices and of the lower-lid vertices below them.
-UPPER_LID = (1, 2, 3)
-LOWER_LID = (7, 6, 5)
-#: An iris shifted less than this (texture px) is drawn as on the key frame.
-STILL = 0.25
-#: The iris pasted is this many times the measured radius (its dark rim included).
-IRIS_REACH = 1.15
+from facemime.shared_constants import (
+    EYES,
+    IRIS_RADIUS,
+    IRIS_REACH,
+    LID_EDGE,
+    LOWER_LID,
+    PASTE_STILL,
+    SPAN_U,
+    SPAN_V,
+    UPPER_LID,
+)
+from facemime.track.eyes import EyeFrame, find_iris
 
 
 def close_lids(vertices: np.ndarray, rings: list[np.ndarray], closure: np.ndarray) -> np.ndarray:
@@ -57,7 +60,7 @@ class _Eye:
         region = texture[y0:y1, x0:x1]
         self.iris_uv = find_iris(frame.patch(texture))[0]
         centre = frame.to_image(self.iris_uv) - [x0, y0]
-        self.radius = 0.21 * w * IRIS_REACH
+        self.radius = IRIS_RADIUS * w * IRIS_REACH
         shape = region.shape[:2]
         yy, xx = np.mgrid[0 : shape[0], 0 : shape[1]].astype(np.float32)
         self.disc = np.clip(self.radius + 0.5 - np.hypot(xx - centre[0], yy - centre[1]), 0.0, 1.0)
@@ -97,7 +100,7 @@ class _Eye:
         ``shift`` (u, v) eye widths."""
         x0, y0, x1, y1 = self.box
         d = np.asarray(shift, np.float64) @ self.frame.axes  # texture px
-        if np.abs(d).max() < STILL:
+        if np.abs(d).max() < PASTE_STILL:
             out[y0:y1, x0:x1] = self.iris  # the key frame's eye as it was
             return
         offset = shift_offset(d)

@@ -16,8 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-#: The look's values in the order of :meth:`Look.vector` (and of the bitstream's kinds 1-6).
-NAMES = ("eye_right_closure", "eye_left_closure", "iris_right_u", "iris_right_v", "iris_left_u", "iris_left_v")
+from facemime.shared_constants import LOOK_NAMES as NAMES  # the order of Look.vector and of the stream's kinds
 
 
 def _frozen(values, shape: tuple[int, ...]) -> np.ndarray:

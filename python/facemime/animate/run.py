@@ -24,7 +24,7 @@ import numpy as np
 from facemime.animate.analysis import Analysis
 from facemime.animate.departure import DEPARTS_AT, departure
 from facemime.animate.expressions import Expressions
-from facemime.animate.synth import BACKGROUND, Puppet, UserMotion
+from facemime.animate.synth import Puppet, UserMotion
 from facemime.errors import InputFileError, InvalidInputError, NoFaceError
 from facemime.fit.actor import Actor
 from facemime.fit.placement import model_iod
@@ -35,12 +35,9 @@ from facemime.io.video import CODECS, VideoReader, VideoWriter
 from facemime.progress import track as progress
 from facemime.render.projection import Pose, project
 from facemime.render.texture_map import fill
+from facemime.shared_constants import BACKGROUND, NO_FACE_DIM, POSE_FIELDS
 from facemime.track.overlay import draw_contours
 from facemime.track.tracker import TrackerParams
-
-POSE_FIELDS = ("yaw", "pitch", "roll", "scale", "tx", "ty")
-#: Tint of the synthesised half in frames without a face.
-NO_FACE_DIM = 0.45
 
 
 @dataclass

@@ -23,37 +23,22 @@ from facemime.fit.placement import model_iod
 from facemime.render.projection import Pose, project
 from facemime.render.scene import SceneMesh
 from facemime.render.texture_map import fill, render_mesh_into
-
-BACKGROUND = (38, 40, 46)
-CAVITY = (52, 18, 22)
-#: Teeth as filmed, not white: the brightest 30% of the mouth opening's pixels in lp_d0's grin
-#: average (185, 161, 146) (lp_d6: 188, 144, 142); measured against (214, 208, 192), mouth PSNR
-#: lp_d0 26.4 -> 27.2 dB, lp_d3 24.1 -> 24.4 dB.
-TEETH = (185, 165, 150)
-GAPS = (150, 140, 128)
-#: Visible height of the upper and lower teeth, fractions of the mouth's width, and the part of
-#: the mouth's width they span (centred).
-UPPER_TEETH = 0.11
-LOWER_TEETH = 0.07
-TEETH_SPAN = 0.72
-#: Most of the opening each row of teeth fills: together all of it, so that teeth meet in a
-#: grin and the dark cavity shows only once the opening exceeds both rows' heights.
-UPPER_SHARE = 0.6
-LOWER_SHARE = 0.4
-#: Opening (fraction of the mouth's width) below which no teeth show: a mouth barely apart shows
-#: the dark gap between the lips.
-TEETH_FROM = 0.04
-#: The lips uncover the teeth as they spread: from none while the mouth's corners are at most
-#: TEETH_SPREAD[0] times their rest distance apart (talking, an "O") to all from TEETH_SPREAD[1]
-#: (a smile or a grin); the upper row always shows at least UPPER_MIN of its height. Measured:
-#: mouth PSNR on lp_d3 (talking, an "O") 23.5 -> 24.1 dB, lp_d0's grin unchanged.
-TEETH_SPREAD = (0.9, 1.05)
-UPPER_MIN = 0.5
-#: Measured motion shows lips whose inner edges are closer than this fraction of the mouth's
-#: width as closed (:meth:`Deformer.sealed`): the tracked inner lips of a closed mouth lie a
-#: pixel or two apart, and the dark line that gap drew cost up to 8 dB in the mouth region.
-SEAL = 0.05
-SHIFT = 4  # sub-pixel bits for cv2 drawing
+from facemime.shared_constants import (
+    BACKGROUND,
+    CAVITY,
+    GAPS,
+    LOWER_SHARE,
+    LOWER_TEETH,
+    SEAL,
+    SHIFT,
+    TEETH,
+    TEETH_FROM,
+    TEETH_SPAN,
+    TEETH_SPREAD,
+    UPPER_MIN,
+    UPPER_SHARE,
+    UPPER_TEETH,
+)
 
 
 def teeth_uncovered(spread: float) -> float:

@@ -31,7 +31,7 @@ import numpy as np
 from facemime.model.head import HeadModel
 from facemime.render.projection import Pose, project, rotation_matrix
 from facemime.render.texture_map import render_mesh_into
-from facemime.track.eyes import EYES
+from facemime.shared_constants import EYES
 
 #: Texels over which an update's edges fade into the texture (the spec's B).
 BLEND = 8

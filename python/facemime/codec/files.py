@@ -25,8 +25,7 @@ from facemime import _core
 from facemime.animate.analysis import Analysis, FrameMotion
 from facemime.animate.deform import Deformer
 from facemime.animate.look import Look
-from facemime.animate.run import NO_FACE_DIM
-from facemime.animate.synth import BACKGROUND, Puppet
+from facemime.animate.synth import Puppet
 from facemime.codec.appearance import Appearance, AppearanceSender
 from facemime.codec.params import Basis, pose_vector
 from facemime.codec.stream import LADDER, MotionDecoder, MotionEncoder, Settings, StreamError
@@ -38,6 +37,7 @@ from facemime.io.outputs import check_outputs, write_bytes
 from facemime.io.video import CODECS, VideoReader, VideoWriter
 from facemime.progress import track as progress
 from facemime.render.texture_map import fill
+from facemime.shared_constants import BACKGROUND, NO_FACE_DIM
 
 SUFFIX = ".fmstream"
 #: Largest stream file read, bytes.

@@ -20,14 +20,12 @@ from functools import cached_property
 import numpy as np
 
 from facemime.animate.deform import Deformer
-from facemime.animate.look import NAMES as LOOK_NAMES
 from facemime.animate.look import Look
 from facemime.model.head import HeadModel
 from facemime.render.projection import Pose
+from facemime.shared_constants import BASIS_ONE, LOOK_NAMES, POSE_FIELDS
 
-POSE_PARAMETERS = 6
-#: Entries of a basis vector are sent ×BASIS_ONE as int16.
-BASIS_ONE = 32767
+POSE_PARAMETERS = len(POSE_FIELDS)
 #: The extra parameters' kinds of the look's values, in the order of :meth:`Look.vector`
 #: (``facemime.animate.look.NAMES``): kind k is ``vector()[k - 1]``.
 LOOK_KINDS = tuple(range(1, len(LOOK_NAMES) + 1))

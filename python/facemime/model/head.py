@@ -25,20 +25,10 @@ import numpy as np
 
 from facemime.errors import InputFileError, InvalidInputError, ModelFormatError
 from facemime.io.limits import limit, parse_json
+from facemime.shared_constants import CONTOUR_GROUPS
 
 HEAD_FORMAT = "facemime.head/1"
 
-#: Groups ordered like the snake contours (image-left to image-right), one vertex per knot.
-CONTOUR_GROUPS = (
-    "mouth_outer_upper",
-    "mouth_outer_lower",
-    "mouth_inner_upper",
-    "mouth_inner_lower",
-    "brow_left_upper",
-    "brow_left_lower",
-    "brow_right_upper",
-    "brow_right_lower",
-)
 #: Groups every facemime head file must have.
 REQUIRED_GROUPS = CONTOUR_GROUPS + ("eye_left", "eye_right", "nose", "face_outline")
 #: Default input limits, each overridden by its environment variable (see the module docstring).

@@ -32,27 +32,15 @@ import numpy as np
 
 from facemime.errors import InvalidInputError
 from facemime.render.texture_map import render_mesh_into
+from facemime.shared_constants import BORDER_STEPS, EDGE_MARGIN, RINGS, SLOW
 from facemime.track.motion import apply, robust_similarity
 
 #: (distance from the face's centre as a multiple of the outline's, share of the head's motion
 #: followed) per ring: the first reaches over the hair and ears and moves with the head; the
 #: second holds the room still, the band between them stretching over what the head uncovers.
-#: Whole-frame PSNR on the ten shared videos against the frozen key frame: rings at 1.45, 2.1,
-#: 3.0 following 1, 0.55, 0.2 of the outline's affine motion were below it on seven videos (vr_1
-#: 26.1 dB against 28.5); the room held still from 1.8 on, five; this ring at 1.2 following the
-#: outline's similarity motion, still from 1.7, two (lp_d3 17.7 against 18.4, st_aoc 15.8 against
-#: 16.4, where the head moves far from where the key frame has it and the tracked pose errs).
-RINGS = ((1.2, 1.0), (1.7, 0.0))
-#: Ring vertices nearer the picture's edge than this fraction of its shorter side (or outside it)
-#: are left out: the border holds the picture there.
-EDGE_MARGIN = 0.04
-#: Border vertices per side (corners included).
-BORDER_STEPS = 9
-#: Triangles whose vertices all moved less than STILL pixels show the key frame as it is; those
-#: that moved less than SLOW are sampled nearest (half the work of bilinear; a shift under a
-#: pixel does not show), the rest bilinear.
+#: Triangles whose vertices all moved less than STILL pixels show the key frame as it is (those
+#: that moved less than :data:`~facemime.shared_constants.SLOW` are sampled nearest).
 STILL = 0.05
-SLOW = 1.0
 
 
 @dataclass(frozen=True, eq=False)

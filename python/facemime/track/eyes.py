@@ -29,20 +29,8 @@ from facemime.animate.deform import head_plane
 from facemime.model.head import HeadModel
 from facemime.render.bilinear import sample_affine
 from facemime.render.projection import Pose, project
+from facemime.shared_constants import DENSITY, EYES, IRIS_RADIUS, IRIS_U, IRIS_V, SPAN_U, SPAN_V
 
-EYES = ("eye_right", "eye_left")
-#: Samples per eye width, and the patch's extent (eye widths) along and across the eye.
-DENSITY = 20
-SPAN_U = (-0.7, 0.7)
-SPAN_V = (-0.55, 0.55)
-#: The iris's radius, eye widths (the shared videos' Face Mesh irises: 0.21 of the corner distance).
-IRIS_RADIUS = 0.21
-#: The lids' rims and lashes inside the eye ring, eye widths: the synthesis does not move them
-#: with the iris.
-LID_EDGE = 0.04
-#: Where an iris centre is looked for, eye widths from the eye's middle.
-IRIS_U = 0.32
-IRIS_V = (-0.2, 0.2)
 #: How far above the key frame's upper lid, and below its lower lid, the trials are compared.
 REACH_UP = 0.15
 REACH_DOWN = 0.15

@@ -720,7 +720,17 @@ void main() {
     }
   };
 
-  // src/render/geometry.ts
+  // src/shared_constants.ts
+  var POSE_FIELDS = ["yaw", "pitch", "roll", "scale", "tx", "ty"];
+  var LOOK_NAMES = [
+    "eye_right_closure",
+    "eye_left_closure",
+    "iris_right_u",
+    "iris_right_v",
+    "iris_left_u",
+    "iris_left_v"
+  ];
+  var BASIS_ONE = 32767;
   var CONTOUR_GROUPS = [
     "mouth_outer_upper",
     "mouth_outer_lower",
@@ -734,8 +744,38 @@ void main() {
   var SOFTEN = 0.02;
   var REACH = 0.45;
   var SEAL = 0.05;
+  var BACKGROUND = [38, 40, 46];
+  var NO_FACE_DIM = 0.45;
+  var CAVITY = [52, 18, 22];
+  var TEETH = [185, 165, 150];
+  var GAPS = [150, 140, 128];
+  var UPPER_TEETH = 0.11;
+  var LOWER_TEETH = 0.07;
+  var TEETH_SPAN = 0.72;
+  var UPPER_SHARE = 0.6;
+  var LOWER_SHARE = 0.4;
+  var TEETH_FROM = 0.04;
+  var TEETH_SPREAD = [0.9, 1.05];
+  var UPPER_MIN = 0.5;
+  var SHIFT = 4;
+  var EYES = ["eye_right", "eye_left"];
+  var DENSITY = 20;
+  var SPAN_U = [-0.7, 0.7];
+  var SPAN_V = [-0.55, 0.55];
+  var IRIS_RADIUS = 0.21;
+  var LID_EDGE = 0.04;
+  var IRIS_U = 0.32;
+  var IRIS_V = [-0.2, 0.2];
   var UPPER_LID = [1, 2, 3];
   var LOWER_LID = [7, 6, 5];
+  var PASTE_STILL = 0.25;
+  var IRIS_REACH = 1.15;
+  var RINGS = [[1.2, 1], [1.7, 0]];
+  var EDGE_MARGIN = 0.04;
+  var BORDER_STEPS = 9;
+  var SLOW = 1;
+
+  // src/render/geometry.ts
   function rotation(yaw, pitch, roll) {
     const [y, p, r] = [yaw, pitch, roll].map((a) => a * Math.PI / 180);
     const ry = [Math.cos(y), 0, Math.sin(y), 0, 1, 0, -Math.sin(y), 0, Math.cos(y)];
@@ -1568,16 +1608,6 @@ void main() {
   }
 
   // src/render/eyes.ts
-  var EYES = ["eye_right", "eye_left"];
-  var DENSITY = 20;
-  var SPAN_U = [-0.7, 0.7];
-  var SPAN_V = [-0.55, 0.55];
-  var IRIS_RADIUS = 0.21;
-  var LID_EDGE = 0.04;
-  var IRIS_U = 0.32;
-  var IRIS_V = [-0.2, 0.2];
-  var STILL = 0.25;
-  var IRIS_REACH = 1.15;
   var EyeFrame = class _EyeFrame {
     constructor(origin, axes) {
       this.origin = origin;
@@ -1724,7 +1754,7 @@ void main() {
       this.irisUv = findIris(eyePatch(tex, frame));
       const centre = frame.toImage(this.irisUv[0], this.irisUv[1]);
       const cx = centre[0] - x0, cy = centre[1] - y0;
-      this.radius = 0.21 * ew * IRIS_REACH;
+      this.radius = IRIS_RADIUS * ew * IRIS_REACH;
       this.disc = new Float64Array(n);
       for (let y = 0; y < h; y++) {
         for (let x2 = 0; x2 < w; x2++) {
@@ -1807,11 +1837,11 @@ void main() {
     }
     /** The warp's offset for an iris shift (u, v) eye widths: texture px (dx, dy) moved, quantised
      * to 1/32 px as facemime.render.bilinear.shift_offset does: each pixel samples the key frame at (x + ox / 32, y + oy / 32);
-     * null when the shift is below STILL. */
+     * null when the shift is below PASTE_STILL. */
     offset(shift) {
       const a = this.frame.axes;
       const dx = shift[0] * a[0] + shift[1] * a[2], dy = shift[0] * a[1] + shift[1] * a[3];
-      if (Math.max(Math.abs(dx), Math.abs(dy)) < STILL) return null;
+      if (Math.max(Math.abs(dx), Math.abs(dy)) < PASTE_STILL) return null;
       return [rint(-Math.fround(dx) * 1024) + 16 >> 5, rint(-Math.fround(dy) * 1024) + 16 >> 5];
     }
     /** Paints the eye into `out` (the texture's RGBA working copy, `width` px wide) with the warp
@@ -1882,18 +1912,6 @@ void main() {
   };
 
   // src/render/mouth.ts
-  var CAVITY = [52, 18, 22];
-  var TEETH = [185, 165, 150];
-  var GAPS = [150, 140, 128];
-  var UPPER_TEETH = 0.11;
-  var LOWER_TEETH = 0.07;
-  var TEETH_SPAN = 0.72;
-  var UPPER_SHARE = 0.6;
-  var LOWER_SHARE = 0.4;
-  var TEETH_FROM = 0.04;
-  var TEETH_SPREAD = [0.9, 1.05];
-  var UPPER_MIN = 0.5;
-  var SHIFT = 4;
   function teethUncovered(spread) {
     return Math.min(Math.max((spread - TEETH_SPREAD[0]) / (TEETH_SPREAD[1] - TEETH_SPREAD[0]), 0), 1);
   }
@@ -2742,10 +2760,6 @@ void main() {
   }
 
   // src/render/scene.ts
-  var RINGS = [[1.2, 1], [1.7, 0]];
-  var EDGE_MARGIN = 0.04;
-  var BORDER_STEPS = 9;
-  var SLOW = 1;
   var SceneMesh = class {
     constructor(width, height, anchors, outline) {
       this.width = width;
@@ -2824,8 +2838,6 @@ void main() {
   }
 
   // src/render/synth.ts
-  var BACKGROUND = [38, 40, 46];
-  var NO_FACE_DIM = 0.45;
   var Synthesizer = class {
     constructor(renderer2, actor, header) {
       this.renderer = renderer2;
@@ -2836,7 +2848,7 @@ void main() {
       if (header.basisLength !== 2 * this.deformer.knots.length) {
         throw new Error(`the stream's basis does not fit the ${this.deformer.knots.length} knots of its actor`);
       }
-      this.basis = Float64Array.from(header.basis, (x2) => x2 / 32767);
+      this.basis = Float64Array.from(header.basis, (x2) => x2 / BASIS_ONE);
       this.key = poseFromValues(header.references.slice(0, 6).map((r, i2) => r * header.steps[i2]));
       this.restWidth = mouthWidth(m, m.vertices);
       this.textureLayer = renderer2.upload(actor.texture);
@@ -2903,11 +2915,14 @@ void main() {
       if (!motion.face) r.dim(NO_FACE_DIM, w, h);
     }
     look(v2, first) {
-      const at = (kind) => {
-        const j = this.header.extras.indexOf(kind);
+      const at = (name) => {
+        const j = this.header.extras.indexOf(LOOK_NAMES.indexOf(name) + 1);
         return j < 0 ? 0 : v2[first + j];
       };
-      return { closure: [at(1), at(2)], iris: [[at(3), at(4)], [at(5), at(6)]] };
+      return {
+        closure: [at("eye_right_closure"), at("eye_left_closure")],
+        iris: [[at("iris_right_u"), at("iris_right_v")], [at("iris_left_u"), at("iris_left_v")]]
+      };
     }
   };
   function paintersOrder(points, depth, triangles) {
@@ -3023,7 +3038,7 @@ void main() {
   };
 
   // src/stream/header.ts
-  var POSE_PARAMETERS = 6;
+  var POSE_PARAMETERS = POSE_FIELDS.length;
   var MAX_VALUE = 2 ** 30;
   var MAX_SIDE = 16384;
   var InvalidHeader = class extends Error {

@@ -55,7 +55,7 @@ function clipLine(width: number, height: number, p: number[]): boolean {
 }
 
 /** An 8-bit image: `w` x `h` pixels of `colour.length` interleaved channels, drawn in `colour`. */
-export interface Canvas { img: Uint8Array; w: number; h: number; colour: number[] }
+export interface Canvas { img: Uint8Array; w: number; h: number; colour: readonly number[] }
 
 /** OpenCV's LineAA on `cv`; points (x, y) in 16.16 fixed point. */
 function lineAA(cv: Canvas, ax0: number, ay0: number, ax1: number, ay1: number): void {

@@ -19,24 +19,7 @@ import type { Model } from './geometry';
 import { clampIndex, erodeEllipse, gaussianBlur, gaussianSize, median, percentile, rint } from '../imaging/filters';
 import { inpaintTelea } from '../imaging/inpaint';
 import { fillPolyAA } from '../imaging/polygon';
-
-/** The eye rings' model groups: the subject's right (image-left) eye first. */
-export const EYES = ['eye_right', 'eye_left'] as const;
-/** Samples per eye width, and the iris patch's extent (eye widths) along and across the eye. */
-const DENSITY = 20;
-const SPAN_U = [-0.7, 0.7];
-const SPAN_V = [-0.55, 0.55];
-/** The iris's radius, eye widths. */
-const IRIS_RADIUS = 0.21;
-/** The lids' rims inside the eye ring, eye widths: not moved with the iris. */
-const LID_EDGE = 0.04;
-/** Where an iris centre is looked for, eye widths from the eye's middle. */
-const IRIS_U = 0.32;
-const IRIS_V = [-0.2, 0.2];
-/** An iris shifted less than this (texture px) is drawn as on the key frame. */
-const STILL = 0.25;
-/** The iris pasted is this many times the measured radius (its dark rim included). */
-const IRIS_REACH = 1.15;
+import { DENSITY, EYES, IRIS_RADIUS, IRIS_REACH, IRIS_U, IRIS_V, LID_EDGE, PASTE_STILL, SPAN_U, SPAN_V } from '../shared_constants';
 
 /** One eye's frame on the texture: `origin` the middle of its corners (x, y) px, `axes` the u and
  * v directions scaled to one eye width (px), rows [ux, uy, vx, vy]. */
@@ -204,7 +187,7 @@ class Eye {
     this.irisUv = findIris(eyePatch(tex, frame));
     const centre = frame.toImage(this.irisUv[0], this.irisUv[1]);
     const cx = centre[0] - x0, cy = centre[1] - y0;
-    this.radius = 0.21 * ew * IRIS_REACH;
+    this.radius = IRIS_RADIUS * ew * IRIS_REACH;
     this.disc = new Float64Array(n);
     for (let y = 0; y < h; y++) {
       for (let x = 0; x < w; x++) {
@@ -287,11 +270,11 @@ class Eye {
 
   /** The warp's offset for an iris shift (u, v) eye widths: texture px (dx, dy) moved, quantised
    * to 1/32 px as facemime.render.bilinear.shift_offset does: each pixel samples the key frame at (x + ox / 32, y + oy / 32);
-   * null when the shift is below STILL. */
+   * null when the shift is below PASTE_STILL. */
   offset(shift: [number, number]): [number, number] | null {
     const a = this.frame.axes;
     const dx = shift[0] * a[0] + shift[1] * a[2], dy = shift[0] * a[1] + shift[1] * a[3];
-    if (Math.max(Math.abs(dx), Math.abs(dy)) < STILL) return null;
+    if (Math.max(Math.abs(dx), Math.abs(dy)) < PASTE_STILL) return null;
     return [(rint(-Math.fround(dx) * 1024) + 16) >> 5, (rint(-Math.fround(dy) * 1024) + 16) >> 5];
   }
 

@@ -8,20 +8,7 @@
  * the built-in head). Image: pixels, x right, y down, (0, 0) the centre of the top-left pixel.
  * Vertices are Float64Array of N*3 (x, y, z per vertex); points Float64Array of N*2.
  */
-
-/** The eight contour groups whose vertices are the knots, in the bitstream's order. */
-export const CONTOUR_GROUPS = [
-  'mouth_outer_upper', 'mouth_outer_lower', 'mouth_inner_upper', 'mouth_inner_lower',
-  'brow_left_upper', 'brow_left_lower', 'brow_right_upper', 'brow_right_lower',
-] as const;
-/** Shepard softening and far-field reach, fractions of the outer eye corners' distance. */
-const SOFTEN = 0.02;
-const REACH = 0.45;
-/** Lips closer than this fraction of the mouth's width are shown shut (synth.SEAL). */
-export const SEAL = 0.05;
-/** Eye ring positions of the upper-lid vertices and of the lower-lid ones below them. */
-const UPPER_LID = [1, 2, 3];
-const LOWER_LID = [7, 6, 5];
+import { CONTOUR_GROUPS, LOWER_LID, REACH, SOFTEN, UPPER_LID } from '../shared_constants';
 
 export interface Model {
   vertices: Float64Array; // N*3

@@ -100,7 +100,7 @@ export class Renderer {
 
   /** Starts a picture of ``width`` x ``height`` px drawn into the viewport rectangle ``view``
    * ([x, y, w, h] of the canvas, y from the top), cleared to ``background`` (RGB 0-255). */
-  begin(width: number, height: number, background: number[], view = [0, 0, width, height]): void {
+  begin(width: number, height: number, background: readonly number[], view = [0, 0, width, height]): void {
     const gl = this.gl;
     gl.viewport(view[0], this.canvas.height - view[1] - view[3], view[2], view[3]);
     gl.disable(gl.SCISSOR_TEST);

@@ -7,20 +7,9 @@
  */
 import { rint } from '../imaging/filters';
 import { fillPolyAA, lineAAShifted } from '../imaging/polygon';
-
-const CAVITY = [52, 18, 22];
-const TEETH = [185, 165, 150];
-const GAPS = [150, 140, 128];
-const UPPER_TEETH = 0.11;
-const LOWER_TEETH = 0.07;
-const TEETH_SPAN = 0.72;
-const UPPER_SHARE = 0.6;
-const LOWER_SHARE = 0.4;
-const TEETH_FROM = 0.04;
-const TEETH_SPREAD = [0.9, 1.05];
-const UPPER_MIN = 0.5;
-/** Sub-pixel bits of the drawn points. */
-const SHIFT = 4;
+import {
+  CAVITY, GAPS, LOWER_SHARE, LOWER_TEETH, SHIFT, TEETH, TEETH_FROM, TEETH_SPAN, TEETH_SPREAD, UPPER_MIN, UPPER_SHARE, UPPER_TEETH,
+} from '../shared_constants';
 
 /** How much of the teeth the lips uncover, 0..1, for corners ``spread`` times their rest
  * distance apart. */

@@ -8,16 +8,7 @@
  * picture's outer pixel edges (-0.5 and W - 0.5).
  */
 import Delaunator from 'delaunator';
-
-/** (reach as a multiple of the outline's, share of the motion followed) per ring. */
-const RINGS: [number, number][] = [[1.2, 1.0], [1.7, 0.0]];
-/** Rings nearer the picture's edge than this fraction of its shorter side are left out. */
-const EDGE_MARGIN = 0.04;
-/** Border vertices per side, corners included. */
-const BORDER_STEPS = 9;
-/** Triangles that moved less than SLOW px are sampled nearest (those that did not move show the
- * key frame's own pixels), the rest bilinear. */
-export const SLOW = 1.0;
+import { BORDER_STEPS, EDGE_MARGIN, RINGS } from '../shared_constants';
 
 export class SceneMesh {
   /** Every vertex in the key frame, N*2 px (the texture coordinates, once normalised). */

@@ -7,15 +7,12 @@
  */
 import type { Header } from '../stream';
 import type { Actor, Picture } from './actor';
-import { closeLids, Deformer, mouthWidth, poseFromValues, project, SEAL, shownPose, type Pose } from './geometry';
+import { closeLids, Deformer, mouthWidth, poseFromValues, project, shownPose, type Pose } from './geometry';
 import { LookPainter } from './eyes';
 import { Renderer, type Layer } from './gl';
 import { mouthPatch, teethUncovered } from './mouth';
-import { SceneMesh, SLOW } from './scene';
-
-const BACKGROUND = [38, 40, 46];
-/** Brightness of a frame without a face (facemime.animate.run.NO_FACE_DIM). */
-const NO_FACE_DIM = 0.45;
+import { SceneMesh } from './scene';
+import { BACKGROUND, BASIS_ONE, LOOK_NAMES, NO_FACE_DIM, SEAL, SLOW } from '../shared_constants';
 
 /** One frame's motion, as decoded: the parameter values of the stream (pose, coefficients,
  * extras) and whether it shows a face. */
@@ -38,7 +35,7 @@ export class Synthesizer {
     if (header.basisLength !== 2 * this.deformer.knots.length) {
       throw new Error(`the stream's basis does not fit the ${this.deformer.knots.length} knots of its actor`);
     }
-    this.basis = Float64Array.from(header.basis, (x) => x / 32767);
+    this.basis = Float64Array.from(header.basis, (x) => x / BASIS_ONE);
     this.key = poseFromValues(header.references.slice(0, 6).map((r, i) => r * header.steps[i]));
     this.restWidth = mouthWidth(m, m.vertices);
     this.textureLayer = renderer.upload(actor.texture);
@@ -110,11 +107,14 @@ export class Synthesizer {
   }
 
   private look(v: ArrayLike<number>, first: number): { closure: [number, number]; iris: [number, number][] } {
-    const at = (kind: number) => {
-      const j = this.header.extras.indexOf(kind);
+    const at = (name: (typeof LOOK_NAMES)[number]) => {
+      const j = this.header.extras.indexOf(LOOK_NAMES.indexOf(name) + 1); // kinds count the look's values from 1
       return j < 0 ? 0 : v[first + j];
     };
-    return { closure: [at(1), at(2)], iris: [[at(3), at(4)], [at(5), at(6)]] };
+    return {
+      closure: [at('eye_right_closure'), at('eye_left_closure')],
+      iris: [[at('iris_right_u'), at('iris_right_v')], [at('iris_left_u'), at('iris_left_v')]],
+    };
   }
 }
 

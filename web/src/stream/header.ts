@@ -1,8 +1,10 @@
 /** The stream header (docs/bitstream.md, "Header"), versions 1 and 2 (with extra parameters). */
+import { POSE_FIELDS } from '../shared_constants';
 
 /** Head-pose parameters that start every frame: yaw, pitch, roll (degrees), ln scale (scale in
  * px per model unit), tx, ty (px). */
-export const POSE_PARAMETERS = 6;
+export const POSE_PARAMETERS = POSE_FIELDS.length;
+
 /** Largest magnitude of a quantised value (and of a reference). */
 export const MAX_VALUE = 2 ** 30;
 /** Largest picture side, px. */
