@@ -6,7 +6,8 @@
  *
  * For tests and measurements the page exposes ``window.facemime`` (see ``Api``). ``?drop=P``
  * drops each received packet with probability P (a seeded generator, ``&seed=N``), to test
- * concealment and resynchronisation.
+ * concealment and resynchronisation; ``?slow=MS`` spends MS ms more on drawing each frame (a slow
+ * machine), to test a page whose drawing lags behind the stream.
  */
 import { readActor, type Actor, type Picture } from './render/actor';
 import { applyUpdate, readUpdate, type Update } from './render/appearance';
@@ -46,6 +47,7 @@ const hud = document.getElementById('hud') as HTMLElement;
 const message = document.getElementById('message') as HTMLElement;
 const params = new URLSearchParams(location.search);
 const dropShare = Number(params.get('drop') ?? 0);
+const slowMs = Number(params.get('slow') ?? 0);
 let seed = Number(params.get('seed') ?? 1) >>> 0 || 1;
 const random = () => { // xorshift32: the same drops for the same seed
   seed ^= seed << 13; seed >>>= 0; seed ^= seed >>> 17; seed ^= seed << 5; seed >>>= 0;
@@ -96,6 +98,7 @@ class Session {
           if (update) this.updates.push({ update, after: this.frames.length });
           else api.counts.refused += 1;
         } else {
+          await nextTask(); // the socket's messages are read between two drawings, not after all
           this.frames.push(e.frame);
           onFrame(e.frame);
         }
@@ -131,6 +134,16 @@ class Session {
   }
 }
 
+/** Resolves in a task of its own, after the events already queued (a message from the socket
+ * among them): drawing that lags behind the stream then delays no intra request. */
+function nextTask(): Promise<void> {
+  return new Promise((resolve) => {
+    const channel = new MessageChannel();
+    channel.port1.onmessage = () => resolve();
+    channel.port2.postMessage(null);
+  });
+}
+
 function same(a: Uint8Array, b: Uint8Array): boolean {
   return a.length === b.length && a.every((x, i) => x === b[i]);
 }
@@ -162,6 +175,7 @@ function present(frame: Frame, position: number): void {
   const t0 = performance.now();
   if (!session.draw(frame, position)) return;
   renderer.gl.finish();
+  while (performance.now() - t0 < slowMs); // ?slow: a slower machine's drawing
   const t1 = performance.now();
   drawTimes.push(t1 - t0);
   counts.drawn += 1;

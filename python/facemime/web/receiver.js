@@ -3640,6 +3640,7 @@ void main() {
   var message = document.getElementById("message");
   var params = new URLSearchParams(location.search);
   var dropShare = Number(params.get("drop") ?? 0);
+  var slowMs = Number(params.get("slow") ?? 0);
   var seed = Number(params.get("seed") ?? 1) >>> 0 || 1;
   var random = () => {
     seed ^= seed << 13;
@@ -3688,6 +3689,7 @@ void main() {
             if (update) this.updates.push({ update, after: this.frames.length });
             else api.counts.refused += 1;
           } else {
+            await nextTask();
             this.frames.push(e.frame);
             onFrame(e.frame);
           }
@@ -3723,6 +3725,13 @@ void main() {
       return true;
     }
   };
+  function nextTask() {
+    return new Promise((resolve) => {
+      const channel = new MessageChannel();
+      channel.port1.onmessage = () => resolve();
+      channel.port2.postMessage(null);
+    });
+  }
   function same(a, b) {
     return a.length === b.length && a.every((x2, i2) => x2 === b[i2]);
   }
@@ -3747,6 +3756,7 @@ void main() {
     const t0 = performance.now();
     if (!session.draw(frame, position)) return;
     renderer.gl.finish();
+    while (performance.now() - t0 < slowMs) ;
     const t1 = performance.now();
     drawTimes.push(t1 - t0);
     counts.drawn += 1;
