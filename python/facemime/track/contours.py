@@ -9,17 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 
-#: Contour name -> feature it belongs to, in the order of the interchange format.
-CONTOUR_NAMES = (
-    "mouth_outer_upper",
-    "mouth_outer_lower",
-    "mouth_inner_upper",
-    "mouth_inner_lower",
-    "brow_left_upper",
-    "brow_left_lower",
-    "brow_right_upper",
-    "brow_right_lower",
-)
+from facemime.shared_constants import CONTOUR_GROUPS
+
+#: The contours' names in the order of the interchange format: the head model's groups of the
+#: same names, whose vertices are the knots.
+CONTOUR_NAMES = CONTOUR_GROUPS
 
 #: Feature name -> its (upper, lower) contours.
 FEATURES = {
