@@ -2,17 +2,16 @@
 
 use facemime_core::adjust::{self, Contour, Settings};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::error::CoreErr;
+use crate::error::{invalid, CoreErr};
 use crate::points::{array, rows};
 
 /// Splits a concatenated array into consecutive runs of the given lengths.
 fn runs<T: Clone>(name: &str, all: &[T], lengths: &[u32]) -> PyResult<Vec<Vec<T>>> {
     let total: usize = lengths.iter().map(|&n| n as usize).sum();
     if total != all.len() {
-        return Err(PyValueError::new_err(format!(
+        return Err(invalid(format!(
             "{name}: lengths add up to {total}, but {} entries were given",
             all.len()
         )));
@@ -57,7 +56,7 @@ fn elastic_adjust<'py>(
         target_lengths.as_slice()?,
     )?;
     if chain_runs.len() != target_runs.len() {
-        return Err(PyValueError::new_err(format!(
+        return Err(invalid(format!(
             "{} chains but {} targets",
             chain_runs.len(),
             target_runs.len()

@@ -3,16 +3,15 @@
 
 use facemime_core::codec::{self, chunk, Header, Output, Quantiser};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 
-use crate::error::CoreErr;
+use crate::error::{invalid, CoreErr};
 
 fn fixed<const N: usize>(name: &str, bytes: &[u8]) -> PyResult<[u8; N]> {
     bytes
         .try_into()
-        .map_err(|_| PyValueError::new_err(format!("{name} must be {N} bytes")))
+        .map_err(|_| invalid(format!("{name} must be {N} bytes")))
 }
 
 /// A pushed frame's reconstruction and the packet it completed.
@@ -49,7 +48,7 @@ impl StreamEncoder {
         extras: Vec<u8>,
     ) -> PyResult<Self> {
         if steps.len() != references.len() || steps.len() != classes.len() {
-            return Err(PyValueError::new_err(
+            return Err(invalid(
                 "steps, references and classes must have one entry per parameter",
             ));
         }
@@ -74,7 +73,7 @@ impl StreamEncoder {
                 .collect(),
             extras,
             basis_rows: u16::try_from(b.ncols())
-                .map_err(|_| PyValueError::new_err("basis vectors are too long"))?,
+                .map_err(|_| invalid("basis vectors are too long"))?,
             basis: b.iter().copied().collect(),
             actor_id: fixed("actor_id", actor_id)?,
             actor_in_stream,
@@ -100,7 +99,7 @@ impl StreamEncoder {
     ) -> PyResult<Pushed<'py>> {
         let v = values
             .as_slice()
-            .map_err(|_| PyValueError::new_err("values must be contiguous"))?;
+            .map_err(|_| invalid("values must be contiguous"))?;
         let (recon, packet) = self.enc.push(face, lost, v).map_err(CoreErr)?;
         Ok((recon.into_pyarray(py), packet.map(|p| PyBytes::new(py, &p))))
     }
@@ -129,7 +128,7 @@ impl StreamEncoder {
 #[pyfunction]
 fn actor_chunk<'py>(py: Python<'py>, payload: &[u8]) -> PyResult<Bound<'py, PyBytes>> {
     if payload.len() > chunk::Kind::Actor.max_payload() {
-        return Err(PyValueError::new_err(
+        return Err(invalid(
             "the actor is larger than a stream may carry (64 MiB)",
         ));
     }

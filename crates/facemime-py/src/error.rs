@@ -1,4 +1,5 @@
-//! The one mapping of core errors to Python: `facemime.errors.InvalidInputError`.
+//! The one mapping of the binding's errors to Python: `facemime.errors.InvalidInputError`, for
+//! the core's errors and for every argument the binding refuses.
 
 use facemime_core::CoreError;
 use pyo3::exceptions::PyValueError;
@@ -15,15 +16,22 @@ impl From<CoreError> for CoreErr {
 
 impl From<CoreErr> for PyErr {
     fn from(e: CoreErr) -> PyErr {
-        let msg = e.0.to_string();
-        Python::attach(|py| {
-            match py
-                .import("facemime.errors")
-                .and_then(|m| m.getattr("InvalidInputError"))
-            {
-                Ok(cls) => PyErr::from_type(cls.cast_into().expect("an exception class"), msg),
-                Err(_) => PyValueError::new_err(msg),
-            }
-        })
+        invalid(e.0.to_string())
     }
+}
+
+/// The error of an input the binding refuses, core or binding alike:
+/// `facemime.errors.InvalidInputError` with `msg` (a plain `ValueError` only where that module
+/// cannot be imported).
+pub fn invalid(msg: impl Into<String>) -> PyErr {
+    let msg = msg.into();
+    Python::attach(|py| {
+        match py
+            .import("facemime.errors")
+            .and_then(|m| m.getattr("InvalidInputError"))
+        {
+            Ok(cls) => PyErr::from_type(cls.cast_into().expect("an exception class"), msg),
+            Err(_) => PyValueError::new_err(msg),
+        }
+    })
 }

@@ -3,10 +3,9 @@
 
 use facemime_core::flow::{self, LkParams, Pyramid};
 use numpy::{IntoPyArray, PyReadonlyArray2, PyReadonlyArrayDyn};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::error::CoreErr;
+use crate::error::{invalid, CoreErr};
 use crate::points::{image_view, point_rows, rows, MaskedPoints};
 
 /// See `facemime.track.flow` for the documented API.
@@ -21,9 +20,7 @@ pub struct FlowFrames {
 impl FlowFrames {
     fn ready(&self) -> PyResult<()> {
         if self.pushed < 2 {
-            return Err(PyValueError::new_err(
-                "the flow needs two frames; push another",
-            ));
+            return Err(invalid("the flow needs two frames; push another"));
         }
         Ok(())
     }

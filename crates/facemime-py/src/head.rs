@@ -8,10 +8,9 @@ use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2, PyReadonlyArray3,
     PyReadonlyArrayDyn,
 };
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::error::CoreErr;
+use crate::error::{invalid, CoreErr};
 use crate::points::{array, image_view, matrix, point_rows, rows};
 
 /// The head's similarity step or None, and the extra points' positions.
@@ -65,7 +64,7 @@ impl HeadFollower {
         let frame = image_view("frame", &frame)?;
         let z = zones.as_array();
         if z.shape()[1..] != [4, 2] {
-            return Err(PyValueError::new_err(format!(
+            return Err(invalid(format!(
                 "zones must have shape (Z, 4, 2), got {:?}",
                 z.shape()
             )));
@@ -142,7 +141,7 @@ impl HeadFollower {
     ) -> PyResult<Bound<'py, PyArray2<f32>>> {
         let m = mask
             .as_slice()
-            .map_err(|_| PyValueError::new_err("mask must be a C-contiguous uint8 array"))?;
+            .map_err(|_| invalid("mask must be a C-contiguous uint8 array"))?;
         let settings = CornerSettings {
             max_corners,
             quality,

@@ -1,5 +1,6 @@
 //! Bindings of `facemime_core::motion`: the robust similarity fit of the head motion.
 
+use crate::error::invalid;
 use facemime_core::{extent, motion};
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -46,9 +47,7 @@ fn grown_box(
 ) -> PyResult<(i64, i64, i64, i64)> {
     let pts = rows::<2, _>("points", &points)?;
     if pts.is_empty() {
-        return Err(pyo3::exceptions::PyValueError::new_err(
-            "a box needs at least one point",
-        ));
+        return Err(invalid("a box needs at least one point"));
     }
     let [x0, y0, x1, y1] = extent::grown_box(pts, margin, width, height);
     Ok((x0, y0, x1, y1))

@@ -7,10 +7,9 @@ use numpy::{
     Element, IntoPyArray, PyArray1, PyArray2, PyReadonlyArray, PyReadonlyArray2, PyReadwriteArray2,
     PyUntypedArrayMethods,
 };
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::error::CoreErr;
+use crate::error::{invalid, CoreErr};
 
 /// The rows of a (K, D) array (float64 points, float32 corners, index pairs); a clear error
 /// naming `name` for another shape.
@@ -20,7 +19,7 @@ pub fn rows<const D: usize, T: Element + Copy>(
 ) -> PyResult<Vec<[T; D]>> {
     let v = a.as_array();
     if v.shape()[1] != D {
-        return Err(PyValueError::new_err(format!(
+        return Err(invalid(format!(
             "{name} must have shape (K, {D}), got {:?}",
             v.shape()
         )));
@@ -44,7 +43,7 @@ pub fn write_rows(out: &mut PyReadwriteArray2<f64>, pts: &[[f64; 2]]) {
 pub fn matrix<const C: usize>(name: &str, m: &PyReadonlyArray2<f64>) -> PyResult<[[f64; C]; 2]> {
     match rows::<C, _>(name, m)?.as_slice() {
         &[a, b] => Ok([a, b]),
-        r => Err(PyValueError::new_err(format!(
+        r => Err(invalid(format!(
             "{name} must have shape (2, {C}), got ({}, {C})",
             r.len()
         ))),
@@ -58,7 +57,7 @@ pub fn same_length(arrays: &[(&str, usize)]) -> PyResult<()> {
     }
     let names: Vec<&str> = arrays.iter().map(|&(name, _)| name).collect();
     let lengths: Vec<String> = arrays.iter().map(|&(_, n)| n.to_string()).collect();
-    Err(PyValueError::new_err(format!(
+    Err(invalid(format!(
         "{} must have the same length, got {}",
         names.join(", "),
         lengths.join(", ")
@@ -93,12 +92,12 @@ pub fn image_view<'a, D: Dimension>(
     let shape = img.shape().to_vec();
     let data = img
         .as_slice()
-        .map_err(|_| PyValueError::new_err(format!("{name} must be a C-contiguous uint8 array")))?;
+        .map_err(|_| invalid(format!("{name} must be a C-contiguous uint8 array")))?;
     let channels = match shape.len() {
         2 => 1,
         3 => shape[2],
         n => {
-            return Err(PyValueError::new_err(format!(
+            return Err(invalid(format!(
                 "{name} must be a (H, W) or (H, W, C) image, got {n} dimensions"
             )))
         }

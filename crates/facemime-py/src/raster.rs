@@ -4,13 +4,12 @@ use facemime_core::raster::{self, DepthMode, Filter, ImageMut, ImageRef, RenderO
 use numpy::{
     IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyReadwriteArray3,
 };
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::error::CoreErr;
+use crate::error::{invalid, CoreErr};
 
 fn contiguous<'a>(name: &str, s: Option<&'a [u8]>) -> PyResult<&'a [u8]> {
-    s.ok_or_else(|| PyValueError::new_err(format!("{name} must be a C-contiguous uint8 array")))
+    s.ok_or_else(|| invalid(format!("{name} must be a C-contiguous uint8 array")))
 }
 
 /// Renders a textured mesh into `out` (H, W, C) uint8 in place; returns
@@ -34,7 +33,7 @@ fn render_mesh_into(
         "nearest" => Filter::Nearest,
         "bilinear" => Filter::Bilinear,
         other => {
-            return Err(PyValueError::new_err(format!(
+            return Err(invalid(format!(
                 "filter must be 'nearest' or 'bilinear', got {other:?}"
             )))
         }
@@ -43,7 +42,7 @@ fn render_mesh_into(
         "painter" => DepthMode::Painter,
         "zbuffer" => DepthMode::ZBuffer,
         other => {
-            return Err(PyValueError::new_err(format!(
+            return Err(invalid(format!(
                 "depth must be 'painter' or 'zbuffer', got {other:?}"
             )))
         }
@@ -58,7 +57,7 @@ fn render_mesh_into(
     let tex_data = contiguous("texture", texture.as_slice().ok())?;
     let out_data = out
         .as_slice_mut()
-        .map_err(|_| PyValueError::new_err("out must be a C-contiguous, writeable uint8 array"))?;
+        .map_err(|_| invalid("out must be a C-contiguous, writeable uint8 array"))?;
     let (tp, p, z, t) = (
         tex_points.as_array(),
         points.as_array(),

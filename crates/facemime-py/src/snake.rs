@@ -8,16 +8,11 @@ use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
     PyReadonlyArray3, PyUntypedArrayMethods,
 };
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use std::sync::Mutex;
 
-use crate::error::CoreErr;
+use crate::error::{invalid, CoreErr};
 use crate::points::{array, image_view, matrix, rows, same_length};
-
-fn err(msg: String) -> PyErr {
-    PyValueError::new_err(msg)
-}
 
 /// Curves over one shared knot array solved jointly by sign descent. See
 /// `facemime.track.snake` for the documented API; arrays follow its conventions.
@@ -39,9 +34,9 @@ fn bands_of<'a>(
         .map(|(k, margin)| {
             let knots = k
                 .as_slice()
-                .map_err(|_| err("band knots must be a contiguous array".into()))?;
+                .map_err(|_| invalid("band knots must be a contiguous array"))?;
             if knots.is_empty() {
-                return Err(err("a band needs at least one knot".into()));
+                return Err(invalid("a band needs at least one knot"));
             }
             within("bands", knots, n)?;
             Ok(Band {
@@ -55,7 +50,9 @@ fn bands_of<'a>(
 /// An error unless every index is below `n` knots.
 fn within(name: &str, idx: &[usize], n: usize) -> PyResult<()> {
     match idx.iter().find(|&&k| k >= n) {
-        Some(k) => Err(err(format!("{name}: knot index {k} is past the {n} knots"))),
+        Some(k) => Err(invalid(format!(
+            "{name}: knot index {k} is past the {n} knots"
+        ))),
         None => Ok(()),
     }
 }
@@ -63,7 +60,7 @@ fn within(name: &str, idx: &[usize], n: usize) -> PyResult<()> {
 /// An error unless the frame is at least 4×4 pixels.
 fn frame_size(width: usize, height: usize) -> PyResult<()> {
     if width < 4 || height < 4 {
-        return Err(err(format!(
+        return Err(invalid(format!(
             "the frame must be at least 4x4, got {width}x{height}"
         )));
     }
@@ -100,15 +97,15 @@ impl SnakeSolver {
             curve_params.as_array(),
         );
         if cp.shape() != [cl.len(), 8] {
-            return Err(err(format!(
+            return Err(invalid(format!(
                 "curve_params must have shape ({}, 8), got {:?}",
                 cl.len(),
                 cp.shape()
             )));
         }
         if cl.iter().map(|&l| l as usize).sum::<usize>() != ck.len() {
-            return Err(err(
-                "curve_lengths must sum to the length of curve_knots".into()
+            return Err(invalid(
+                "curve_lengths must sum to the length of curve_knots",
             ));
         }
         let n_knots = ck.iter().map(|&i| i as usize + 1).max().unwrap_or(0);
@@ -125,7 +122,11 @@ impl SnakeSolver {
             let operator = match r[7] {
                 0.0 => Operator::Directional,
                 1.0 => Operator::Magnitude,
-                v => return Err(err(format!("curve {c} operator must be 0 or 1, got {v}"))),
+                v => {
+                    return Err(invalid(format!(
+                        "curve {c} operator must be 0 or 1, got {v}"
+                    )))
+                }
             };
             let p = CurveParams {
                 alpha: r[0],
@@ -141,7 +142,7 @@ impl SnakeSolver {
         }
         let (pr, pp) = (pairs.as_array(), pair_params.as_array());
         if pr.ncols() != 2 || pp.shape() != [pr.nrows(), 2] {
-            return Err(err(format!(
+            return Err(invalid(format!(
                 "pairs must be (P, 2) and pair_params (P, 2), got {:?} and {:?}",
                 pr.shape(),
                 pp.shape()
@@ -152,7 +153,7 @@ impl SnakeSolver {
             let kind = match pp[[k, 0]] {
                 0.0 => PairKind::MinGap,
                 1.0 => PairKind::Keep,
-                v => return Err(err(format!("pair {k} kind must be 0 or 1, got {v}"))),
+                v => return Err(invalid(format!("pair {k} kind must be 0 or 1, got {v}"))),
             };
             specs.push(PairSpec {
                 a: pr[[k, 0]] as usize,
@@ -251,7 +252,7 @@ impl SnakeSolver {
         let (start, rest) = (rows::<2, _>("start", &start)?, rows::<2, _>("rest", &rest)?);
         let n = self.problem.n_knots();
         if start.len() != n || rest.len() != n {
-            return Err(err(format!(
+            return Err(invalid(format!(
                 "start and rest must have {n} knots, got {} and {}",
                 start.len(),
                 rest.len()
@@ -260,7 +261,7 @@ impl SnakeSolver {
         let bands = bands_of(&bands, n)?;
         let mouth = mouth_knots
             .as_slice()
-            .map_err(|_| err("mouth_knots must be a contiguous array".into()))?;
+            .map_err(|_| invalid("mouth_knots must be a contiguous array"))?;
         within("mouth_knots", mouth, n)?;
         let curves = mouth_curves.as_array().to_vec();
         let more = MorePasses {
@@ -275,7 +276,7 @@ impl SnakeSolver {
             down: [down.0, down.1],
             pair_targets: pair_targets
                 .as_slice()
-                .map_err(|_| err("pair_targets must be a contiguous array".into()))?,
+                .map_err(|_| invalid("pair_targets must be a contiguous array"))?,
             bounds: [bounds.0, bounds.1],
         };
         // The buffer is locked with the GIL released: a second thread tracking on this solver
@@ -358,7 +359,7 @@ impl<'a> FrameArgs<'a> {
     ) -> PyResult<Self> {
         let shape = field.as_array().shape().to_vec();
         if shape[2] != FIELD_CHANNELS {
-            return Err(err(format!(
+            return Err(invalid(format!(
                 "field must have shape (H, W, {}), got {shape:?}",
                 FIELD_CHANNELS
             )));
@@ -366,7 +367,7 @@ impl<'a> FrameArgs<'a> {
         Ok(FrameArgs {
             data: field
                 .as_slice()
-                .map_err(|_| err("field must be a C-contiguous float32 array".into()))?,
+                .map_err(|_| invalid("field must be a C-contiguous float32 array"))?,
             shape,
             origin: [origin.0, origin.1],
             bounds: [bounds.0, bounds.1],
@@ -414,7 +415,7 @@ fn frame_field<'py>(
     let shape = snake::field_shape(&img, before.as_ref(), region, sigma).map_err(CoreErr)?;
     let out = match out {
         Some(o) if o.shape() != shape => {
-            return Err(err(format!(
+            return Err(invalid(format!(
                 "out must have shape {shape:?}, got {:?}",
                 o.shape()
             )))
@@ -426,7 +427,7 @@ fn frame_field<'py>(
         let mut buf = out.try_readwrite()?;
         let slice = buf
             .as_slice_mut()
-            .map_err(|_| err("out must be a C-contiguous float32 array".into()))?;
+            .map_err(|_| invalid("out must be a C-contiguous float32 array"))?;
         py.detach(|| {
             snake::frame_field(
                 &img,
@@ -484,7 +485,7 @@ fn reported_knots<'py>(
     let linear = matrix::<2>("linear", &linear)?;
     let (upper, lower) = (upper.as_array().to_vec(), lower.as_array().to_vec());
     if upper.len() != lower.len() {
-        return Err(err("upper and lower must pair their knots".into()));
+        return Err(invalid("upper and lower must pair their knots"));
     }
     within("upper", &upper, knots.len())?;
     within("lower", &lower, knots.len())?;
