@@ -42,10 +42,10 @@ from urllib.parse import parse_qs, urlparse
 import cv2
 import numpy as np
 
-from facemime.animate.analysis import Analysis
+from facemime.animate.analysis import start_analysis
 from facemime.animate.replay import FPS_RANGE, load_replay
 from facemime.animate.synth import Puppet, UserMotion
-from facemime.errors import FacemimeError, InputFileError, InvalidInputError, NoFaceError
+from facemime.errors import FacemimeError, InputFileError, InvalidInputError
 from facemime.fit.actor import Actor
 from facemime.fit.placement import model_iod
 from facemime.io.video import VideoReader
@@ -121,10 +121,7 @@ class Viewer:
                             "the viewer plays one frame size"
                         )
                     if analysis is None:
-                        try:
-                            analysis = Analysis(frame, str(self.source), fps=self.fps)
-                        except NoFaceError as e:
-                            raise NoFaceError(f"{e}; the video must start with a frontal face") from None
+                        analysis = start_analysis(frame, str(self.source), fps=self.fps)
                         puppet = Puppet(
                             self._actor or analysis.actor,
                             analysis.deformer.feature_sizes(),

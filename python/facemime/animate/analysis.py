@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
@@ -216,3 +217,13 @@ class Analysis:
             "feature_sizes": np.round(self.deformer.feature_sizes(), 3).tolist(),
             "iod": round(model_iod(self.actor.model), 3),
         }
+
+
+def start_analysis(frame: np.ndarray, video: str, **options: Any) -> Analysis:
+    """The :class:`Analysis` of a video whose first frame is ``frame`` (``video``: its name, in
+    messages; ``options``: :class:`Analysis`'s). Raises :class:`~facemime.errors.NoFaceError`,
+    saying that the video must start with a frontal face, where that frame shows none."""
+    try:
+        return Analysis(frame, f"the first frame of {video}", **options)
+    except NoFaceError as e:
+        raise NoFaceError(f"{e}; the video must start with a frontal face") from None

@@ -21,11 +21,11 @@ from pathlib import Path
 
 import numpy as np
 
-from facemime.animate.analysis import Analysis
+from facemime.animate.analysis import Analysis, start_analysis
 from facemime.animate.departure import DEPARTS_AT, departure
 from facemime.animate.expressions import Expressions
 from facemime.animate.synth import Puppet, UserMotion
-from facemime.errors import InputFileError, InvalidInputError, NoFaceError
+from facemime.errors import InputFileError, InvalidInputError
 from facemime.fit.actor import Actor
 from facemime.fit.placement import model_iod
 from facemime.io.actor_file import load_actor
@@ -125,10 +125,7 @@ class SideBySide:
                 break
             h, w = frame.shape[:2]
             if self.analysis is None:
-                try:
-                    self.analysis = Analysis(frame, f"the first frame of {self._name}", self._params, fps=self._fps)
-                except NoFaceError as e:
-                    raise NoFaceError(f"{e}; the video must start with a frontal face") from None
+                self.analysis = start_analysis(frame, self._name, params=self._params, fps=self._fps)
                 actor = self.analysis.actor
                 driven = actor if self._target is None else self._target
                 puppet = Puppet(

@@ -21,11 +21,11 @@ from typing import Protocol
 import numpy as np
 
 from facemime import _core
-from facemime.animate.analysis import Analysis, FrameMotion
+from facemime.animate.analysis import FrameMotion, start_analysis
 from facemime.codec.files import Clip, encode_clip
 from facemime.codec.params import Basis, pose_vector
 from facemime.codec.stream import DEFAULT_QUALITY, LADDER, MotionEncoder, Settings
-from facemime.errors import InputFileError, InvalidInputError, NoFaceError
+from facemime.errors import InputFileError, InvalidInputError
 from facemime.fit.actor import Actor
 from facemime.io.actor_file import actor_bytes
 from facemime.io.video import VideoReader
@@ -208,10 +208,7 @@ class Sender(threading.Thread):
         first, arrived = next(self._frames, (None, 0.0))
         if first is None:
             raise InputFileError(f"{source.name} has no frames")
-        try:
-            self.analysis = Analysis(first, f"the first frame of {source.name}", actor=actor, fps=source.fps)
-        except NoFaceError as e:
-            raise NoFaceError(f"{e}; the video must start with a frontal face") from None
+        self.analysis = start_analysis(first, source.name, actor=actor, fps=source.fps)
         self.actor = actor or self.analysis.actor
         # made now, not when the stream starts: encoding the texture and scene takes ~0.3 s, which
         # delayed the first packets that much

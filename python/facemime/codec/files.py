@@ -22,14 +22,14 @@ from pathlib import Path
 import numpy as np
 
 from facemime import _core
-from facemime.animate.analysis import Analysis, FrameMotion
+from facemime.animate.analysis import FrameMotion, start_analysis
 from facemime.animate.deform import Deformer
 from facemime.animate.look import Look
 from facemime.animate.synth import Puppet
 from facemime.codec.appearance import Appearance, AppearanceSender
 from facemime.codec.params import Basis, pose_vector
 from facemime.codec.stream import LADDER, MotionDecoder, MotionEncoder, Settings, StreamError
-from facemime.errors import InputFileError, InvalidInputError, NoFaceError
+from facemime.errors import InputFileError, InvalidInputError
 from facemime.fit.actor import Actor
 from facemime.fit.placement import model_iod
 from facemime.io.actor_file import load_actor
@@ -99,10 +99,7 @@ def analyse(video: str | Path, actor: Actor | None = None) -> Clip:
         analysis, motion = None, []
         for frame in progress(reader, reader.frames or None, "analysing"):
             if analysis is None:
-                try:
-                    analysis = Analysis(frame, f"the first frame of {video}", actor=actor, fps=reader.fps)
-                except NoFaceError as e:
-                    raise NoFaceError(f"{e}; the video must start with a frontal face") from None
+                analysis = start_analysis(frame, str(video), actor=actor, fps=reader.fps)
                 motion.append(analysis.last)
             else:
                 motion.append(analysis.update(frame))
