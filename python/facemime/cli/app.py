@@ -5,6 +5,7 @@ modules beside this one, one per family; :mod:`facemime.cli.main` runs them."""
 from __future__ import annotations
 
 from enum import IntEnum
+from pathlib import Path
 
 import click
 
@@ -31,6 +32,16 @@ class ExitStatus(IntEnum):
 def cli(traceback: bool) -> None:
     """Track mouth and eyebrow motion with dynamic contours and re-synthesise it on a textured
     3D head model."""
+
+
+def actor_option(help: str):
+    """``--actor NAME.actor`` (``actor_file``), with what it is for in this command."""
+    return click.option("--actor", "actor_file", type=click.Path(path_type=Path), help=help)
+
+
+def out_option(help: str):
+    """``--out PATH`` (``out_file``, required), with what is written there."""
+    return click.option("--out", "out_file", type=click.Path(path_type=Path), required=True, help=help)
 
 
 #: ``--force`` of every command that writes files.

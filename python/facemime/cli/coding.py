@@ -7,18 +7,15 @@ from pathlib import Path
 
 import click
 
-from facemime.cli.app import cli, force_option, mask_only_option
+from facemime.cli.app import actor_option, cli, force_option, mask_only_option, out_option
 
 
 @cli.command()
 @click.argument("video", metavar="VIDEO_OR_TRACK", type=click.Path(path_type=Path))
-@click.option(
-    "--actor",
-    "actor_file",
-    type=click.Path(path_type=Path),
-    help="NAME.actor of this person that the receiver already holds: the stream names it instead of "
+@actor_option(
+    "NAME.actor of this person that the receiver already holds: the stream names it instead of "
     "carrying it (default: fit one on the first frame, or for a track file the generic head, "
-    "and carry it).",
+    "and carry it)."
 )
 @click.option("--quality", type=click.IntRange(0, 10), help="0 (coarsest) to 10 (finest); default 5, under 2 kbit/s.")
 @click.option(
@@ -46,7 +43,7 @@ from facemime.cli.app import cli, force_option, mask_only_option
     show_default=True,
     help="kbit/s for sending the face's appearance again where it changes (light, skin); 0: never.",
 )
-@click.option("--out", "out_file", type=click.Path(path_type=Path), required=True, help="X.fmstream to write.")
+@out_option("X.fmstream to write.")
 @force_option
 def encode(
     video: Path,
@@ -93,19 +90,8 @@ def encode(
 
 @cli.command()
 @click.argument("stream", type=click.Path(path_type=Path))
-@click.option(
-    "--actor",
-    "actor_file",
-    type=click.Path(path_type=Path),
-    help="NAME.actor the stream names, when the stream does not carry its actor.",
-)
-@click.option(
-    "--out",
-    "out_file",
-    type=click.Path(path_type=Path),
-    required=True,
-    help="Video of the synthesised picture to write (.mp4 or .webm).",
-)
+@actor_option("NAME.actor the stream names, when the stream does not carry its actor.")
+@out_option("Video of the synthesised picture to write (.mp4 or .webm).")
 @mask_only_option
 @force_option
 def decode(stream: Path, actor_file: Path | None, out_file: Path, mask_only: bool, force: bool) -> None:
@@ -132,12 +118,7 @@ def decode(stream: Path, actor_file: Path | None, out_file: Path, mask_only: boo
 
 @cli.command()
 @click.argument("source", metavar="VIDEO_OR_CAMERA")
-@click.option(
-    "--actor",
-    "actor_file",
-    type=click.Path(path_type=Path),
-    help="NAME.actor of this person to send (default: fit one on the first frame); the stream carries it.",
-)
+@actor_option("NAME.actor of this person to send (default: fit one on the first frame); the stream carries it.")
 @click.option(
     "--port",
     default=8766,

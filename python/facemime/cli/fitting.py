@@ -7,12 +7,12 @@ from pathlib import Path
 
 import click
 
-from facemime.cli.app import cli, force_option
+from facemime.cli.app import cli, force_option, out_option
 
 
 @cli.command("model-preview")
 @click.argument("model", required=False, type=click.Path(path_type=Path))
-@click.option("--out", "out_file", type=click.Path(path_type=Path), required=True, help="PNG to write.")
+@out_option("PNG to write.")
 @force_option
 def model_preview(model: Path | None, out_file: Path, force: bool) -> None:
     """Render a head model (facemime .json or CANDIDE .wfm; default: the built-in head) from
@@ -43,13 +43,7 @@ def model_preview(model: Path | None, out_file: Path, force: bool) -> None:
     type=click.Path(path_type=Path),
     help="facemime.points/1 JSON with reference points marked by hand (default: found automatically).",
 )
-@click.option(
-    "--out",
-    "out_file",
-    type=click.Path(path_type=Path),
-    required=True,
-    help="NAME.actor to write; the preview goes to NAME.preview.png.",
-)
+@out_option("NAME.actor to write; the preview goes to NAME.preview.png.")
 @force_option
 def fit(source: Path, frame: int, points_file: Path | None, out_file: Path, force: bool) -> None:
     """Fit the generic head to the frontal face in IMAGE_OR_VIDEO: reference points, elastic
@@ -75,9 +69,7 @@ def fit(source: Path, frame: int, points_file: Path | None, out_file: Path, forc
     help="facemime.init/1 JSON with the eight contours of the first tracked frame "
     "(default: found automatically on the first frame).",
 )
-@click.option(
-    "--out", "out_file", type=click.Path(path_type=Path), required=True, help="facemime.track/1 JSON to write."
-)
+@out_option("facemime.track/1 JSON to write.")
 @click.option(
     "--overlay", type=click.Path(path_type=Path), help="Also write the video with the contours drawn (.mp4 or .webm)."
 )

@@ -8,25 +8,18 @@ from pathlib import Path
 
 import click
 
-from facemime.cli.app import cli, force_option, mask_only_option, user_motion_options
+from facemime.cli.app import actor_option, cli, force_option, mask_only_option, out_option, user_motion_options
 
 
 @cli.command()
 @click.argument("video", metavar="VIDEO_OR_TRACK", type=click.Path(path_type=Path))
-@click.option(
-    "--actor",
-    "actor_file",
-    type=click.Path(path_type=Path),
-    help="NAME.actor to drive (from facemime fit; default: the face fitted on the first frame, or for a "
-    "track file the generic head).",
+@actor_option(
+    "NAME.actor to drive (from facemime fit; default: the face fitted on the first frame, or for a "
+    "track file the generic head)."
 )
-@click.option(
-    "--out",
-    "out_file",
-    type=click.Path(path_type=Path),
-    required=True,
-    help="Side-by-side video to write (.mp4 or .webm): the original with contours | the synthesised picture "
-    "(for a track file: the synthesised picture alone).",
+@out_option(
+    "Side-by-side video to write (.mp4 or .webm): the original with contours | the synthesised picture "
+    "(for a track file: the synthesised picture alone)."
 )
 @click.option(
     "--track",
@@ -107,12 +100,7 @@ def run(
 
 @cli.command()
 @click.argument("source", metavar="VIDEO_OR_TRACK", type=click.Path(path_type=Path))
-@click.option(
-    "--actor",
-    "actor_file",
-    type=click.Path(path_type=Path),
-    help="NAME.actor to drive (default: the video's own face, or the generic head for a track file).",
-)
+@actor_option("NAME.actor to drive (default: the video's own face, or the generic head for a track file).")
 @click.option("--port", default=8765, show_default=True, help="Local port of the viewer's web page (0: any free port).")
 @click.option("--no-browser", is_flag=True, help="Do not open a browser; print the address only.")
 @mask_only_option
@@ -141,19 +129,10 @@ def view(source: Path, actor_file: Path | None, port: int, no_browser: bool, mas
 
 @cli.command()
 @click.argument("track", type=click.Path(path_type=Path))
-@click.option(
-    "--actor",
-    "actor_file",
-    type=click.Path(path_type=Path),
-    help="NAME.actor to carry the performance (default: the generic head, as view plays a track file).",
-)
-@click.option(
-    "--out",
-    "out_file",
-    type=click.Path(path_type=Path),
-    required=True,
-    help="PERFORMANCE.glb to write: binary glTF 2.0, the textured head, its expression morph targets and "
-    "one animation (weights and head pose) at the track's frame rate.",
+@actor_option("NAME.actor to carry the performance (default: the generic head, as view plays a track file).")
+@out_option(
+    "PERFORMANCE.glb to write: binary glTF 2.0, the textured head, its expression morph targets and "
+    "one animation (weights and head pose) at the track's frame rate."
 )
 @force_option
 def export(track: Path, actor_file: Path | None, out_file: Path, force: bool) -> None:
