@@ -1,5 +1,5 @@
 //! Elastic adjustment of a wire-frame model to contours marked on a frontal image
-//! (method.md §2, after Reinders et al.).
+//! (docs/method.md §2, after Reinders et al.).
 //!
 //! Everything is 2-D, in image pixels: the model's vertices as projected in the frontal view.
 //! A *contour* pairs a chain of model vertices (V_1..V_nv, a polyline through the current

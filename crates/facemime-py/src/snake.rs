@@ -14,8 +14,8 @@ use std::sync::Mutex;
 use crate::error::{invalid, CoreErr};
 use crate::points::{array, image_view, matrix, rows, same_length};
 
-/// Curves over one shared knot array solved jointly by sign descent. See
-/// `facemime.track.snake` for the documented API; arrays follow its conventions.
+/// Curves over one shared knot array solved jointly by sign descent (docs/method.md §1), as
+/// `facemime.track.tracker.Tracker` builds and runs it; arrays follow its conventions.
 #[pyclass(module = "facemime._core", frozen)]
 pub struct SnakeSolver {
     problem: Problem,

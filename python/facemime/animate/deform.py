@@ -1,5 +1,5 @@
 """Local deformation: the tracked mouth and brow contours, taken into the head's own frame, move
-their model vertices (the knots), and every other vertex follows smoothly (method.md §3).
+their model vertices (the knots), and every other vertex follows smoothly (docs/method.md §3).
 
 Knot offsets are (x, y) displacements in model units (millimetres for the built-in head) in the
 head's own frame — with the head's rotation, scale and translation taken out — relative to the

@@ -1,4 +1,4 @@
-"""Fitting the generic head to one person (method.md §2): reference points (from a file or found
+"""Fitting the generic head to one person (docs/method.md §2): reference points (from a file or found
 automatically), placement and elastic adjustment, texture smearing, and the resulting actor."""
 
 from facemime.fit.auto import AutoPoints, auto_points

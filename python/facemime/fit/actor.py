@@ -80,7 +80,7 @@ class Actor:
 
 def smear_texture(model: HeadModel, photo: np.ndarray, fit: Fit, points: ReferencePoints, source: dict) -> Actor:
     """Build the actor: ``model`` with ``fit``'s vertices, textured by ``photo`` ((H, W, 3) uint8
-    RGB) — each vertex's texture coordinate is where it projects in the photo (method.md §2.4)."""
+    RGB) — each vertex's texture coordinate is where it projects in the photo (docs/method.md §2.4)."""
     h, w = photo.shape[:2]
     px = project(fit.vertices, fit.pose)[0]
     lo, hi = px.min(axis=0), px.max(axis=0)

@@ -1,4 +1,4 @@
-"""Placing and elastically adjusting a head model on reference points (method.md §2).
+"""Placing and elastically adjusting a head model on reference points (docs/method.md §2).
 
 The model is seen frontally (yaw = pitch = 0) under the orthographic projection of
 :mod:`facemime.render.projection`: a :class:`~facemime.render.projection.Pose` with a roll, a

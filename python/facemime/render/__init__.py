@@ -1,4 +1,4 @@
-"""Synthesis (method.md §3): orthographic projection, back-face culling, far-to-near order and
+"""Synthesis (docs/method.md §3): orthographic projection, back-face culling, far-to-near order and
 per-triangle affine texture mapping, the last three in the Rust core."""
 
 from facemime.render.projection import Pose, project, rotation_matrix

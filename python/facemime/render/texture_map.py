@@ -1,4 +1,4 @@
-"""Texture-mapped triangle meshes, drawn by the Rust core (method.md §3, the paper's eq. 18).
+"""Texture-mapped triangle meshes, drawn by the Rust core (docs/method.md §3, the paper's eq. 18).
 
 Each destination triangle A'B'C' is filled scan line by scan line; every destination pixel P'
 takes the texture at ``P = A + M (P' - A')`` with M solved once per triangle, so no deformation

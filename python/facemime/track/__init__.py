@@ -1,4 +1,4 @@
-"""Tracking mouth and eyebrow contours through a video with STB-snakes (method.md §1).
+"""Tracking mouth and eyebrow contours through a video with STB-snakes (docs/method.md §1).
 
 The public entry point is :class:`facemime.track.Tracker`, fed one frame at a time.
 """

@@ -4,7 +4,7 @@ the face between consecutive frames, from pyramidal Lucas-Kanade optical flow
 in the rigid parts of the face (nose bridge and nose, forehead), forward-backward checked and
 fitted robustly (:func:`robust_similarity`, deterministic: the same frames always give the same
 track). Mouth and brows ride on this motion before the snakes refine them, so the
-snake search range δ0/(1−σ) can stay small (method.md §4).
+snake search range δ0/(1−σ) can stay small (docs/method.md §4).
 
 Transforms are 2×3 float64 matrices mapping (x, y) pixels of one frame to another.
 """

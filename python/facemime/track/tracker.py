@@ -1,6 +1,6 @@
 """The contour tracker: the eight mouth and brow curves of ``facemime.track.contours`` as
 STB-snakes over one shared knot array, solved jointly each frame after head-motion
-compensation (method.md §1).
+compensation (docs/method.md §1).
 
 Per frame:
 
@@ -68,7 +68,7 @@ AGREE = 1.0
 
 @dataclass(frozen=True)
 class CurveWeights:
-    """Energy weights of a curve (method.md §1): tension α, rigidity β (both against the rest
+    """Energy weights of a curve (docs/method.md §1): tension α, rigidity β (both against the rest
     shape), temporal smoothness τ, image contrast ρ, temporal brightness γ, and the weights of
     the luma and colour (red − green) derivatives in H (their signs come from the edge's
     polarity, :data:`facemime.track.contours.POLARITY`)."""

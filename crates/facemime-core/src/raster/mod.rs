@@ -1,4 +1,4 @@
-//! Texture-mapping rasteriser (method.md §3, the paper's eq. 18).
+//! Texture-mapping rasteriser (docs/method.md §3, the paper's eq. 18).
 //!
 //! - [`span`]: which pixels a triangle covers, scan line by scan line, with exact integer edge
 //!   functions so that triangles sharing an edge cover every pixel exactly once.

@@ -1,4 +1,4 @@
-//! The energies of one curve (method.md §1) and of the knot pairs that couple curves, each
+//! The energies of one curve (docs/method.md §1) and of the knot pairs that couple curves, each
 //! returned with its gradient with respect to the knot coordinates.
 //!
 //! For a curve with knots K_0..K_m, rest knots R_0..R_m, starting knots S_0..S_m and chord Δ:

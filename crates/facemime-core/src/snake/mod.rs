@@ -1,4 +1,4 @@
-//! STB-snakes (Nesi & Magnolfi 1996, §2; method.md §1): open curves given by m+1 knots, drawn as
+//! STB-snakes (Nesi & Magnolfi 1996, §2; docs/method.md §1): open curves given by m+1 knots, drawn as
 //! the linear B-spline through them with n points per segment, moved frame to frame by the
 //! paper's sign-descent solver.
 //!
