@@ -11,7 +11,58 @@ Conventions used across the package:
 - Left/right of the face are the subject's own.
 """
 
-from facemime._core import __version__
-from facemime.errors import FacemimeError, InputFileError, InvalidInputError, ModelFormatError
+from __future__ import annotations
 
-__all__ = ["FacemimeError", "InputFileError", "InvalidInputError", "ModelFormatError", "__version__"]
+import importlib
+from typing import Any
+
+from facemime._core import __version__
+from facemime.errors import FacemimeError, InputFileError, InvalidInputError, ModelFormatError, NoFaceError
+
+#: The public API: name -> the module that defines it, imported on first use (``import facemime``
+#: stays light: the command line and the errors need none of these modules). Where each lives, and
+#: its documentation, is that module's; these names stay when modules move.
+_API = {
+    # one function per command, files in and out (as the command line runs them)
+    "fit_file": "facemime.fit.run",
+    "track_video": "facemime.track.video",
+    "run_video": "facemime.animate.run",
+    "encode_video": "facemime.codec.files",
+    "decode_stream": "facemime.codec.files",
+    "export_track": "facemime.export.performance",
+    "run_batch": "facemime.batch",
+    "run_demo": "facemime.demo",
+    # frame by frame, in memory
+    "read_photo": "facemime.io.photo",
+    "VideoReader": "facemime.io.video",
+    "VideoWriter": "facemime.io.video",
+    "fit_actor": "facemime.fit.run",
+    "Actor": "facemime.fit.actor",
+    "load_actor": "facemime.io.actor_file",
+    "save_actor": "facemime.io.actor_file",
+    "FaceTracker": "facemime.track.redetect",
+    "Analysis": "facemime.animate.analysis",
+    "start_analysis": "facemime.animate.analysis",
+    "Puppet": "facemime.animate.synth",
+    "UserMotion": "facemime.animate.synth",
+    "Pose": "facemime.render.projection",
+    "Look": "facemime.animate.look",
+    "MotionEncoder": "facemime.codec.stream",
+    "MotionDecoder": "facemime.codec.stream",
+}
+
+__all__ = [
+    "FacemimeError", "InputFileError", "InvalidInputError", "ModelFormatError", "NoFaceError", "__version__", *_API,
+]  # fmt: skip
+
+
+def __getattr__(name: str) -> Any:
+    if name not in _API:
+        raise AttributeError(f"module 'facemime' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_API[name]), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_API))
