@@ -18,6 +18,12 @@ from facemime.codec.stream import MotionDecoder
 from facemime.io.video import VideoReader
 
 INTRA, INTER = 3, 4  # packet kinds
+#: The call has ended and the page has drawn every frame it decoded (drawing can lag behind).
+DRAWN_TO_THE_END = (
+    "() => { const s = window.facemime.stats();"
+    " return document.getElementById('message').textContent.includes('ended')"
+    " && s.drawn > 0 && window.facemime.frames.length === s.frames + s.concealed; }"
+)
 
 
 def start_call(shared, record) -> tuple[subprocess.Popen, str]:
@@ -57,7 +63,7 @@ def test_two_pages_receive_a_live_call_one_of_them_losing_packets(browser, share
         _, err = proc.communicate(timeout=120)
         assert proc.returncode == 0, err
         for page in (whole, lossy):
-            page.wait_for_function("() => document.getElementById('message').textContent.includes('ended')")
+            page.wait_for_function(DRAWN_TO_THE_END, timeout=60000)
         got = {
             name: (
                 page.evaluate("() => window.facemime.frames"),
@@ -112,12 +118,7 @@ def test_a_page_whose_drawing_lags_behind_the_call_still_resynchronises(browser,
         page.goto(url + "?drop=0.1&seed=3&slow=60")
         _, err = proc.communicate(timeout=120)
         assert proc.returncode == 0, err
-        page.wait_for_function(
-            "() => { const s = window.facemime.stats();"
-            " return document.getElementById('message').textContent.includes('ended')"
-            " && s.drawn > 0 && window.facemime.frames.length === s.frames + s.concealed; }",
-            timeout=60000,
-        )
+        page.wait_for_function(DRAWN_TO_THE_END, timeout=60000)
         frames, stats = page.evaluate("() => [window.facemime.frames, window.facemime.stats()]")
     finally:
         if proc.poll() is None:
