@@ -420,3 +420,137 @@ def test_numbers_too_large_for_a_float_give_one_line(files, tmp_path, capsys):
         "mouth_outer_upper",
     )
     assert listing(tmp_path) == ["init.json"]
+
+
+# Found by a hostile-input sweep of every command (each case used to end as "a bug", exit 2, or hang).
+def edited_actor(src, dst, edit):
+    """``src`` with its actor.json changed by ``edit`` (a function of the parsed document)."""
+    with zipfile.ZipFile(src) as z, zipfile.ZipFile(dst, "w") as out:
+        for info in z.infolist():
+            data = z.read(info)
+            if info.filename == "actor.json":
+                doc = json.loads(data)
+                edit(doc)
+                data = json.dumps(doc).encode()
+            out.writestr(info.filename, data)
+
+
+def encrypted_actor(src, dst):
+    """``src`` with every member marked encrypted (bit 0 of the flags of its local and central
+    headers), as zipfile reads an archive it needs a password for."""
+    data = bytearray(src.read_bytes())
+    for signature, flags in ((b"PK\x03\x04", 6), (b"PK\x01\x02", 8)):
+        at = data.find(signature)
+        while at >= 0:
+            data[at + flags] |= 1
+            at = data.find(signature, at + 4)
+    dst.write_bytes(bytes(data))
+
+
+def short_eyes(doc):
+    doc["model"]["groups"]["eye_left"] = doc["model"]["groups"]["eye_left"][:4]
+
+
+def eyes_off_the_texture(doc):
+    for v in doc["model"]["groups"]["eye_left"]:
+        doc["model"]["uv"][v][0] = 1.3
+
+
+def huge_scale(doc):
+    doc["pose"]["scale"] = 1e300
+
+
+@pytest.mark.parametrize(
+    ("make", "message"),
+    [
+        (encrypted_actor, "an encrypted archive"),
+        (lambda src, dst: edited_actor(src, dst, short_eyes), "eye_left has 4 (needs 8)"),
+        (lambda src, dst: edited_actor(src, dst, eyes_off_the_texture), "eyes' texture coordinates"),
+        (lambda src, dst: edited_actor(src, dst, huge_scale), "pose out of range"),
+    ],
+)
+def test_actor_files_that_passed_validation_and_then_broke_give_one_line(files, tmp_path, capsys, make, message):
+    make(files / "a.actor", tmp_path / "bad.actor")
+    track = tmp_path / "t.json"
+    one_line_error(
+        *run(capsys, "encode", str(files / "face.mp4"), "--actor", str(tmp_path / "bad.actor"), "--out", "x.fmstream"),
+        message,
+    )
+    assert not track.exists()
+
+
+def test_a_stream_whose_starting_pose_is_out_of_range_gives_one_line(actor, tmp_path, capsys):
+    from facemime.codec.params import Basis
+    from facemime.codec.stream import MotionEncoder, Settings
+    from facemime.render.projection import Pose
+
+    basis = Basis.learn(np.zeros((4, 60, 2)), 2)
+    encoder = MotionEncoder(actor, 25.0, (640, 480), basis, Settings(), True, reference=Pose(scale=1e-30))
+    frames = [encoder.push(True, [], Pose(scale=1.0, tx=320, ty=240), np.zeros((60, 2))).data for _ in range(4)]
+    (tmp_path / "s.fmstream").write_bytes(encoder.start() + b"".join(frames) + encoder.finish())
+    code, out, err = run(capsys, "decode", str(tmp_path / "s.fmstream"), "--out", str(tmp_path / "d.mp4"))
+    one_line_error(code, out, err, "starting pose is out of range")
+    assert listing(tmp_path) == ["s.fmstream"]
+
+
+def test_a_head_model_index_beyond_any_integer_gives_one_line(tmp_path, capsys):
+    (tmp_path / "big.wfm").write_text(
+        "# VERTEX LIST:\n3\n0 0 0\n1 0 0\n0 1 0\n# FACE LIST:\n1\n0 1 99999999999999999999999\n"
+    )
+    code, out, err = run(capsys, "model-preview", str(tmp_path / "big.wfm"), "--out", str(tmp_path / "p.png"))
+    one_line_error(code, out, err, "FACE LIST")
+
+
+def test_a_track_whose_pose_is_out_of_range_gives_one_line(shared, tmp_path, capsys):
+    track = tmp_path / "t.json"
+    assert run(capsys, "run", str(shared / "video" / "lp_d0.mp4"), "--out", str(tmp_path / "r.mp4"))[0] == 0
+    doc = json.loads((tmp_path / "r.json").read_text())
+    doc["frames"][5]["pose"]["tx"] = 1e300
+    track.write_text(json.dumps(doc))
+    for command, out in (("export", "p.glb"), ("encode", "s.fmstream")):
+        code, stdout, err = run(capsys, command, str(track), "--out", str(tmp_path / out))
+        one_line_error(code, stdout, err, "frame entry 5 has a pose out of range")
+        assert not (tmp_path / out).exists()
+
+
+def test_fit_refuses_points_whose_eyes_coincide(tmp_path, capsys, astronaut):
+    points = {
+        "format": "facemime.points/1",
+        "points": {
+            "eye_right_outer": [100, 100], "eye_right_inner": [100, 100], "eye_left_inner": [100, 100],
+            "eye_left_outer": [100, 100], "mouth_outer_upper": [[90, 200], [110, 195], [130, 200]],
+            "mouth_outer_lower": [[90, 200], [110, 210], [130, 200]],
+        },
+    }  # fmt: skip
+    (tmp_path / "p.json").write_text(json.dumps(points))
+    code, out, err = run(capsys, "fit", str(astronaut), "--points", str(tmp_path / "p.json"), "--out", "x.actor")
+    one_line_error(code, out, err, "the outer eye corners are 0.0 px apart")
+
+
+def test_a_call_that_cannot_write_its_recording_stops_at_once(shared, tmp_path):
+    (tmp_path / "file").write_text("a file, not a folder")
+    done = subprocess.run(
+        [sys.executable, "-m", "facemime", "call", str(shared / "video" / "lp_d0.mp4"), "--no-browser", "--port", "0",
+         "--record", str(tmp_path / "file" / "c.fmstream")],
+        capture_output=True, text=True, timeout=60, input="",
+    )  # fmt: skip
+    assert done.returncode == 1 and done.stderr.strip().splitlines()[-1].startswith("facemime: error: cannot write")
+
+
+def test_a_call_of_a_video_shorter_than_its_warm_up_fails_and_records_nothing(shared, tmp_path):
+    from facemime.io.video import VideoReader
+
+    with VideoReader(shared / "video" / "lp_d0.mp4") as reader, VideoWriter(tmp_path / "two.mp4", fps=25) as w:
+        for _, frame in zip(range(2), reader):
+            w.write(frame)
+    record = tmp_path / "c.fmstream"
+    done = subprocess.run(
+        [sys.executable, "-m", "facemime", "call", str(tmp_path / "two.mp4"), "--no-browser", "--port", "0",
+         "--record", str(record)],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert done.returncode == 1, done.stderr
+    assert done.stderr.strip().splitlines()[-1] == (
+        "facemime: error: two.mp4 has 2 frames, fewer than the 50 of warm-up the call analyses before it streams"
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["two.mp4"]

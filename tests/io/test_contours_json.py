@@ -276,10 +276,13 @@ def test_motion_frames_default_their_index_face_and_lost(tmp_path):
         ({"frames": {}}, "'frames' must be a non-empty list"),
         ({"frames": [[1]]}, "frame entry 0 needs a 'pose'"),
         ({"pose": {"yaw": 0}}, "frame entry 0 needs a 'pose' with yaw, pitch, roll, scale, tx, ty and 'offsets'"),
-        ({"offsets": [[0.0, 0.0]] * 2}, "frame entry 0 has malformed 'offsets' or 'pose'"),
-        ({"offsets": [[0.0, 0.0], [0.0, 1e999], [0.0, 0.0]]}, "frame entry 0 has malformed 'offsets' or 'pose'"),
-        ({"scale": 0.0}, "frame entry 0 has malformed 'offsets' or 'pose'"),
-        ({"yaw": 1e999}, "frame entry 0 has malformed 'offsets' or 'pose'"),
+        ({"offsets": [[0.0, 0.0]] * 2}, "frame entry 0 has malformed 'offsets'"),
+        ({"offsets": [[0.0, 0.0], [0.0, 1e999], [0.0, 0.0]]}, "frame entry 0 has malformed 'offsets'"),
+        ({"offsets": [[0.0, 0.0], [0.0, 1e300], [0.0, 0.0]]}, "frame entry 0 has malformed 'offsets'"),
+        ({"scale": 0.0}, "frame entry 0 has a pose out of range"),
+        ({"scale": 1e300}, "frame entry 0 has a pose out of range"),
+        ({"tx": -1e300}, "frame entry 0 has a pose out of range"),
+        ({"yaw": 1e999}, "frame entry 0 has a pose out of range"),
         ({"lost": "mouth"}, "frame entry 0: 'lost' must be a list of feature names"),
         ({"lost": [1]}, "frame entry 0: 'lost' must be a list of feature names"),
     ],
@@ -291,7 +294,7 @@ def test_bad_motion_files_give_one_line_naming_the_file(tmp_path, change, messag
     for key, value in change.items():
         if key in ("model", "frames"):
             doc[key] = value
-        elif key in ("scale", "yaw"):
+        elif key in ("scale", "yaw", "tx"):
             frame["pose"][key] = value
         else:
             frame[key] = value

@@ -86,6 +86,8 @@ class Call:
         self._serving: threading.Thread | None = None
         self.server = None
         try:
+            if self.record_path is not None:
+                self._recording = _Recording(self.record_path)
             self.sender = Sender(self.source, self, actor, quality, packet_frames, keyframe, warmup, rate)
             self.hub = Hub(
                 {
@@ -97,12 +99,12 @@ class Call:
                 self.sender.request_intra,
             )
             self.server = make_server(self.hub, port, web)
-            if self.record_path is not None:
-                self._recording = _Recording(self.record_path)
         except BaseException:
             self.source.close()
+            if self._recording is not None:
+                self._recording.close(keep=False)
             if self.server is not None:
-                self.server.shutdown()
+                self.server.socket.close()  # it never served: shutdown() would wait for serve_forever
             raise
 
     @property

@@ -255,10 +255,14 @@ class Sender(threading.Thread):
                     self._start()
             else:
                 self._push(motion, arrived)
-        if self.encoder is None:  # the source ended within the warm-up: a stream of no frames
-            self._start()
-        if not self._stopping.is_set():
-            self._send(self.encoder.finish())
+        if self._stopping.is_set():
+            return
+        if self.encoder is None:  # the source ended within the warm-up: nothing to stream
+            raise InputFileError(
+                f"{self.source.name} has {len(self._warm)} frames, fewer than the {self.warmup_frames} of warm-up "
+                "the call analyses before it streams"
+            )
+        self._send(self.encoder.finish())
 
     def _choose_quality(self) -> None:
         """Without a quality given: the finest whose warm-up frames, coded as the stream will be

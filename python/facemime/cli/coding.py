@@ -195,13 +195,14 @@ def call(
             if s.delays
             else ""
         )
-        click.echo(
-            f"sent {s.frames} frames ({s.warmup_frames} of warm-up not sent) at quality "
-            f"{c.sender.settings.quality}: motion "
-            f"{s.motion_kbit_s(c.sender.fps):.2f} kbit/s ({s.packet_bytes} bytes in {s.packets} packets), "
-            f"header {s.header_bytes} bytes, actor {s.actor_bytes} bytes; {s.intra_honoured} of "
-            f"{s.intra_asked} intra requests honoured; {c.hub.served} clients served{delays}",
-            err=True,
-        )
+        if s.header_bytes:  # a stream started: what it sent
+            click.echo(
+                f"sent {s.frames} frames ({s.warmup_frames} of warm-up not sent) at quality "
+                f"{c.sender.settings.quality}: motion "
+                f"{s.motion_kbit_s(c.sender.fps):.2f} kbit/s ({s.packet_bytes} bytes in {s.packets} packets), "
+                f"header {s.header_bytes} bytes, actor {s.actor_bytes} bytes; {s.intra_honoured} of "
+                f"{s.intra_asked} intra requests honoured; {c.hub.served} clients served{delays}",
+                err=True,
+            )
     if record is not None and c.sender.stats.header_bytes:
         click.echo(str(record))

@@ -32,6 +32,7 @@ from facemime.codec.params import (
 from facemime.errors import FacemimeError, InvalidInputError
 from facemime.fit.actor import Actor
 from facemime.io.actor_file import ActorFileError, actor_bytes, actor_from_bytes, actor_id
+from facemime.io.limits import pose_in_range
 from facemime.render.projection import Pose
 from facemime.track.contours import FEATURES
 
@@ -420,7 +421,12 @@ class MotionDecoder:
         h = self._core.header()
         if h is None:
             raise StreamError(f"{self.name} has no header")
-        return pose_from_vector(np.array(h["references"][:POSE_PARAMETERS]) * np.array(h["steps"][:POSE_PARAMETERS]))
+        values = np.array(h["references"][:POSE_PARAMETERS]) * np.array(h["steps"][:POSE_PARAMETERS])
+        with np.errstate(over="ignore", under="ignore"):  # judged below
+            pose = pose_from_vector(values)
+        if not pose_in_range(pose.yaw, pose.pitch, pose.roll, pose.scale, pose.tx, pose.ty):
+            raise StreamError(f"{self.name}: the header's starting pose is out of range ({pose})")
+        return pose
 
     def _rest(self) -> np.ndarray:
         assert self.info is not None  # read with the header

@@ -53,6 +53,9 @@ GROUPS = {
     "mouth": CONTOUR_NAMES[:4],
 }
 
+#: The least distance between the outer eye corners, px: closer, the points mark no face to fit.
+MIN_EYE_DISTANCE = 8.0
+
 ReferencePoints = dict[str, np.ndarray]
 
 
@@ -93,4 +96,9 @@ def check_points(points: object, width: int, height: int, where: str = "points")
         if (arr < -0.5).any() or (arr[:, 0] > width - 0.5).any() or (arr[:, 1] > height - 0.5).any():
             raise InvalidInputError(f"{where}: {name} has points outside the {width}x{height} image")
         out[name] = arr
+    iod = float(np.linalg.norm(out["eye_right_outer"][0] - out["eye_left_outer"][0]))
+    if iod < MIN_EYE_DISTANCE:
+        raise InvalidInputError(
+            f"{where}: the outer eye corners are {iod:.1f} px apart; a face needs at least {MIN_EYE_DISTANCE:g}"
+        )
     return out

@@ -33,7 +33,7 @@ import numpy as np
 
 from facemime.errors import FacemimeError, InputFileError, InvalidInputError, ModelFormatError
 from facemime.fit.actor import Actor
-from facemime.io.limits import image_size, limit, parse_json
+from facemime.io.limits import image_size, limit, parse_json, pose_in_range
 from facemime.io.outputs import OutputFileError, check_outputs, write_bytes
 from facemime.model.head import head_document, head_from_document
 from facemime.render.projection import Pose
@@ -148,6 +148,8 @@ def actor_from_bytes(source: str | Path | bytes, where: str) -> Actor:
             scene = None if scene_member is None else _member(z, scene_member, MAX_TEXTURE_BYTES, where)
     except (zipfile.BadZipFile, EOFError, zipfile.LargeZipFile, NotImplementedError, zlib.error) as e:
         raise ActorFileError(f"{where}: not a facemime actor file, or truncated ({e})") from None
+    except RuntimeError:  # zipfile's word for a member marked encrypted
+        raise ActorFileError(f"{where}: not a facemime actor file (an encrypted archive)") from None
     except OSError as e:
         raise InputFileError(f"cannot read {where}: {e.strerror or e}") from None
     try:
@@ -176,12 +178,17 @@ def actor_from_bytes(source: str | Path | bytes, where: str) -> Actor:
         raise ActorFileError(str(e)) from None
     if model.uv is None:
         raise ActorFileError(f"{where}: model has no texture coordinates")
+    eyes = model.uv[np.concatenate([model.groups["eye_left"], model.groups["eye_right"]])]
+    if eyes.min() < 0.0 or eyes.max() > 1.0:  # the eyes are repainted from the texture around them
+        raise ActorFileError(f"{where}: the eyes' texture coordinates must lie within 0..1")
     try:
         pose = Pose(**{k: float(doc["pose"][k]) for k in ("yaw", "pitch", "roll", "scale", "tx", "ty")})
         source = doc.get("source", {})
         points = {str(k): np.asarray(v, dtype=np.float64).reshape(-1, 2) for k, v in doc.get("points", {}).items()}
-        if not isinstance(source, dict) or not np.isfinite(list(pose.__dict__.values())).all() or pose.scale <= 0:
-            raise ValueError("bad pose or source")
+        if not isinstance(source, dict):
+            raise ValueError("bad source")
+        if not pose_in_range(pose.yaw, pose.pitch, pose.roll, pose.scale, pose.tx, pose.ty):
+            raise ValueError(f"pose out of range: {pose}")
     except (KeyError, TypeError, ValueError, AttributeError, OverflowError) as e:
         raise ActorFileError(f"{where}: malformed actor ({e})") from None
     if scene_image is not None:

@@ -44,12 +44,14 @@ import numpy as np
 
 from facemime.animate.look import Look
 from facemime.errors import FacemimeError
-from facemime.io.limits import parse_json, read_json_text
+from facemime.io.limits import parse_json, pose_in_range, read_json_text
 from facemime.io.outputs import OutputFileError, write_text
 from facemime.track.contours import CONTOUR_NAMES
 
 INIT_FORMAT = "facemime.init/1"
 POSE_KEYS = ("yaw", "pitch", "roll", "scale", "tx", "ty")
+#: Largest magnitude of a knot offset a track file may hold, model units (a face is ~150 wide).
+MAX_OFFSET = 1e4
 #: Largest magnitude of a look value a track file may hold (closures, eye widths).
 LOOK_LIMIT = 10.0
 TRACK_FORMAT = "facemime.track/1"
@@ -355,13 +357,10 @@ def read_motion(path: str | Path) -> tuple[dict[str, Any], dict[str, Any], list[
             raise ContourFileError(
                 f"{where}: frame entry {n} needs a 'pose' with {', '.join(POSE_KEYS)} and 'offsets' (or 'weights')"
             ) from None
-        if (
-            arr.shape != (k, 2)
-            or not np.isfinite(arr).all()
-            or not all(np.isfinite(list(values.values())))
-            or values["scale"] <= 0
-        ):
-            raise ContourFileError(f"{where}: frame entry {n} has malformed 'offsets' or 'pose'")
+        if arr.shape != (k, 2) or not np.isfinite(arr).all() or np.abs(arr).max(initial=0.0) > MAX_OFFSET:
+            raise ContourFileError(f"{where}: frame entry {n} has malformed 'offsets'")
+        if not pose_in_range(*(values[key] for key in POSE_KEYS)):
+            raise ContourFileError(f"{where}: frame entry {n} has a pose out of range ({values})")
         try:
             look = f.get("look", {})
             if not isinstance(look, dict):

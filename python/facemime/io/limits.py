@@ -16,12 +16,34 @@ variable (a whole number):
 from __future__ import annotations
 
 import json
+import math
 import os
 import struct
 from pathlib import Path
 from typing import Any
 
 from facemime.errors import InputFileError, InvalidInputError
+
+#: The head poses facemime reads (an actor's, a stream's starting pose, a track's): the largest
+#: angle (degrees), the range of the scale (pixels per model unit) and the largest position of the
+#: model origin (pixels, far beyond any picture).
+MAX_POSE_ANGLE, POSE_SCALES, MAX_POSE_POSITION = 360.0, (1e-3, 1e4), 1e6
+
+
+def pose_in_range(yaw: float, pitch: float, roll: float, scale: float, tx: float, ty: float) -> bool:
+    """Whether a head pose's values are finite and within the limits above.
+
+    >>> pose_in_range(10.0, 0.0, 2.0, 1.9, 250.0, 240.0), pose_in_range(0.0, 0.0, 0.0, 1e300, 0.0, 0.0)
+    (True, False)
+    """
+    angles, position = (yaw, pitch, roll), (tx, ty)
+    return (
+        all(math.isfinite(a) and abs(a) <= MAX_POSE_ANGLE for a in angles)
+        and math.isfinite(scale)
+        and POSE_SCALES[0] <= scale <= POSE_SCALES[1]
+        and all(math.isfinite(p) and abs(p) <= MAX_POSE_POSITION for p in position)
+    )
+
 
 DEFAULTS = {
     "FACEMIME_MAX_IMAGE_PIXELS": 100_000_000,

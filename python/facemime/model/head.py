@@ -31,6 +31,10 @@ HEAD_FORMAT = "facemime.head/1"
 
 #: Groups every facemime head file must have.
 REQUIRED_GROUPS = CONTOUR_GROUPS + ("eye_left", "eye_right", "nose", "face_outline")
+#: The fewest vertices each required group needs: an eye ring is corner, three upper-lid vertices,
+#: corner, three lower-lid ones; the outline's tenth vertex is the chin, the nose's seventh its tip;
+#: a contour is a curve.
+MIN_GROUP_SIZES = {**dict.fromkeys(CONTOUR_GROUPS, 2), "eye_left": 8, "eye_right": 8, "nose": 7, "face_outline": 10}
 #: Default input limits, each overridden by its environment variable (see the module docstring).
 #: Largest vertex coordinate, model units (a face is some hundreds of millimetres; a farther vertex
 #: is a broken file, and would overflow the pixel arithmetic of previews).
@@ -266,6 +270,9 @@ def head_from_document(doc: object, where: str) -> HeadModel:
     problem = _first_problem(vertices, triangles, uv, groups, (units,))
     if problem:
         raise ModelFormatError(f"{where}: {problem}")
+    short = [f"{g} has {len(groups[g])} (needs {n})" for g, n in MIN_GROUP_SIZES.items() if len(groups[g]) < n]
+    if short:
+        raise ModelFormatError(f"{where}: vertex groups too short: {'; '.join(short)}")
     return HeadModel(
         vertices,
         triangles,

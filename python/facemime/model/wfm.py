@@ -63,7 +63,10 @@ class _Lines:
         try:
             if len(parts) != count:
                 raise ValueError
-            return [kind(p) for p in parts]
+            values = [kind(p) for p in parts]
+            if kind is int and any(abs(v) >= 1 << 63 for v in values):  # beyond int64: no index or count
+                raise ValueError
+            return values
         except ValueError:
             self.pos -= 1
             raise self.fail(
