@@ -104,12 +104,17 @@ def measure(video: Path, reference: Path, every: int) -> dict:
     }
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def video_arguments(description: str) -> argparse.Namespace:
+    """The command line of the benchmarks that score decoded frames: --data, --videos, --every."""
+    parser = argparse.ArgumentParser(description=description.split("\n\n")[0])
     parser.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data")
     parser.add_argument("--videos", default=",".join(VIDEOS))
     parser.add_argument("--every", type=int, default=3, help="score every N-th frame")
-    args = parser.parse_args()
+    return parser.parse_args()
+
+
+def main() -> None:
+    args = video_arguments(__doc__)
     cv2.setNumThreads(1)
     results = {}
     print(f"{'video':10s} {'kbit/s':>7s} {'key face':>8s} {'face':>6s} {'mouth':>6s} {'eyes':>6s}  (dB, luma PSNR)")

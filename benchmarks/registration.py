@@ -25,7 +25,6 @@ import os
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import argparse
 import json
 import sys
 from pathlib import Path
@@ -39,7 +38,7 @@ from facemime.fit.run import fit_actor
 from facemime.io.video import VideoReader
 from facemime.render.projection import project
 from facemime.render.texture_map import render_mesh_into
-from receiver import VIDEOS, luma, masks, psnr
+from receiver import luma, masks, psnr, video_arguments
 from receiver import measure as decode_scores
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -99,11 +98,7 @@ def registered(video: Path, reference: Path, every: int) -> float:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data")
-    parser.add_argument("--videos", default=",".join(VIDEOS))
-    parser.add_argument("--every", type=int, default=3, help="score every N-th frame")
-    args = parser.parse_args()
+    args = video_arguments(__doc__)
     cv2.setNumThreads(1)
     results = {}
     print(f"{'video':10s} {'decode':>7s} {'registered':>10s}  (face, dB luma PSNR)")
