@@ -41,8 +41,6 @@ from facemime.render.texture_map import render_mesh_into
 from receiver import luma, masks, psnr, video_arguments
 from receiver import measure as decode_scores
 
-ROOT = Path(__file__).resolve().parents[1]
-
 
 def delaunay(points: np.ndarray) -> np.ndarray:
     """(T, 3) vertex indices of the Delaunay triangles of ``points`` (N, 2) px."""
