@@ -144,13 +144,13 @@ def _delaunay(points: np.ndarray) -> np.ndarray:
         if key not in index:
             index[key] = i
             subdiv.insert(key)
-    tris = []
+    found: list[list[int]] = []
     for x0, y0, x1, y1, x2, y2 in subdiv.getTriangleList():
         try:
-            tris.append([index[(float(x0), float(y0))], index[(float(x1), float(y1))], index[(float(x2), float(y2))]])
+            found.append([index[(float(x0), float(y0))], index[(float(x1), float(y1))], index[(float(x2), float(y2))]])
         except KeyError:  # a triangle on Subdiv2D's virtual outer vertices
             continue
-    tris = np.array(tris, np.int64).reshape(-1, 3)
+    tris = np.array(found, np.int64).reshape(-1, 3)
     a, b, c = (points[tris[:, k]] for k in range(3))
     cross = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
     tris = tris[np.abs(cross) > 1e-9]

@@ -39,6 +39,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
@@ -193,7 +194,7 @@ class TrackerParams:
         """The farthest a solver pass moves a knot coordinate, δ0/(1−σ) px."""
         return self.delta0 / (1.0 - self.sigma)
 
-    def with_(self, **changes: object) -> TrackerParams:
+    def with_(self, **changes: Any) -> TrackerParams:
         """A copy with some settings changed."""
         return replace(self, **changes)
 
@@ -558,16 +559,16 @@ class Tracker:
                     knots[self._features[feature]] = fallback[self._features[feature]]
         self._mouth_lost_for = self._mouth_lost_for + 1 if any(f.startswith("mouth") for f in lost) else 0
         if 0 < p.mouth_relocate <= self._mouth_lost_for and self._lips is not None and self._lips.active:
-            found, more = self._relocate_mouth(frame, knots, carried, down, targets)
+            relocated, more = self._relocate_mouth(frame, self._lips, knots, carried, down, targets)
             iters += more
-            if found is not None:
-                confidence.update(found)
+            if relocated is not None:
+                confidence.update(relocated)
                 lost = [f for f in lost if not f.startswith("mouth")]
         if p.inner_search > 0 and "mouth_inner" in lost:
-            found, more = self._search_inner(frame, knots, rest, down, targets, carried, assessed_inner)
+            inner, more = self._search_inner(frame, knots, rest, down, targets, carried, assessed_inner)
             iters += more
-            if found is not None:
-                confidence["mouth_inner"] = found
+            if inner is not None:
+                confidence["mouth_inner"] = inner
                 lost.remove("mouth_inner")
                 if "mouth_outer" not in lost:
                     self._mouth_lost_for = 0
@@ -731,9 +732,15 @@ class Tracker:
         return None, iters
 
     def _relocate_mouth(
-        self, frame: np.ndarray, knots: np.ndarray, carried: np.ndarray, down: np.ndarray, targets: np.ndarray
+        self,
+        frame: np.ndarray,
+        lips: LipSearch,
+        knots: np.ndarray,
+        carried: np.ndarray,
+        down: np.ndarray,
+        targets: np.ndarray,
     ) -> tuple[dict[str, float] | None, int]:
-        """Look for the mouth, lost for ``mouth_relocate`` frames, where its lip colour is found
+        """Look for the mouth, lost for ``mouth_relocate`` frames, where its lip colour (``lips``'s) is found
         near where the brows put the first frame's mouth, in that mouth's shape, and let one
         solver pass (the frame's ``down`` and gap ``targets``) settle it there. The settled mouth
         replaces the mouth knots (in place) only when it is no longer lost: confidences at least
@@ -743,7 +750,9 @@ class Tracker:
         upper, lower = self._index["mouth_outer_upper"], self._index["mouth_outer_lower"]
         outer = lambda k: np.concatenate([k[upper], k[lower][::-1]])  # noqa: E731
         polygon = outer(expected)
-        found = relocate(frame, self._lips.colour, polygon, outer(knots), down)
+        if lips.colour is None:  # no lip colour to look for (then the search is not active either)
+            return None, 0
+        found = relocate(frame, lips.colour, polygon, outer(knots), down)
         if found is None:
             return None, 0
         mouth = self._mouth_knots
