@@ -140,6 +140,7 @@ class SideBySide:
                 solver = Expressions.of(actor.model).solver()
             else:
                 motion = self.analysis.update(frame)
+            assert puppet is not None and synth is not None and canvas is not None  # made on the first frame
             t1 = time.perf_counter()
             if puppet.scene is None:
                 fill(synth, BACKGROUND)
@@ -157,7 +158,7 @@ class SideBySide:
             }
             self.weights.append(solver.step(motion.offsets, motion.look.closure))
             record["weights"] = solver.named(self.weights[-1])
-            if compare and motion.face:
+            if compare and motion.face and puppet.shown is not None:  # shown: set by the render above
                 vertices, shown = puppet.shown
                 share = departure(frame, synth, project(vertices[outline], shown)[0])
                 record.update(scene_departure=share, scene_departs=share > DEPARTS_AT)
@@ -252,7 +253,7 @@ def run_video(
         raise InvalidInputError(f"the weights file must end in .csv, got {csv.name!r}")
     actor_path = actor if isinstance(actor, (str, Path)) else None
     with Outputs([out, track] + ([csv] if csv else []), force, inputs=[video, actor_path]) as outputs:
-        target = load_actor(actor_path) if actor_path is not None else actor
+        target = load_actor(actor) if isinstance(actor, (str, Path)) else actor
         with (
             VideoReader(video) as reader,
             VideoWriter(outputs.stage(out), reader.fps) as writer,
@@ -269,6 +270,8 @@ def run_video(
                 reader.fps,
             )
             encode = write_frames(writer, work)
+            if work.analysis is None:
+                raise InputFileError(f"video {video} has no frames")
             result = work.result([out, track] + ([csv] if csv else []), encode)
             result.warnings.extend(reader.warnings)
             busy = sum(v for k, v in result.seconds.items() if k not in ("encode", "fit", "decode"))
@@ -305,7 +308,7 @@ def run_track(
     with Outputs([out], force, inputs=[track, actor_path]) as outputs:
         seconds = dict.fromkeys(("decode", "track", "pose", "look", "synth", "compose"), 0.0)
         t0 = time.perf_counter()
-        replay = load_replay(track, load_actor(actor_path) if actor_path is not None else actor)
+        replay = load_replay(track, load_actor(actor) if isinstance(actor, (str, Path)) else actor)
         puppet = replay.puppet(mask_only)
         seconds["decode"] = time.perf_counter() - t0
 
