@@ -9,8 +9,8 @@ motion, as the paper's keyboard did: arrows turn and tilt the head, ``q``/``e`` 
 The page shows an MJPEG stream (``/stream``); ``/key?k=NAME`` applies a key and answers the new
 state as JSON; ``/frame.jpg`` is the next frame. The server listens on 127.0.0.1 only, answers
 only requests addressed to this machine and from its own pages
-(:func:`facemime.local_only.addressed_here`: 403 otherwise), of at most :data:`MAX_HEAD` bytes and without a body, and
-serves at most ``max_clients`` connections at once (503 beyond), each dropped after ``timeout``
+(:func:`facemime.local_only.addressed_here`: 403 otherwise), of at most :data:`MAX_HEAD` bytes
+and without a body, and serves at most ``max_clients`` connections at once (503 beyond), each dropped after ``timeout``
 seconds without progress.
 
 Every client sees the same frames: one thread plays the viewer at its frame rate while anyone

@@ -2,7 +2,8 @@
  * The facemime receiver page: decodes a facemime stream (docs/bitstream.md) and draws each frame
  * on the stream's actor with WebGL2. Served by ``facemime call``, it receives a live stream over
  * a WebSocket (``/stream``) and asks the sender for an intra packet when it joins and as soon as
- * it decodes a loss (again, at most every ``INTRA_EVERY_MS``, until it is back in sync); anywhere, a saved ``.fmstream`` file dropped on it (or chosen) plays.
+ * it decodes a loss (again, at most every ``INTRA_EVERY_MS``, until it is back in sync);
+ * anywhere, a saved ``.fmstream`` file dropped on it (or chosen) plays.
  *
  * For tests and measurements the page exposes ``window.facemime`` (see ``Api``). ``?drop=P``
  * drops each received packet with probability P (a seeded generator, ``&seed=N``), to test
