@@ -43,12 +43,12 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from facemime.face.finder import follow_face
 from facemime.io.video import VideoReader
 from facemime.metrics import group_nme, pooled_summary, resample, summarize
+from facemime.networks.finder import follow_face
 from facemime.track import TrackerParams
-from facemime.track.contours import CONTOUR_NAMES, GROUPS, from_face_mesh
 from facemime.track.redetect import FaceTracker, Redetection
+from facemime.types.contours import CONTOUR_NAMES, GROUPS, from_face_mesh
 
 VIDEOS = ("lp_d0", "lp_d3", "lp_d6", "lp_d12", "vr_1", "vr_2", "st_aoc", "st_kh", "mt_sun", "mt_yongen")
 ROOT = Path(__file__).resolve().parents[1]

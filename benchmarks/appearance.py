@@ -38,8 +38,8 @@ from facemime.animate.synth import Puppet
 from facemime.codec.appearance import Appearance
 from facemime.codec.files import analyse, encode_clip, with_appearance
 from facemime.codec.stream import MotionDecoder, Settings
-from facemime.fit.placement import model_iod
 from facemime.io.video import VideoReader
+from facemime.types.head import model_iod
 from fidelity import regions, scores
 
 VIDEOS = ("lp_d0", "lp_d3", "lp_d6", "lp_d12", "mt_sun", "mt_yongen", "st_aoc", "st_kh", "vr_1", "vr_2")

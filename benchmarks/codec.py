@@ -52,9 +52,9 @@ from facemime.animate.synth import Puppet
 from facemime.codec.files import MAX_COEFFICIENTS, Clip, analyse, encode_clip
 from facemime.codec.params import Basis
 from facemime.codec.stream import MotionDecoder, MotionEncoder, Settings
-from facemime.fit.placement import model_iod
 from facemime.io.video import VideoReader
 from facemime.shared_constants import BASIS_ONE
+from facemime.types.head import model_iod
 from synthesis import ssim_map
 
 VIDEOS = ("lp_d0", "lp_d3", "lp_d6", "lp_d12", "vr_1", "vr_2", "mt_sun", "mt_yongen", "st_aoc", "st_kh")

@@ -41,8 +41,8 @@ import numpy as np
 from facemime.animate.analysis import Analysis
 from facemime.animate.expressions import BLINKS, MAGNITUDES, NAMES, Expressions, unit_patterns
 from facemime.animate.synth import Puppet
-from facemime.fit.placement import model_iod
 from facemime.io.video import VideoReader
+from facemime.types.head import model_iod
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from synthesis import regions

@@ -43,12 +43,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from facemime.animate.analysis import Analysis
-from facemime.animate.look import Look
 from facemime.animate.synth import Puppet
 from facemime.codec.files import Clip, encode_clip
 from facemime.codec.stream import Settings
-from facemime.fit.placement import model_iod
 from facemime.io.video import VideoReader
+from facemime.types.head import model_iod
+from facemime.types.look import Look
 from synthesis import ssim_map
 
 VIDEOS = ("lp_d0", "lp_d3", "lp_d6", "lp_d12", "mt_sun", "mt_yongen", "st_aoc", "st_kh", "vr_1", "vr_2")

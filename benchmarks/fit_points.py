@@ -23,11 +23,11 @@ from pathlib import Path
 import numpy as np
 
 from facemime.errors import NoFaceError
-from facemime.face.mesh import POINT_INDICES, reference_points
 from facemime.fit import auto_points
-from facemime.fit.points import GROUPS
 from facemime.io.photo import read_photo
 from facemime.metrics import curve_error
+from facemime.networks.mesh import POINT_INDICES, reference_points
+from facemime.types.points import GROUPS
 from haar_points import haar_points
 
 VIDEOS = ("lp_d0", "lp_d3", "lp_d6", "lp_d12", "vr_1", "vr_2", "st_aoc", "st_kh", "mt_sun", "mt_yongen")

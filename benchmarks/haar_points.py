@@ -17,13 +17,14 @@ import cv2
 import numpy as np
 
 from facemime.errors import FacemimeError, NoFaceError
-from facemime.fit.placement import frontal_pose, model_eye_centres, model_iod
-from facemime.fit.points import GROUPS, ReferencePoints, model_chain
-from facemime.model.head import HeadModel, generic_head
-from facemime.render.projection import project
-from facemime.track.contours import CONTOUR_NAMES
+from facemime.fit.placement import frontal_pose
+from facemime.head.generic import generic_head
 from facemime.track.match import locate
 from facemime.track.tracker import Tracker, TrackerParams
+from facemime.types.contours import CONTOUR_NAMES
+from facemime.types.head import HeadModel, model_eye_centres, model_iod
+from facemime.types.points import GROUPS, ReferencePoints, model_chain
+from facemime.types.pose import project
 
 #: Another face counts (for the several-faces warning) when at least this fraction of the
 #: chosen face's width.

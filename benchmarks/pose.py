@@ -4,11 +4,11 @@ Truth: the reference's rotation of each frame relative to the first, by orthogon
 its rigid 3-D landmarks (:data:`facemime.animate.landmark_pose.RIGID`: forehead, temples, nose,
 eye corners, cheekbones) on the first frame's. Each estimate's rotation is taken relative to its
 own first frame the same way (R_t R_0^T), as yaw, pitch and roll (degrees,
-:func:`facemime.render.projection.rotation_matrix`'s convention):
+:func:`facemime.types.pose.rotation_matrix`'s convention):
 
 - **run**: the pose of ``facemime run``'s analysis (:class:`facemime.animate.analysis.Analysis`);
 - **landmarks**: :class:`facemime.animate.landmark_pose.LandmarkPose` on one landmark pass a frame
-  (:func:`facemime.face.finder.follow_face`: the crop the last frame's landmarks frame, no
+  (:func:`facemime.networks.finder.follow_face`: the crop the last frame's landmarks frame, no
   detection), unfiltered, then through :class:`~facemime.animate.landmark_pose.PoseFilter`
   (One-Euro) and a constant-velocity Kalman filter at the settings asked for.
 
@@ -47,9 +47,9 @@ import numpy as np
 
 from facemime.animate.analysis import Analysis
 from facemime.animate.landmark_pose import RIGID, LandmarkPose, PoseFilter, angles, camera_points, procrustes
-from facemime.face.finder import find_face, follow_face
 from facemime.io.video import VideoReader
-from facemime.render.projection import Pose, rotation_matrix
+from facemime.networks.finder import find_face, follow_face
+from facemime.types.pose import Pose, rotation_matrix
 
 VIDEOS = ("lp_d0", "lp_d3", "lp_d6", "lp_d12", "mt_sun", "mt_yongen", "st_aoc", "st_kh", "vr_1", "vr_2")
 ROOT = Path(__file__).resolve().parents[1]

@@ -7,7 +7,7 @@ The clip: yaw swept 0 → +30 → −30 → 0 degrees, then pitch 0 → +20 → 
 same, then all three at once (yaw 20 sin, pitch 12 sin, roll 10 sin at unrelated rates), at most
 2 degrees a frame; the mouth opens and closes and the brows rise and fall throughout. Truth and
 estimate are taken relative to the first frame, as yaw, pitch and roll (degrees,
-:func:`facemime.render.projection.rotation_matrix`'s convention).
+:func:`facemime.types.pose.rotation_matrix`'s convention).
 
 Per photo and axis: the mean absolute error (degrees) and the slope of the estimate on the
 truth (least squares through the origin; 1 = fully measured); and the 3 x 3 matrix of each
@@ -38,7 +38,7 @@ from facemime.animate.deform import Deformer
 from facemime.animate.synth import key_frame, scene_mesh, synthesize
 from facemime.fit.run import fit_actor
 from facemime.io.photo import read_photo
-from facemime.track.contours import CONTOUR_NAMES
+from facemime.types.contours import CONTOUR_NAMES
 
 ROOT = Path(__file__).resolve().parents[1]
 AXES = ("yaw", "pitch", "roll")

@@ -31,9 +31,9 @@ from facemime.animate.synth import Puppet
 from facemime.codec.appearance import Appearance
 from facemime.codec.files import encode_video
 from facemime.codec.stream import MotionDecoder
-from facemime.fit.placement import model_iod
 from facemime.io.video import VideoReader
 from facemime.shared_constants import NO_FACE_DIM
+from facemime.types.head import model_iod
 
 VIDEOS = ("lp_d0", "lp_d3", "lp_d6", "lp_d12", "mt_sun", "mt_yongen", "st_aoc", "st_kh", "vr_1", "vr_2")
 ROOT = Path(__file__).resolve().parents[1]

@@ -24,7 +24,7 @@ import time
 import cv2
 import numpy as np
 
-from facemime.model import generic_head, painted_texture
+from facemime.head import generic_head, painted_texture
 from facemime.render import Pose, fill, project, render_mesh_into
 
 SIZES = ((128, 128), (640, 480))

@@ -57,11 +57,11 @@ from facemime.animate.analysis import Analysis
 from facemime.animate.departure import DEPARTS_AT, departure
 from facemime.animate.run import SideBySide, run_video
 from facemime.animate.synth import Puppet, key_frame, synthesize
-from facemime.fit.placement import model_iod
 from facemime.io.video import VideoReader
-from facemime.render.projection import project
 from facemime.render.texture_map import render_mesh_into
-from facemime.track.contours import from_face_mesh
+from facemime.types.contours import from_face_mesh
+from facemime.types.head import model_iod
+from facemime.types.pose import project
 
 VIDEOS = ("lp_d0", "lp_d3", "lp_d6", "lp_d12", "mt_sun", "mt_yongen", "st_aoc", "st_kh", "vr_1", "vr_2")
 ROOT = Path(__file__).resolve().parents[1]

@@ -45,8 +45,8 @@ import numpy as np
 
 import facemime.track.tracker as tracker_module
 from facemime.track import Tracker, motion
-from facemime.track.contours import CONTOUR_NAMES, from_face_mesh
 from facemime.track.redetect import FaceTracker
+from facemime.types.contours import CONTOUR_NAMES, from_face_mesh
 
 VIDEOS = ("lp_d0", "lp_d3", "lp_d12")
 ROOT = Path(__file__).resolve().parents[1]

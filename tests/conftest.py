@@ -12,11 +12,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from facemime.face.mesh import reference_points as face_mesh_points
 from facemime.fit import fit_model
 from facemime.fit.actor import smear_texture
+from facemime.head import generic_head
 from facemime.io.video import VideoReader
-from facemime.model import generic_head
+from facemime.networks.mesh import reference_points as face_mesh_points
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT.parent / "shared"

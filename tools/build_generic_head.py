@@ -1,4 +1,4 @@
-"""Build facemime's generic head model (python/facemime/model/data/generic_head.json).
+"""Build facemime's generic head model (python/facemime/head/data/generic_head.json).
 
 The model is *measured*, not copied from any model file: the frontal first frames of the six
 shared videos (../shared/data/video/*.landmarks.npz, MediaPipe Face Mesh points with depth) are
@@ -127,7 +127,7 @@ def deformation_units(v: np.ndarray, triangles: np.ndarray, g: dict[str, list[in
     its knot pattern (the blinks: the lids closed), with its description. ``v``: the vertices as
     the file stores them (rounded), so that the units are those facemime computes from the file."""
     from facemime.animate.expressions import DESCRIPTIONS, Expressions
-    from facemime.model.head import HeadModel
+    from facemime.types.head import HeadModel
 
     model = HeadModel(v, np.asarray(triangles, np.int64), None, {k: np.asarray(i, np.int64) for k, i in g.items()})
     e = Expressions.of(model)
@@ -216,7 +216,7 @@ def build(video_dir: Path) -> dict:
 
 
 def main() -> None:
-    out = Path(__file__).resolve().parents[1] / "python/facemime/model/data/generic_head.json"
+    out = Path(__file__).resolve().parents[1] / "python/facemime/head/data/generic_head.json"
     if sys.argv[1:] == ["--units-only"]:
         update_units(out)
         return

@@ -28,7 +28,6 @@ from facemime.animate.analysis import Analysis
 from facemime.animate.run import pose_dict
 from facemime.animate.synth import Puppet, key_frame, scene_mesh, synthesize
 from facemime.fit.actor import generic_actor
-from facemime.fit.placement import model_iod
 from facemime.fit.preview import preview_sheet
 from facemime.fit.run import fit_actor
 from facemime.io import VideoWriter, write_image
@@ -37,9 +36,10 @@ from facemime.io.contours_json import track_document, write_json
 from facemime.io.outputs import Outputs, write_bytes, write_text
 from facemime.metrics import group_nme, summarize
 from facemime.progress import track
-from facemime.render.projection import project
-from facemime.track.contours import CONTOUR_NAMES, GROUPS
 from facemime.track.overlay import draw_contours
+from facemime.types.contours import CONTOUR_NAMES, GROUPS
+from facemime.types.head import model_iod
+from facemime.types.pose import project
 
 FPS = 25
 SIZE = (512, 512)

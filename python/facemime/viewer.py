@@ -46,14 +46,14 @@ from facemime.animate.analysis import start_analysis
 from facemime.animate.replay import FPS_RANGE, load_replay
 from facemime.animate.synth import Puppet, UserMotion
 from facemime.errors import FacemimeError, InputFileError, InvalidInputError
-from facemime.fit.actor import Actor
-from facemime.fit.placement import model_iod
 from facemime.io.video import VideoReader
 from facemime.local_only import addressed_here
-from facemime.render.projection import Pose
 from facemime.render.texture_map import fill
 from facemime.shared_constants import BACKGROUND
 from facemime.track.overlay import draw_contours
+from facemime.types.actor import Actor
+from facemime.types.head import model_iod
+from facemime.types.pose import Pose
 
 #: Key -> the change it makes to the user motion.
 KEYS = {

@@ -8,8 +8,8 @@ from facemime.demo import SIZE, astronaut_photo
 from facemime.fit.run import fit_actor
 from facemime.io.video import VideoReader
 from facemime.metrics import group_nme
-from facemime.render.projection import project
-from facemime.track.contours import GROUPS, from_face_mesh
+from facemime.types.contours import GROUPS, from_face_mesh
+from facemime.types.pose import project
 
 NOSE_TIP = 4  # Face Mesh point
 

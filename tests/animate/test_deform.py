@@ -1,11 +1,11 @@
 import numpy as np
 import pytest
 
-from facemime.animate.deform import Deformer, head_plane
+from facemime.animate.deform import Deformer
 from facemime.errors import InvalidInputError
-from facemime.model import generic_head
-from facemime.model.wfm import load_wfm
-from facemime.render.projection import Pose, project
+from facemime.head import generic_head
+from facemime.io.wfm import load_wfm
+from facemime.types.pose import Pose, head_plane, project
 
 
 def test_head_plane_undoes_the_projection_at_known_depth():

@@ -4,11 +4,12 @@ import numpy as np
 import pytest
 
 from facemime.animate.expressions import BLINKS, NAMES, Expressions
+from facemime.animate.motion_file import read_motion, weights_to_motion
 from facemime.animate.synth import Puppet
 from facemime.fit.actor import generic_actor
-from facemime.io.contours_json import ContourFileError, read_motion, track_entry, weights_to_motion
-from facemime.model import generic_head
-from facemime.render.projection import Pose
+from facemime.head import generic_head
+from facemime.io.contours_json import ContourFileError, track_entry
+from facemime.types.pose import Pose
 
 POSE = {"yaw": 4.0, "pitch": -2.0, "roll": 3.0, "scale": 2.4, "tx": 256.0, "ty": 240.0}
 

@@ -15,12 +15,12 @@ from facemime.animate.landmark_pose import (
     camera_points,
     procrustes,
 )
-from facemime.face.finder import find_face, follow_face
-from facemime.face.mesh import reference_points
 from facemime.fit.placement import fit_model
+from facemime.head import generic_head
 from facemime.io.video import VideoReader
-from facemime.model import generic_head
-from facemime.render.projection import Pose, project, rotation_matrix
+from facemime.networks.finder import find_face, follow_face
+from facemime.networks.mesh import reference_points
+from facemime.types.pose import Pose, project, rotation_matrix
 
 RNG = np.random.default_rng(11)
 

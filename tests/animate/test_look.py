@@ -6,12 +6,12 @@ import pytest
 
 from facemime.animate.deform import Deformer
 from facemime.animate.eyes import LookPainter, close_lids
-from facemime.animate.look import NAMES, Look
 from facemime.animate.synth import Puppet
 from facemime.fit.actor import generic_actor
-from facemime.fit.placement import model_iod
-from facemime.render.projection import project
 from facemime.shared_constants import EYES
+from facemime.types.head import model_iod
+from facemime.types.look import NAMES, Look
+from facemime.types.pose import project
 
 
 @pytest.fixture(scope="module")

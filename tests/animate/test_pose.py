@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from facemime.animate.pose import fit_pose, lift, moved
-from facemime.model import generic_head
-from facemime.render.projection import Pose, project
+from facemime.head import generic_head
+from facemime.types.pose import Pose, project
 
 
 @pytest.mark.parametrize(

@@ -3,9 +3,9 @@ import pytest
 
 from facemime.animate.synth import Puppet, UserMotion, draw_mouth_interior, synthesize, teeth_uncovered
 from facemime.errors import InvalidInputError
-from facemime.fit.placement import model_iod
-from facemime.render.projection import project
 from facemime.shared_constants import SEAL
+from facemime.types.head import model_iod
+from facemime.types.pose import project
 
 GREEN = (0, 255, 0)
 

@@ -9,7 +9,7 @@ import pytest
 
 from facemime.io.actor_file import load_actor
 from facemime.metrics import group_nme
-from facemime.track.contours import GROUPS, from_face_mesh
+from facemime.types.contours import GROUPS, from_face_mesh
 
 from .test_cli import first_frames, run
 

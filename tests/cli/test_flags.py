@@ -10,7 +10,7 @@ import sys
 import cv2
 import pytest
 
-import facemime.model
+import facemime.head
 from facemime.cli import main as cli_main
 from facemime.errors import FacemimeError
 
@@ -45,7 +45,7 @@ def test_an_error_is_one_line_without_traceback_and_the_trace_with_it(tmp_path, 
 
 
 def test_a_defect_says_so_in_one_line_and_shows_its_trace_with_traceback(tmp_path, capsys, monkeypatch):
-    monkeypatch.setattr(facemime.model, "generic_head", _raise(RuntimeError("broken head")))
+    monkeypatch.setattr(facemime.head, "generic_head", _raise(RuntimeError("broken head")))
     out = str(tmp_path / "x.png")
     code, _, err = run(capsys, "model-preview", "--out", out)
     assert code == 2 and err.count("\n") == 1
@@ -83,7 +83,7 @@ def test_a_usage_error_exits_2_with_the_usage(tmp_path, capsys, monkeypatch, arg
 
 @pytest.mark.parametrize("error", [KeyboardInterrupt(), cli_main.Terminated(signal.SIGTERM)])
 def test_an_interrupt_exits_130_and_a_termination_143_leaving_nothing(tmp_path, capsys, monkeypatch, error):
-    monkeypatch.setattr(facemime.model, "generic_head", _raise(error))
+    monkeypatch.setattr(facemime.head, "generic_head", _raise(error))
     code, stdout, err = run(capsys, "model-preview", "--out", str(tmp_path / "x.png"))
     if isinstance(error, KeyboardInterrupt):
         assert code == 130 and err.splitlines()[-1] == "facemime: interrupted"

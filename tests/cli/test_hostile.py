@@ -341,8 +341,8 @@ def mutate(doc, data):
 @settings(max_examples=40, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(st.data())
 def test_mutated_points_and_head_models_never_escape_as_a_traceback(tmp_path, capsys, astronaut, data):
-    from facemime.model import generic_head
-    from facemime.model.head import head_document
+    from facemime.head import generic_head
+    from facemime.io.head_file import head_document
 
     head = tmp_path / "head.json"
     head.write_text(json.dumps(mutate(head_document(generic_head()), data)))
@@ -482,7 +482,7 @@ def test_actor_files_that_passed_validation_and_then_broke_give_one_line(files, 
 def test_a_stream_whose_starting_pose_is_out_of_range_gives_one_line(actor, tmp_path, capsys):
     from facemime.codec.params import Basis
     from facemime.codec.stream import MotionEncoder, Settings
-    from facemime.render.projection import Pose
+    from facemime.types.pose import Pose
 
     basis = Basis.learn(np.zeros((4, 60, 2)), 2)
     encoder = MotionEncoder(actor, 25.0, (640, 480), basis, Settings(), True, reference=Pose(scale=1e-30))

@@ -7,15 +7,15 @@ import av
 import numpy as np
 import pytest
 
-from facemime.animate.look import NAMES
+from facemime.animate.motion_file import read_motion
 from facemime.animate.run import SideBySide
 from facemime.errors import InputFileError
-from facemime.io.contours_json import read_motion
 from facemime.io.video import VideoReader, VideoWriter
 from facemime.metrics import group_nme
 from facemime.shared_constants import BACKGROUND
-from facemime.track.contours import GROUPS, from_face_mesh
 from facemime.track.overlay import draw_contours
+from facemime.types.contours import GROUPS, from_face_mesh
+from facemime.types.look import NAMES
 
 from .test_cli import first_frames, run
 

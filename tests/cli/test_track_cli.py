@@ -9,8 +9,8 @@ import pytest
 from facemime.io.contours_json import init_document, write_json
 from facemime.io.video import VideoWriter
 from facemime.metrics import group_nme
-from facemime.track.contours import GROUPS, from_face_mesh
 from facemime.track.synthetic import band_face
+from facemime.types.contours import GROUPS, from_face_mesh
 
 from .test_cli import first_frames, run
 

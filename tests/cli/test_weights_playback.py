@@ -8,13 +8,13 @@ import numpy as np
 
 from facemime.animate.deform import Deformer
 from facemime.animate.expressions import NAMES, Expressions
+from facemime.animate.motion_file import read_motion
 from facemime.codec.files import read_stream
 from facemime.codec.stream import COEFFICIENT_STEP, DEFAULT_QUALITY, LADDER, MotionDecoder
 from facemime.fit.actor import generic_actor
-from facemime.io.contours_json import read_motion
+from facemime.head import generic_head
 from facemime.io.video import VideoReader
-from facemime.model import generic_head
-from facemime.render.projection import project
+from facemime.types.pose import project
 
 from .test_cli import first_frames, run
 

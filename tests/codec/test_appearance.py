@@ -8,13 +8,13 @@ import pytest
 
 from facemime import _core
 from facemime.animate.deform import Deformer
-from facemime.animate.look import Look
 from facemime.animate.synth import Puppet
 from facemime.codec.appearance import BLEND, CHECK, WINDOW, Appearance, AppearanceSender, Update, parse, paste
 from facemime.fit.actor import generic_actor
-from facemime.fit.placement import model_iod
-from facemime.render.projection import project
 from facemime.shared_constants import EYES
+from facemime.types.head import model_iod
+from facemime.types.look import Look
+from facemime.types.pose import project
 
 
 def test_an_update_inside_the_texture_fades_in_over_its_edges():

@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 
 from facemime import _core
-from facemime.animate.look import Look
 from facemime.codec.files import analyse, encode_clip
 from facemime.codec.params import LOOK_KINDS, Basis, pose_vector, topology_id
 from facemime.codec.stream import LOOK_STEPS, MotionDecoder, MotionEncoder, Settings, StreamError
 from facemime.errors import InvalidInputError
 from facemime.io.actor_file import actor_bytes, actor_from_bytes, actor_id
+from facemime.types.look import Look
 
 
 @pytest.fixture(scope="module")

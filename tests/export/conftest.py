@@ -14,9 +14,9 @@ import pytest
 
 from facemime.animate.deform import Deformer
 from facemime.export import export_track
-from facemime.fit.placement import model_iod
-from facemime.model import generic_head
-from facemime.render.projection import Pose
+from facemime.head import generic_head
+from facemime.types.head import model_iod
+from facemime.types.pose import Pose
 
 ROOT = Path(__file__).resolve().parents[2]
 WEB = ROOT / "web"

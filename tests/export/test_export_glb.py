@@ -15,7 +15,7 @@ from facemime.export import export_track, load_performance
 from facemime.export.animation import node_keys
 from facemime.fit.actor import generic_actor
 from facemime.io.actor_file import load_actor
-from facemime.render.projection import rotation_matrix
+from facemime.types.pose import rotation_matrix
 
 from .conftest import write_track
 

@@ -21,13 +21,13 @@ import numpy as np
 import pytest
 
 from facemime.animate.expressions import Expressions
+from facemime.animate.motion_file import read_motion
 from facemime.animate.synth import Puppet, synthesize
 from facemime.export import glb_bytes, load_performance
 from facemime.io.actor_file import load_actor
-from facemime.io.contours_json import read_motion
-from facemime.render.projection import Pose, project
 from facemime.render.texture_map import coverage
 from facemime.shared_constants import BACKGROUND
+from facemime.types.pose import Pose, project
 
 #: Least PSNR (dB) of three.js's picture against facemime's over the face: the measured values
 #: (module docstring) less a margin of about 4 dB for other Chromium and three.js versions.

@@ -132,8 +132,8 @@ def test_a_file_without_a_scene_loads_and_shows_the_face_alone(tmp_path, actor):
     from dataclasses import replace
 
     from facemime.animate.synth import Puppet
-    from facemime.fit.placement import model_iod
     from facemime.shared_constants import BACKGROUND
+    from facemime.types.head import model_iod
 
     path = save_actor(tmp_path / "old.actor", replace(actor, scene=None))
     with zipfile.ZipFile(path) as z:

@@ -6,9 +6,9 @@ import pytest
 from facemime import _core
 from facemime.errors import InvalidInputError
 from facemime.fit import check_points, fit_model, frontal_pose
+from facemime.head import generic_head
 from facemime.metrics import curve_error
-from facemime.model import generic_head
-from facemime.render.projection import project
+from facemime.types.pose import project
 
 
 def grid() -> np.ndarray:

@@ -6,11 +6,11 @@ import pytest
 
 from facemime.errors import NoFaceError
 from facemime.fit import auto_points
-from facemime.fit.points import GROUPS
 from facemime.io.video import VideoReader
 from facemime.metrics import curve_error
 from facemime.render.head_view import render_head
-from facemime.render.projection import Pose, project
+from facemime.types.points import GROUPS
+from facemime.types.pose import Pose, project
 
 CORNERS = {
     "eye_right_outer": ("eye_right", 0),

@@ -5,22 +5,22 @@ import json
 import numpy as np
 import pytest
 
-from facemime.animate.look import Look
+from facemime.animate.motion_file import read_motion
 from facemime.errors import InputFileError
 from facemime.io.contours_json import (
     ContourFileError,
     TrackWriter,
     init_document,
     read_init,
-    read_motion,
     read_track,
     track_document,
     track_entry,
     write_json,
 )
 from facemime.io.outputs import OutputFileError
-from facemime.track.contours import CONTOUR_NAMES
 from facemime.track.synthetic import band_face
+from facemime.types.contours import CONTOUR_NAMES
+from facemime.types.look import Look
 
 
 def test_track_json_round_trips(tmp_path):

@@ -2,9 +2,10 @@ import cv2
 import numpy as np
 import pytest
 
-from facemime.model import generic_head, load_wfm
+from facemime.head import generic_head
+from facemime.io.wfm import load_wfm
 from facemime.render.head_view import LIGHT, draw_wireframe, render_shaded, views_sheet
-from facemime.render.projection import Pose, project, rotation_matrix
+from facemime.types.pose import Pose, project, rotation_matrix
 
 
 def shaded_one_by_one(model, pose, size, colour=(205, 180, 160), background=255):

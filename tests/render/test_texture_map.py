@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from facemime.errors import InvalidInputError
-from facemime.model import generic_head, painted_texture
+from facemime.head import generic_head, painted_texture
 from facemime.render import Pose, coverage, fill, project, render_mesh, render_mesh_into
 
 RNG = np.random.default_rng(7)

@@ -6,8 +6,8 @@ import pytest
 from facemime.metrics import curve_error, group_nme
 from facemime.track import CONTOUR_NAMES, Tracker, TrackerParams
 from facemime.track.brows import BrowSearch
-from facemime.track.contours import GROUPS
 from facemime.track.synthetic import SKIN, band_face
+from facemime.types.contours import GROUPS
 
 BROWS = [n for n in CONTOUR_NAMES if n.startswith("brow")]
 
@@ -43,7 +43,7 @@ def test_follows_the_brows_through_a_real_head_jump(shared):
     # motion measured only 5. Tracked from frame 900 without the search, her left brow was
     # lost for 9 frames (NME up to 0.077).
     from facemime.io.video import VideoReader
-    from facemime.track.contours import from_face_mesh as reference_contours
+    from facemime.types.contours import from_face_mesh as reference_contours
 
     z = np.load(shared / "video" / "lp_d6.landmarks.npz")
     with VideoReader(shared / "video" / "lp_d6.mp4") as reader:
@@ -63,8 +63,8 @@ def test_a_brow_raised_fast_is_not_left_on_the_eyelid(shared):
     # confidence: the brows' NME stays at 0.076 to 0.125 through frame 890, unflagged. The
     # landmark model's checks keep the brows on: measured at most 0.022 over those frames.
     from facemime.io.video import VideoReader
-    from facemime.track.contours import from_face_mesh as reference_contours
     from facemime.track.redetect import FaceTracker, Redetection
+    from facemime.types.contours import from_face_mesh as reference_contours
 
     z = np.load(shared / "video" / "lp_d6.landmarks.npz")
     with VideoReader(shared / "video" / "lp_d6.mp4") as reader:

@@ -6,13 +6,13 @@ import pytest
 
 from facemime.animate.analysis import Analysis
 from facemime.animate.deform import Deformer
-from facemime.animate.look import Look
 from facemime.animate.synth import Puppet
 from facemime.fit.actor import generic_actor
-from facemime.fit.placement import model_iod
 from facemime.io.video import VideoReader
 from facemime.shared_constants import DENSITY, SPAN_U, SPAN_V
 from facemime.track.eyes import EyeFrame, EyeTracker, find_iris
+from facemime.types.head import model_iod
+from facemime.types.look import Look
 
 
 def drawn_eye(iris_uv: tuple[float, float]) -> np.ndarray:

@@ -91,8 +91,8 @@ def test_the_inner_lips_follow_a_real_mouth_opening_wide_on_teeth(shared):
     from facemime.io.video import VideoReader
     from facemime.metrics import group_nme
     from facemime.track import Tracker
-    from facemime.track.contours import GROUPS
-    from facemime.track.contours import from_face_mesh as reference_contours
+    from facemime.types.contours import GROUPS
+    from facemime.types.contours import from_face_mesh as reference_contours
 
     z = np.load(shared / "video" / "lp_d6.landmarks.npz")
     with VideoReader(shared / "video" / "lp_d6.mp4") as reader:

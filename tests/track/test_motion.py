@@ -9,9 +9,10 @@ import pytest
 
 from facemime.io.video import VideoReader
 from facemime.track import Tracker
-from facemime.track.contours import from_face_mesh
-from facemime.track.motion import CORNER_BLOCK, DETECT_MARGIN, QUALITY, HeadMotion, apply, robust_similarity
+from facemime.track.motion import CORNER_BLOCK, DETECT_MARGIN, QUALITY, HeadMotion
 from facemime.track.synthetic import band_face
+from facemime.types.contours import from_face_mesh
+from facemime.types.similarity import apply, robust_similarity
 
 NOSE_BRIDGE = [6, 197, 195, 5]  # Face Mesh landmarks on the nose, between the eyes and the tip
 

@@ -7,11 +7,11 @@ import pytest
 
 from facemime.metrics import curve_error, group_nme
 from facemime.track import CONTOUR_NAMES, Tracker, TrackerParams
-from facemime.track.contours import GROUPS
 from facemime.track.lips import lip_colour
 from facemime.track.match import find
 from facemime.track.mouth import mouth_shift, relocate
 from facemime.track.synthetic import LIP, SKIN, band_face
+from facemime.types.contours import GROUPS
 
 MOUTH = [n for n in CONTOUR_NAMES if n.startswith("mouth")]
 
@@ -60,7 +60,7 @@ def test_follows_a_mouth_pushed_sideways_in_a_real_video(shared):
     # every start. With it, the worst frame swings from start to start (0.05-0.13 over ten
     # starts with 0.2 px of noise; 0.079 on average against 0.111): so compare over five.
     from facemime.io.video import VideoReader
-    from facemime.track.contours import from_face_mesh as reference_contours
+    from facemime.types.contours import from_face_mesh as reference_contours
 
     z = np.load(shared / "video" / "lp_d6.landmarks.npz")
     with VideoReader(shared / "video" / "lp_d6.mp4") as reader:

@@ -8,9 +8,9 @@ import pytest
 from facemime.io.video import VideoReader
 from facemime.metrics import group_nme
 from facemime.track import Tracker
-from facemime.track.contours import GROUPS, from_face_mesh
 from facemime.track.redetect import FaceTracker, Redetection
 from facemime.track.synthetic import band_face
+from facemime.types.contours import GROUPS, from_face_mesh
 
 
 def read(shared, name, count, size=None):

@@ -7,8 +7,8 @@ import pytest
 from facemime.io.video import VideoReader
 from facemime.metrics import group_nme
 from facemime.track import Tracker, TrackerParams
-from facemime.track.contours import GROUPS, from_face_mesh
 from facemime.track.scale import FrameScale
+from facemime.types.contours import GROUPS, from_face_mesh
 
 
 @pytest.mark.parametrize(

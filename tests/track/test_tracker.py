@@ -6,8 +6,8 @@ import pytest
 from facemime.errors import InvalidInputError
 from facemime.metrics import curve_error, group_nme
 from facemime.track import CONTOUR_NAMES, FEATURES, Tracker, TrackerParams
-from facemime.track.contours import GROUPS
 from facemime.track.synthetic import band_face
+from facemime.types.contours import GROUPS
 
 
 def sequence(steps, **per_step):
@@ -229,7 +229,7 @@ def test_tracks_a_real_talking_face(shared, name, count):
     # lp_d0 opens her mouth wide and closes it again: with a rest shape that could not change
     # (TrackerParams(mouth_affine=0)) the inner lips stayed behind (mean NME 0.044, max 0.08).
     from facemime.io.video import VideoReader
-    from facemime.track.contours import from_face_mesh as reference_contours
+    from facemime.types.contours import from_face_mesh as reference_contours
 
     z = np.load(shared / "video" / f"{name}.landmarks.npz")
     with VideoReader(shared / "video" / f"{name}.mp4") as reader:

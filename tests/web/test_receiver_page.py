@@ -14,8 +14,8 @@ from facemime.codec.appearance import Appearance
 from facemime.codec.files import encode_video
 from facemime.codec.params import look_from_extras, pose_from_vector
 from facemime.codec.stream import MotionDecoder, Settings
-from facemime.fit.placement import model_iod
 from facemime.shared_constants import NO_FACE_DIM
+from facemime.types.head import model_iod
 
 
 @pytest.fixture(scope="module")

@@ -17,12 +17,12 @@ import numpy as np
 import pytest
 
 from facemime import _core
-from facemime.animate.look import Look
 from facemime.codec.params import Basis, look_from_extras, pose_from_vector
 from facemime.codec.stream import MotionDecoder, MotionEncoder, Settings
 from facemime.fit.actor import generic_actor
-from facemime.render.projection import Pose
-from facemime.track.contours import FEATURES
+from facemime.types.contours import FEATURES
+from facemime.types.look import Look
+from facemime.types.pose import Pose
 
 ROOT = Path(__file__).resolve().parents[2]
 WEB = ROOT / "web"

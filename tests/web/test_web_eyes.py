@@ -24,13 +24,13 @@ import numpy as np
 import pytest
 
 from facemime.animate.eyes import LookPainter
-from facemime.animate.look import Look
-from facemime.face.mesh import reference_points
 from facemime.fit import fit_model
 from facemime.fit.actor import generic_actor, smear_texture
 from facemime.fit.run import fit_actor
+from facemime.head import generic_head
 from facemime.io.video import VideoReader
-from facemime.model import generic_head
+from facemime.networks.mesh import reference_points
+from facemime.types.look import Look
 
 ROOT = Path(__file__).resolve().parents[2]
 WEB = ROOT / "web"

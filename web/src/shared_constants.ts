@@ -2,7 +2,7 @@
 /** The pose's values, in their order in a frame's parameter vector (degrees; pixels per model unit,
  * carried in the stream as its natural log; pixels). */
 export const POSE_FIELDS = ["yaw", "pitch", "roll", "scale", "tx", "ty"] as const;
-/** The look's values (facemime.animate.look), in order: the stream's extra parameter of kind k is
+/** The look's values (facemime.types.look), in order: the stream's extra parameter of kind k is
  * the k-th of them (kinds from 1). */
 export const LOOK_NAMES = [
   "eye_right_closure",

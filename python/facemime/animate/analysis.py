@@ -30,19 +30,20 @@ import numpy as np
 
 from facemime.animate.deform import Deformer
 from facemime.animate.landmark_pose import LandmarkPose, PoseFilter
-from facemime.animate.look import Look
 from facemime.animate.pose import PoseTracker
 from facemime.errors import NoFaceError
-from facemime.face.finder import follow_face
-from facemime.face.mesh import reference_points
-from facemime.fit.actor import Actor
-from facemime.fit.placement import fit_model, model_iod
+from facemime.fit.placement import fit_model
 from facemime.fit.run import find_points, fit_actor, init_contours
-from facemime.render.projection import Pose
-from facemime.track.contours import FEATURES
+from facemime.networks.finder import follow_face
+from facemime.networks.mesh import reference_points
 from facemime.track.eyes import EyeTracker
 from facemime.track.redetect import FaceTracker
 from facemime.track.tracker import TrackerParams
+from facemime.types.actor import Actor
+from facemime.types.contours import FEATURES
+from facemime.types.head import model_iod
+from facemime.types.look import Look
+from facemime.types.pose import Pose
 
 #: Frames at least between two fits of the actor that anchor a pose carried by the head's step.
 #: On lp_d6 and lp_d12 (PSNR of the re-synthesised face, mean of the two): a fit on every such
@@ -62,7 +63,7 @@ class FrameMotion:
     contours collapsed; ``face``: False when the face was not found (pose and offsets then
     repeat the last good frame's); ``pose``: the head pose of the analysis actor; ``offsets``:
     (K, 2) knot offsets, model units; ``redetected``: the face landmark model put the contours
-    right on this frame; ``look``: the eyes (:class:`~facemime.animate.look.Look`, relative to
+    right on this frame; ``look``: the eyes (:class:`~facemime.types.look.Look`, relative to
     the first frame's).
     """
 

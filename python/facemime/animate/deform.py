@@ -20,28 +20,14 @@ from collections.abc import Mapping
 import numpy as np
 
 from facemime.errors import InvalidInputError
-from facemime.fit.placement import model_iod
 from facemime.metrics import resample
-from facemime.model.head import HeadModel
-from facemime.render.projection import Pose, rotation_matrix
 from facemime.shared_constants import CONTOUR_GROUPS, REACH, SOFTEN
+from facemime.types.head import HeadModel, model_iod
+from facemime.types.pose import Pose, head_plane
 
 UPPER = ("mouth_outer_upper", "mouth_inner_upper")
 LOWER = ("mouth_outer_lower", "mouth_inner_lower")
 BROWS = tuple(n for n in CONTOUR_GROUPS if n.startswith("brow"))
-
-
-def head_plane(points: np.ndarray, depth: np.ndarray, pose: Pose) -> np.ndarray:
-    """Model-space (x, y) of image ``points`` (K, 2) px seen in ``pose``, each at its model
-    depth ``depth`` (K,): the inverse of the orthographic projection for points of known z."""
-    r = rotation_matrix(pose.yaw, pose.pitch, pose.roll)
-    # (u - tx - s·r02·z, v - ty + s·r12·z) = s·[[r00, r01], [-r10, -r11]] (x, y), inverted.
-    det = pose.scale * (r[1, 0] * r[0, 1] - r[0, 0] * r[1, 1])
-    inverse = np.array([[-r[1, 1], -r[0, 1]], [r[1, 0], r[0, 0]]]) / det
-    rhs = np.column_stack(
-        [points[:, 0] - pose.tx - pose.scale * r[0, 2] * depth, points[:, 1] - pose.ty + pose.scale * r[1, 2] * depth]
-    )
-    return rhs @ inverse.T
 
 
 def mouth_width(model: HeadModel, vertices: np.ndarray) -> float:

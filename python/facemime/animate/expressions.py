@@ -37,8 +37,8 @@ import numpy as np
 from facemime.animate.deform import Deformer
 from facemime.animate.eyes import close_lids
 from facemime.errors import InvalidInputError
-from facemime.model.head import HeadModel
 from facemime.shared_constants import EYES
+from facemime.types.head import HeadModel
 
 #: The controls, in the order of every weight vector.
 NAMES: tuple[str, ...] = (
@@ -220,7 +220,7 @@ def unit_patterns(model: HeadModel, deformer: Deformer | None = None) -> np.ndar
 def generic_unit_patterns() -> np.ndarray:
     """:func:`unit_patterns` of the generic head (read-only): the patterns of any actor fitted
     from it, times its feature sizes."""
-    from facemime.model import generic_head
+    from facemime.head import generic_head
 
     return _frozen(unit_patterns(generic_head()))
 

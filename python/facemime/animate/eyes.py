@@ -16,8 +16,6 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from facemime.animate.look import Look
-from facemime.fit.actor import Actor
 from facemime.render.bilinear import shift_offset, shifted
 from facemime.shared_constants import (
     EYES,
@@ -31,6 +29,8 @@ from facemime.shared_constants import (
     UPPER_LID,
 )
 from facemime.track.eyes import EyeFrame, find_iris
+from facemime.types.actor import Actor
+from facemime.types.look import Look
 
 
 def close_lids(vertices: np.ndarray, rings: list[np.ndarray], closure: np.ndarray) -> np.ndarray:
@@ -110,7 +110,7 @@ class _Eye:
 
 
 class LookPainter:
-    """Paints a :class:`~facemime.animate.look.Look` on ``actor``: :meth:`vertices` closes the
+    """Paints a :class:`~facemime.types.look.Look` on ``actor``: :meth:`vertices` closes the
     lids, :meth:`texture` moves the irises."""
 
     def __init__(self, actor: Actor):

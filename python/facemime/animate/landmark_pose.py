@@ -5,12 +5,12 @@ The key frame's rigid landmarks are lifted into the actor's model frame once
 (:class:`LandmarkPose`): their image positions and depths, undone by the key frame's pose, with
 the depths' offset set so that they lie on the actor's mesh on average. Each later frame's rigid
 landmarks are aligned to those model points (rotation, scale, translation; Huber-weighted
-rounds against outlying points), which gives the frame's :class:`~facemime.render.projection.Pose`
+rounds against outlying points), which gives the frame's :class:`~facemime.types.pose.Pose`
 absolutely, in the model's frame, not relative to the first frame.
 
 Frames: landmarks are image pixels (x right, y down, depth smaller = nearer the camera, in the
 same pixel scale). They are aligned in camera coordinates (x right, y up, z towards the camera:
-``(x, -y, -depth)``), the frame in which :func:`~facemime.render.projection.project` places the
+``(x, -y, -depth)``), the frame in which :func:`~facemime.types.pose.project` places the
 rotated model: image x = tx + scale · x, image y = ty − scale · y.
 """
 
@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from facemime.animate.pose import lift
-from facemime.render.projection import Pose, rotation_matrix
+from facemime.types.pose import Pose, rotation_matrix
 
 #: Face Mesh landmarks that move with the skull, not with the expression: forehead, temples,
 #: nose bridge and tip, the eyes' corners and the cheekbones (64 points).
@@ -78,7 +78,7 @@ def procrustes(
 
 def angles(rotation: np.ndarray) -> tuple[float, float, float]:
     """(yaw, pitch, roll) degrees of a rotation ``Rz(roll) @ Rx(pitch) @ Ry(yaw)``
-    (:func:`~facemime.render.projection.rotation_matrix`'s convention).
+    (:func:`~facemime.types.pose.rotation_matrix`'s convention).
 
     >>> np.round(angles(rotation_matrix(yaw=30, pitch=-12, roll=7)), 9).tolist()
     [30.0, -12.0, 7.0]

@@ -1,5 +1,5 @@
 """Head pose per frame from the optical flow: the orthographic pose (yaw, pitch, roll, scale,
-translation; see :class:`facemime.render.projection.Pose`) that best maps rigid 3D points of the
+translation; see :class:`facemime.types.pose.Pose`) that best maps rigid 3D points of the
 actor's model onto where the optical flow followed them. The analysis measures the pose on the
 Face Mesh landmarks (:mod:`facemime.animate.landmark_pose`) and falls back to this on frames
 whose landmark pass finds no face.
@@ -17,8 +17,8 @@ from dataclasses import replace
 import numpy as np
 
 from facemime import _core
-from facemime.render.projection import Pose, project
 from facemime.track.motion import HeadMotion
+from facemime.types.pose import Pose, project
 
 #: Fewest lifted points that fit a pose.
 MIN_POINTS = 6

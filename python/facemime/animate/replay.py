@@ -18,13 +18,15 @@ import numpy as np
 
 from facemime.animate.analysis import FrameMotion
 from facemime.animate.deform import Deformer
+from facemime.animate.motion_file import read_motion
 from facemime.animate.synth import Puppet
 from facemime.errors import InvalidInputError
-from facemime.fit.actor import Actor, generic_actor
-from facemime.fit.placement import model_iod
-from facemime.io.contours_json import ContourFileError, read_motion
-from facemime.io.limits import limit
-from facemime.render.projection import Pose
+from facemime.fit.actor import generic_actor
+from facemime.io.contours_json import ContourFileError
+from facemime.limits import limit
+from facemime.types.actor import Actor
+from facemime.types.head import model_iod
+from facemime.types.pose import Pose
 
 #: The largest frame side of a track file's ``video`` block, pixels.
 MAX_SIDE = 16384

@@ -3,7 +3,7 @@
 Writes a side-by-side video (the original with the tracked contours | the synthesised picture:
 the face in the driven actor's scene, or alone with ``mask_only``) that browsers play, and the
 ``facemime.track/1`` JSON with contours, head pose, knot offsets, look (the eyes,
-:mod:`facemime.animate.look`) and expression weights (:mod:`facemime.animate.expressions`)
+:mod:`facemime.types.look`) and expression weights (:mod:`facemime.animate.expressions`)
 per frame, and on request the weights as CSV (``frame,time_s,<names...>``); when the face is
 synthesised in its own scene, also how far each frame departs from that synthesis
 (:mod:`facemime.animate.departure`): per frame ``scene_departure`` (0..1) and
@@ -26,18 +26,18 @@ from facemime.animate.departure import DEPARTS_AT, departure
 from facemime.animate.expressions import Expressions
 from facemime.animate.synth import Puppet, UserMotion
 from facemime.errors import InputFileError, InvalidInputError
-from facemime.fit.actor import Actor
-from facemime.fit.placement import model_iod
 from facemime.io.actor_file import load_actor
 from facemime.io.contours_json import TrackWriter
 from facemime.io.outputs import Outputs, write_text
 from facemime.io.video import CODECS, VideoReader, VideoWriter
 from facemime.progress import track as progress
-from facemime.render.projection import Pose, project
 from facemime.render.texture_map import fill
 from facemime.shared_constants import BACKGROUND, NO_FACE_DIM, POSE_FIELDS
 from facemime.track.overlay import draw_contours
 from facemime.track.tracker import TrackerParams
+from facemime.types.actor import Actor
+from facemime.types.head import model_iod
+from facemime.types.pose import Pose, project
 
 
 @dataclass

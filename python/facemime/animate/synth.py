@@ -16,11 +16,7 @@ import numpy as np
 
 from facemime.animate.deform import Deformer, mouth_width
 from facemime.animate.eyes import LookPainter
-from facemime.animate.look import Look
 from facemime.errors import InvalidInputError
-from facemime.fit.actor import Actor
-from facemime.fit.placement import model_iod
-from facemime.render.projection import Pose, project
 from facemime.render.scene import SceneMesh
 from facemime.render.texture_map import fill, render_mesh_into
 from facemime.shared_constants import (
@@ -39,6 +35,10 @@ from facemime.shared_constants import (
     UPPER_SHARE,
     UPPER_TEETH,
 )
+from facemime.types.actor import Actor
+from facemime.types.head import model_iod
+from facemime.types.look import Look
+from facemime.types.pose import Pose, project
 
 
 def teeth_uncovered(spread: float) -> float:

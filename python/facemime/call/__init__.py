@@ -14,8 +14,8 @@ from typing import BinaryIO
 from facemime.call.sender import KEYFRAME, PACKET_FRAMES, RATE, WARMUP, Sender, open_source
 from facemime.call.server import GOING_AWAY, PORT, Hub, make_server
 from facemime.errors import InvalidInputError
-from facemime.fit.actor import Actor
 from facemime.io.outputs import OutputFileError, check_outputs, temporary_sibling
+from facemime.types.actor import Actor
 
 __all__ = ["KEYFRAME", "PACKET_FRAMES", "PORT", "RATE", "WARMUP", "Call"]
 

@@ -26,9 +26,9 @@ from facemime.codec.files import Clip, encode_clip
 from facemime.codec.params import Basis, pose_vector
 from facemime.codec.stream import DEFAULT_QUALITY, LADDER, MotionEncoder, Settings
 from facemime.errors import InputFileError, InvalidInputError
-from facemime.fit.actor import Actor
 from facemime.io.actor_file import actor_bytes
 from facemime.io.video import VideoReader
+from facemime.types.actor import Actor
 
 #: Seconds of analysed frames the basis is learned from before the stream starts (not streamed).
 WARMUP = 2.0

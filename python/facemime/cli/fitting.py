@@ -17,8 +17,10 @@ from facemime.cli.app import cli, force_option, out_option
 def model_preview(model: Path | None, out_file: Path, force: bool) -> None:
     """Render a head model (facemime .json or CANDIDE .wfm; default: the built-in head) from
     five angles, textured, shaded and as a wireframe, into one PNG."""
+    from facemime.head import generic_head, painted_texture
     from facemime.io import check_image_suffix, check_outputs, write_image
-    from facemime.model import generic_head, load_head, load_wfm, painted_texture
+    from facemime.io.head_file import load_head
+    from facemime.io.wfm import load_wfm
     from facemime.render.head_view import views_sheet
 
     check_image_suffix(out_file)

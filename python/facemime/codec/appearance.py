@@ -28,10 +28,10 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from facemime.model.head import HeadModel
-from facemime.render.projection import Pose, project, rotation_matrix
 from facemime.render.texture_map import render_mesh_into
 from facemime.shared_constants import EYES
+from facemime.types.head import HeadModel
+from facemime.types.pose import Pose, project, rotation_matrix
 
 #: Texels over which an update's edges fade into the texture (the spec's B).
 BLEND = 8

@@ -24,20 +24,20 @@ import numpy as np
 from facemime import _core
 from facemime.animate.analysis import FrameMotion, start_analysis
 from facemime.animate.deform import Deformer
-from facemime.animate.look import Look
 from facemime.animate.synth import Puppet
 from facemime.codec.appearance import Appearance, AppearanceSender
 from facemime.codec.params import Basis, pose_vector
 from facemime.codec.stream import LADDER, MotionDecoder, MotionEncoder, Settings, StreamError
 from facemime.errors import InputFileError, InvalidInputError
-from facemime.fit.actor import Actor
-from facemime.fit.placement import model_iod
 from facemime.io.actor_file import load_actor
 from facemime.io.outputs import check_outputs, write_bytes
 from facemime.io.video import CODECS, VideoReader, VideoWriter
 from facemime.progress import track as progress
 from facemime.render.texture_map import fill
 from facemime.shared_constants import BACKGROUND, NO_FACE_DIM
+from facemime.types.actor import Actor
+from facemime.types.head import model_iod
+from facemime.types.look import Look
 
 SUFFIX = ".fmstream"
 #: Largest stream file read, bytes.

@@ -1,13 +1,13 @@
 """A frame's motion as the bitstream's parameter vector, and back.
 
 The vector is the head pose (yaw, pitch, roll in degrees; ln of the scale, the scale in pixels
-per model unit; tx, ty in pixels: :class:`facemime.render.projection.Pose`) followed by M
+per model unit; tx, ty in pixels: :class:`facemime.types.pose.Pose`) followed by M
 coefficients of the knot offsets on an orthonormal basis (model units, millimetres for the
 generic head): offsets (K, 2), flattened x0, y0, x1, y1, ..., are ``basis.T @ coefficients``.
 The basis travels in the stream's header as int16 (entries ×32767); both ends use that
 quantised basis, so they agree exactly. A version-2 stream (``docs/bitstream.md``, "Look") ends
 the vector with *extras*, each named by a kind: facemime sends the six values of a
-:class:`facemime.animate.look.Look` as kinds 1-6 (:data:`LOOK_KINDS`).
+:class:`facemime.types.look.Look` as kinds 1-6 (:data:`LOOK_KINDS`).
 """
 
 from __future__ import annotations
@@ -20,14 +20,14 @@ from functools import cached_property
 import numpy as np
 
 from facemime.animate.deform import Deformer
-from facemime.animate.look import Look
-from facemime.model.head import HeadModel
-from facemime.render.projection import Pose
 from facemime.shared_constants import BASIS_ONE, LOOK_NAMES, POSE_FIELDS
+from facemime.types.head import HeadModel
+from facemime.types.look import Look
+from facemime.types.pose import Pose
 
 POSE_PARAMETERS = len(POSE_FIELDS)
 #: The extra parameters' kinds of the look's values, in the order of :meth:`Look.vector`
-#: (``facemime.animate.look.NAMES``): kind k is ``vector()[k - 1]``.
+#: (``facemime.types.look.NAMES``): kind k is ``vector()[k - 1]``.
 LOOK_KINDS = tuple(range(1, len(LOOK_NAMES) + 1))
 
 

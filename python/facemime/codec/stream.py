@@ -19,7 +19,6 @@ import numpy as np
 
 from facemime import _core
 from facemime.animate.deform import Deformer
-from facemime.animate.look import Look
 from facemime.codec.params import (
     LOOK_KINDS,
     POSE_PARAMETERS,
@@ -30,11 +29,12 @@ from facemime.codec.params import (
     topology_id,
 )
 from facemime.errors import FacemimeError, InvalidInputError
-from facemime.fit.actor import Actor
 from facemime.io.actor_file import ActorFileError, actor_bytes, actor_from_bytes, actor_id
-from facemime.io.limits import pose_in_range
-from facemime.render.projection import Pose
-from facemime.track.contours import FEATURES
+from facemime.limits import pose_in_range
+from facemime.types.actor import Actor
+from facemime.types.contours import FEATURES
+from facemime.types.look import Look
+from facemime.types.pose import Pose
 
 #: The quality a stream gets unless told otherwise (0 = coarsest ... 10 = finest).
 DEFAULT_QUALITY = 5
@@ -59,7 +59,7 @@ LADDER = (
 #: 0.001; halving the coefficients' step from 3 (2 mm changed it by less than 0.001 anywhere).
 POSE_STEPS = (0.5, 0.5, 0.5, 0.004, 0.5, 0.5)
 COEFFICIENT_STEP = 3.0
-#: Quantiser steps at factor 1 of the look's values (``facemime.animate.look``, in the order of
+#: Quantiser steps at factor 1 of the look's values (``facemime.types.look``, in the order of
 #: its NAMES): eye closure (share of the key frame's opening), iris u and v (eye widths).
 LOOK_STEPS = (1 / 16, 1 / 16, 0.02, 0.02, 0.02, 0.02)
 
@@ -144,7 +144,7 @@ class MotionEncoder:
     (learned from the clip, :meth:`Basis.learn`); ``classes``: per parameter, the spread class
     of its starting table (``facemime._core.choose_classes``; default: a middle class);
     ``reference``: the pose intra frames are coded from (default: the actor's); ``look``: the
-    stream carries each frame's :class:`~facemime.animate.look.Look` (format version 2; without
+    stream carries each frame's :class:`~facemime.types.look.Look` (format version 2; without
     it the stream is version 1 and the receiver decodes a neutral look); ``actor_data``: the
     carried actor's file bytes when already made (:func:`~facemime.io.actor_file.actor_bytes`
     with a WebP texture: a live sender makes them before its stream starts, as they take a few

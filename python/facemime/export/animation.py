@@ -1,6 +1,6 @@
 """A track's head poses and expression weights as glTF keyframes.
 
-facemime's pose is orthographic (:mod:`facemime.render.projection`): a model point ``v`` lands
+facemime's pose is orthographic (:mod:`facemime.types.pose`): a model point ``v`` lands
 at pixel ``(tx, ty) + scale * (R v)_xy`` with the image's y down and
 ``R = Rz(roll) Rx(pitch) Ry(yaw)``. The model's axes are glTF's (x to the subject's left, y up,
 z towards the camera: the asset's front faces +z), so the rotation goes over as it is. The
@@ -42,7 +42,7 @@ def _multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def quaternions(yaw: np.ndarray, pitch: np.ndarray, roll: np.ndarray) -> np.ndarray:
     """(T, 4) unit quaternions (x, y, z, w) of ``Rz(roll) Rx(pitch) Ry(yaw)`` (degrees, see
-    :func:`facemime.render.projection.rotation_matrix`), each on the side of the one before
+    :func:`facemime.types.pose.rotation_matrix`), each on the side of the one before
     (``q`` and ``-q`` are one rotation; glTF interpolates between neighbours as given).
 
     >>> np.round(quaternions(np.array([90.0]), np.zeros(1), np.zeros(1)), 4).tolist()

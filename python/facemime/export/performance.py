@@ -30,14 +30,16 @@ import cv2
 import numpy as np
 
 from facemime import __version__
+from facemime.animate.motion_file import read_motion
 from facemime.animate.replay import track_settings
 from facemime.errors import InputFileError, InvalidInputError
 from facemime.export.animation import POSE_KEYS, node_keys
 from facemime.export.gltf import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, Glb
-from facemime.fit.actor import Actor, generic_actor
-from facemime.fit.placement import model_iod
-from facemime.io.contours_json import TRACK_FORMAT, ContourFileError, load_document, read_motion
+from facemime.fit.actor import generic_actor
+from facemime.io.contours_json import TRACK_FORMAT, ContourFileError, load_document
 from facemime.io.outputs import check_outputs, write_bytes
+from facemime.types.actor import Actor
+from facemime.types.head import model_iod
 
 #: Metres per model unit, by the model's ``unit``.
 METRES = {"mm": 0.001, "cm": 0.01, "m": 1.0}

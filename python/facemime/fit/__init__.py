@@ -3,7 +3,7 @@ automatically), placement and elastic adjustment, texture smearing, and the resu
 
 from facemime.fit.auto import AutoPoints, auto_points
 from facemime.fit.placement import Fit, fit_model, frontal_pose
-from facemime.fit.points import GROUPS, NAMES, REQUIRED, ReferencePoints, check_points, model_chain
+from facemime.types.points import GROUPS, NAMES, REQUIRED, ReferencePoints, check_points, model_chain
 
 __all__ = [
     "GROUPS",

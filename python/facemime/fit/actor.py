@@ -7,17 +7,19 @@ texture's top-left corner; texel (i, j) has its centre at ((i + 0.5) / W, (j + 0
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 
 import cv2
 import numpy as np
 
 from facemime.errors import InvalidInputError
 from facemime.fit.placement import Fit
-from facemime.fit.points import ReferencePoints
-from facemime.model.head import HeadModel, generic_head
-from facemime.model.texture import painted_texture
-from facemime.render.projection import Pose, project
+from facemime.head.generic import generic_head
+from facemime.head.texture import painted_texture
+from facemime.types.actor import Actor
+from facemime.types.head import HeadModel
+from facemime.types.points import ReferencePoints
+from facemime.types.pose import Pose, project
 
 #: The texture is the photo cropped around the face with this margin (fraction of the face size)
 #: and shrunk, if needed, to at most this many pixels on its longer side.
@@ -25,57 +27,6 @@ TEXTURE_MARGIN = 0.08
 TEXTURE_MAX_SIDE = 1024
 #: The scene (the whole source photo) is shrunk, if needed, to at most this many pixels a side.
 SCENE_MAX_SIDE = 2048
-
-
-@dataclass(frozen=True, eq=False)
-class Actor:
-    """A fitted, textured head.
-
-    Attributes
-    ----------
-    model : HeadModel
-        The adjusted model; its ``uv`` address ``texture``.
-    texture : (H, W, 3) uint8 array
-        RGB, the source photo cropped around the face.
-    pose : Pose
-        The frontal pose that maps ``model.vertices`` onto the source photo.
-    source : dict
-        Where the face came from: ``file`` (name only), ``frame``, ``width``, ``height``.
-    points : dict of str -> (K, 2) float64 array
-        The reference points the model was fitted to, pixels of the source photo.
-    scene : (Hs, Ws, 3) uint8 array or None
-        RGB, the whole source photo (shrunk to at most :data:`SCENE_MAX_SIDE` pixels a side):
-        the picture the face is synthesised in (:mod:`facemime.render.scene`); None for an
-        actor without one (the face is then shown alone).
-    """
-
-    model: HeadModel
-    texture: np.ndarray
-    pose: Pose
-    source: dict = field(default_factory=dict)
-    points: ReferencePoints = field(default_factory=dict)
-    scene: np.ndarray | None = None
-
-    def __post_init__(self) -> None:
-        for name, t in (("texture", self.texture), ("scene", self.scene)):
-            if t is None and name == "scene":
-                continue
-            if not (
-                isinstance(t, np.ndarray)
-                and t.dtype == np.uint8
-                and t.ndim == 3
-                and t.shape[2] == 3
-                and min(t.shape[:2]) >= 1
-            ):
-                raise InvalidInputError(
-                    f"actor {name} must be an (H, W, 3) uint8 image, got {getattr(t, 'shape', type(t).__name__)}"
-                )
-        if self.scene is not None and not all(
-            isinstance(self.source.get(k), int) and self.source[k] > 0 for k in ("width", "height")
-        ):
-            raise InvalidInputError("an actor with a scene needs its source picture's width and height")
-        if self.model.uv is None:
-            raise InvalidInputError("actor model needs texture coordinates (uv)")
 
 
 def smear_texture(model: HeadModel, photo: np.ndarray, fit: Fit, points: ReferencePoints, source: dict) -> Actor:

@@ -1,6 +1,6 @@
 """Reference points found automatically on a face photo, offline: the largest human face and its
-Face Mesh landmarks (:func:`facemime.face.find_face`), read as facemime's reference points
-(:func:`facemime.face.reference_points`).
+Face Mesh landmarks (:func:`facemime.networks.find_face`), read as facemime's reference points
+(:func:`facemime.networks.reference_points`).
 
 The points are the landmark model's, not settled on the image edges: on the ten shared videos'
 first frames and the seven shared photos, settling the mouth and brow curves with the tracker's
@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from facemime.face.finder import Face, find_face
-from facemime.face.mesh import reference_points
-from facemime.fit.points import ReferencePoints
+from facemime.networks.finder import Face, find_face
+from facemime.networks.mesh import reference_points
+from facemime.types.points import ReferencePoints
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,7 @@
 """Placing and elastically adjusting a head model on reference points (docs/method.md §2).
 
 The model is seen frontally (yaw = pitch = 0) under the orthographic projection of
-:mod:`facemime.render.projection`: a :class:`~facemime.render.projection.Pose` with a roll, a
+:mod:`facemime.types.pose`: a :class:`~facemime.types.pose.Pose` with a roll, a
 scale (pixels per model unit) and a translation maps it onto the photo.
 """
 
@@ -12,9 +12,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from facemime import _core
-from facemime.fit.points import LIDS, POINTS, ReferencePoints, model_chain
-from facemime.model.head import HeadModel
-from facemime.render.projection import Pose, project, rotation_matrix
+from facemime.types.head import HeadModel, model_iod
+from facemime.types.points import LIDS, POINTS, ReferencePoints, model_chain
+from facemime.types.pose import Pose, project, rotation_matrix
 
 #: Elastic adjustment settings: initial rigidity ψ as a fraction of the inter-ocular distance,
 #: its shrink factor per iteration, ε, most iterations, and the stop threshold (fraction of the
@@ -24,17 +24,6 @@ SHRINK = 0.4
 EPSILON = 2.0
 ITERATIONS = 8
 TOLERANCE = 0.004
-
-
-def model_iod(model: HeadModel) -> float:
-    """Distance between the model's outer eye corners, model units."""
-    g = model.groups
-    return float(np.linalg.norm(model.vertices[g["eye_right"][0], :2] - model.vertices[g["eye_left"][4], :2]))
-
-
-def model_eye_centres(model: HeadModel) -> np.ndarray:
-    """Midpoints of each eye's corners, image-left eye (the subject's right) first: (2, 3)."""
-    return np.array([model.vertices[model.groups[e][[0, 4]]].mean(axis=0) for e in ("eye_right", "eye_left")])
 
 
 def frontal_pose(model_points: np.ndarray, image_points: np.ndarray) -> Pose:
@@ -73,7 +62,7 @@ class Fit:
 
 def fit_model(model: HeadModel, points: ReferencePoints) -> Fit:
     """Scale and place ``model`` on validated reference ``points`` (see
-    :func:`facemime.fit.points.check_points`), then adjust it elastically until its contours
+    :func:`facemime.types.points.check_points`), then adjust it elastically until its contours
     lie on theirs.
 
     The placement is the least-squares similarity of the single points (but the lids) and the

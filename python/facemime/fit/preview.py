@@ -6,9 +6,9 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from facemime.fit.actor import Actor
 from facemime.render.head_view import draw_wireframe, render_head
-from facemime.render.projection import Pose, project
+from facemime.types.actor import Actor
+from facemime.types.pose import Pose, project
 
 YAWS = (-30.0, 0.0, 30.0)
 

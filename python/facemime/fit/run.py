@@ -9,17 +9,19 @@ from pathlib import Path
 import numpy as np
 
 from facemime.errors import InvalidInputError, NoFaceError
-from facemime.fit.actor import Actor, smear_texture
+from facemime.fit.actor import smear_texture
 from facemime.fit.auto import AutoPoints, auto_points
 from facemime.fit.placement import fit_model
 from facemime.fit.preview import preview_sheet
+from facemime.head.generic import generic_head
 from facemime.io.actor_file import actor_bytes
 from facemime.io.outputs import Outputs, write_bytes, write_image
 from facemime.io.photo import read_photo
 from facemime.io.points_json import read_points
-from facemime.model.head import HeadModel, generic_head
-from facemime.render.projection import project
-from facemime.track.contours import CONTOUR_NAMES
+from facemime.types.actor import Actor
+from facemime.types.contours import CONTOUR_NAMES
+from facemime.types.head import HeadModel
+from facemime.types.pose import project
 
 
 @dataclass

@@ -32,11 +32,11 @@ import cv2
 import numpy as np
 
 from facemime.errors import FacemimeError, InputFileError, InvalidInputError, ModelFormatError
-from facemime.fit.actor import Actor
-from facemime.io.limits import image_size, limit, parse_json, pose_in_range
+from facemime.io.head_file import head_document, head_from_document
 from facemime.io.outputs import OutputFileError, check_outputs, write_bytes
-from facemime.model.head import head_document, head_from_document
-from facemime.render.projection import Pose
+from facemime.limits import image_size, limit, parse_json, pose_in_range
+from facemime.types.actor import Actor
+from facemime.types.pose import Pose
 
 ACTOR_FORMAT = "facemime.actor/1"
 #: Largest member sizes accepted when loading, bytes (uncompressed).
@@ -201,7 +201,7 @@ def actor_from_bytes(source: str | Path | bytes, where: str) -> Actor:
 
 def _check_scene_source(source: dict[str, Any], scene: np.ndarray, where: str) -> None:
     """Refuse a scene whose source picture (what it is drawn at) is larger than the input policy
-    allows for an image (:mod:`facemime.io.limits`), or of another shape than the scene: the
+    allows for an image (:mod:`facemime.limits`), or of another shape than the scene: the
     scene is that picture, at most shrunk."""
     w, h = source.get("width"), source.get("height")
     if not (isinstance(w, int) and isinstance(h, int) and w > 0 and h > 0):

@@ -12,11 +12,11 @@ extends ``facemime.track/1`` compatibly with per-frame keys:
 - ``pose``: the head pose, ``yaw``, ``pitch``, ``roll`` in degrees (rotations of the model about
   its own y, x, z axes, applied yaw first), ``scale`` in pixels per model unit and ``tx``, ``ty``
   the pixel position of the model origin (orthographic, see
-  :mod:`facemime.render.projection`);
+  :mod:`facemime.types.pose`);
 - ``offsets``: (K, 2) displacements of the model's contour vertices (the knots) in the head's own
   frame, model units, relative to the first frame: the local motion that drives synthesis;
 - ``look``: the eyes, relative to the first frame (names and units in
-  :mod:`facemime.animate.look`: ``eye_right_closure``, ``iris_right_u``, ...); a name left
+  :mod:`facemime.types.look`: ``eye_right_closure``, ``iris_right_u``, ...); a name left
   out is 0;
 - ``weights``: named expression weights, name -> 0..1 (the non-zero ones, 4 decimals; names and
   what they do in :mod:`facemime.animate.expressions`), solved from the offsets and the look. A
@@ -42,11 +42,10 @@ from typing import Any
 
 import numpy as np
 
-from facemime.animate.look import Look
 from facemime.errors import FacemimeError
-from facemime.io.limits import parse_json, pose_in_range, read_json_text
 from facemime.io.outputs import OutputFileError, write_text
-from facemime.track.contours import CONTOUR_NAMES
+from facemime.limits import parse_json, read_json_text
+from facemime.types.contours import CONTOUR_NAMES
 
 INIT_FORMAT = "facemime.init/1"
 POSE_KEYS = ("yaw", "pitch", "roll", "scale", "tx", "ty")
@@ -65,7 +64,7 @@ class ContourFileError(FacemimeError, ValueError):
 
 def load_json(path: str | Path, what: str) -> Any:
     """The JSON document of the ``what`` file at ``path`` (within the input policy's size, see
-    :mod:`facemime.io.limits`)."""
+    :mod:`facemime.limits`)."""
     p = Path(path)
     data = read_json_text(p, what)
     try:
@@ -257,133 +256,3 @@ def read_track(path: str | Path) -> tuple[dict[str, Any], dict[int, Contours]]:
             raise ContourFileError(f"{where}: frame entry {k} must be an object with an integer 'index'")
         out[f["index"]] = _contours(f, f"{where} frame {f['index']}", None, require_all=False)
     return doc.get("video", {}), out
-
-
-def _weights(raw: Any, where: str) -> np.ndarray:
-    """The (E,) weight vector of a frame's ``weights`` object (name -> 0..1, a missing name 0)."""
-    from facemime.animate.expressions import NAMES
-
-    if not isinstance(raw, dict):
-        raise ContourFileError(f"{where}: 'weights' must be an object of expression name -> weight in [0, 1]")
-    unknown = [k for k in raw if k not in NAMES]
-    if unknown:
-        raise ContourFileError(
-            f"{where}: unknown expression weight {unknown[0]!r} in 'weights' (known: {', '.join(NAMES)})"
-        )
-    w = np.zeros(len(NAMES))
-    for k, v in raw.items():
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0.0 <= float(v) <= 1.0:
-            raise ContourFileError(f"{where}: expression weight {k!r} must be a number in [0, 1], got {v!r}")
-        w[NAMES.index(k)] = float(v)
-    return w
-
-
-def _generic_model_block() -> dict[str, Any]:
-    """The ``model`` block of motion made for the generic head (its knots and sizes)."""
-    from facemime.animate.deform import Deformer
-    from facemime.fit.placement import model_iod
-    from facemime.model import generic_head
-
-    head = generic_head()
-    d = Deformer(head)
-    return {
-        "unit": head.unit,
-        "knots": d.knots.tolist(),
-        "feature_sizes": d.feature_sizes().tolist(),
-        "iod": model_iod(head),
-    }
-
-
-def weights_to_motion(weights: np.ndarray, sizes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(knot offsets (K, 2), lid closures (2,)) of expression ``weights`` (E,) on a face whose
-    knots (the generic head's, as every actor fitted from it) have feature ``sizes`` (K,)."""
-    from facemime.animate.expressions import BLINKS, NAMES, generic_unit_patterns
-
-    unit = generic_unit_patterns()
-    if len(sizes) != unit.shape[1]:
-        raise ValueError(
-            f"expression weights need the generic head's {unit.shape[1]} knots, the motion has {len(sizes)}"
-        )
-    offsets = np.tensordot(weights, unit * np.asarray(sizes, np.float64)[None, :, None], axes=([-1], [0]))
-    return offsets, np.array([weights[NAMES.index(n)] for n in BLINKS])
-
-
-def read_motion(path: str | Path) -> tuple[dict[str, Any], dict[str, Any], list[dict[str, Any]]]:
-    """Read the motion of a ``facemime.track/1`` file written by ``facemime run``: (video info,
-    the ``model`` block, frames in order as dicts with ``index``, ``face`` (bool), ``pose``
-    (mapping of the six pose values), ``offsets`` ((K, 2) float64 array), ``look`` (a
-    :class:`facemime.animate.look.Look`; neutral for files written before it, or without one),
-    ``weights`` ((E,) expression weights, or None) and ``lost`` (the features named lost). A frame with
-    ``weights`` and no ``offsets`` gets its offsets from them, and its lid closures unless its ``look`` gives them
-    (:mod:`facemime.animate.expressions`); a file of such frames needs no ``model`` block."""
-    doc = load_document(path, "track", TRACK_FORMAT)
-    where = str(path)
-    model = doc.get("model")
-    frames = doc.get("frames")
-    authored = (
-        isinstance(frames, list)
-        and bool(frames)
-        and all(isinstance(f, dict) and "offsets" not in f and "weights" in f for f in frames)
-    )
-    if model is None and authored:
-        model = _generic_model_block()
-    if (
-        not isinstance(model, dict)
-        or not isinstance(model.get("knots"), list)
-        or not isinstance(model.get("feature_sizes"), list)
-    ):
-        raise ContourFileError(
-            f"{where}: has no head motion ('model' with 'knots' and 'feature_sizes'); write it with facemime run"
-        )
-    if not isinstance(frames, list) or not frames:
-        raise ContourFileError(f"{where}: 'frames' must be a non-empty list")
-    k = len(model["knots"])
-    out = []
-    for n, f in enumerate(frames):
-        pose, offsets = (f.get("pose", {}), f.get("offsets")) if isinstance(f, dict) else ({}, None)
-        weights = None
-        if isinstance(f, dict) and "weights" in f:
-            weights = _weights(f["weights"], f"{where}: frame entry {n}")
-        closure = None
-        if offsets is None and weights is not None:
-            try:
-                offsets, closure = weights_to_motion(weights, np.asarray(model["feature_sizes"], np.float64))
-            except (TypeError, ValueError) as e:
-                raise ContourFileError(f"{where}: frame entry {n}: {e}") from None
-        try:
-            values = {key: float(pose[key]) for key in POSE_KEYS}
-            arr = np.asarray(offsets, dtype=np.float64)
-        except (TypeError, KeyError, ValueError, OverflowError):
-            raise ContourFileError(
-                f"{where}: frame entry {n} needs a 'pose' with {', '.join(POSE_KEYS)} and 'offsets' (or 'weights')"
-            ) from None
-        if arr.shape != (k, 2) or not np.isfinite(arr).all() or np.abs(arr).max(initial=0.0) > MAX_OFFSET:
-            raise ContourFileError(f"{where}: frame entry {n} has malformed 'offsets'")
-        if not pose_in_range(*(values[key] for key in POSE_KEYS)):
-            raise ContourFileError(f"{where}: frame entry {n} has a pose out of range ({values})")
-        try:
-            look = f.get("look", {})
-            if not isinstance(look, dict):
-                raise TypeError
-            if closure is not None:  # the blinks' closures where the look gives none
-                look = {"eye_right_closure": closure[0], "eye_left_closure": closure[1], **look}
-            look = Look.from_dict(look)
-        except (TypeError, ValueError, OverflowError):
-            raise ContourFileError(f"{where}: frame entry {n} has a malformed 'look'") from None
-        if not np.isfinite(look.vector()).all() or np.abs(look.vector()).max() > LOOK_LIMIT:
-            raise ContourFileError(f"{where}: frame entry {n} has a 'look' value beyond ±{LOOK_LIMIT:g}")
-        lost = f.get("lost", [])
-        if not isinstance(lost, list) or not all(isinstance(x, str) for x in lost):
-            raise ContourFileError(f"{where}: frame entry {n}: 'lost' must be a list of feature names")
-        out.append(
-            {
-                "index": f.get("index", n),
-                "face": bool(f.get("face", True)),
-                "pose": values,
-                "offsets": arr,
-                "look": look,
-                "weights": weights,
-                "lost": lost,
-            }
-        )
-    return doc.get("video", {}), model, out

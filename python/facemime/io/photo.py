@@ -8,8 +8,8 @@ import cv2
 import numpy as np
 
 from facemime.errors import InputFileError, InvalidInputError
-from facemime.io.limits import check_image_file
 from facemime.io.video import VideoReader
+from facemime.limits import check_image_file
 
 #: Still-image file types read with OpenCV; anything else is opened as a video.
 IMAGE_TYPES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp")

@@ -2,7 +2,7 @@
 
 ``{"format": "facemime.points/1", "points": {"eye_right_outer": [x, y], ...,
 "mouth_outer_upper": [[x, y], ...], ...}}`` — names and required ones in
-:mod:`facemime.fit.points`; (x, y) pixels, origin at the centre of the top-left pixel, y down.
+:mod:`facemime.types.points`; (x, y) pixels, origin at the centre of the top-left pixel, y down.
 """
 
 from __future__ import annotations
@@ -10,8 +10,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from facemime.errors import InvalidInputError
-from facemime.fit.points import ReferencePoints, check_points
 from facemime.io.contours_json import ContourFileError, load_document
+from facemime.types.points import ReferencePoints, check_points
 
 POINTS_FORMAT = "facemime.points/1"
 

@@ -1,7 +1,7 @@
 """Pictures of a head model: textured and flat-shaded (both by the Rust rasteriser) and
 wireframe views.
 
-Poses and coordinates as in :mod:`facemime.render.projection`.
+Poses and coordinates as in :mod:`facemime.types.pose`.
 """
 
 from __future__ import annotations
@@ -10,9 +10,9 @@ import cv2
 import numpy as np
 
 from facemime.errors import InvalidInputError
-from facemime.model.head import HeadModel
-from facemime.render.projection import Pose, project, rotation_matrix
 from facemime.render.texture_map import render_mesh
+from facemime.types.head import HeadModel
+from facemime.types.pose import Pose, project, rotation_matrix
 
 LIGHT = np.array([0.3, 0.4, 1.0]) / np.linalg.norm([0.3, 0.4, 1.0])  # model-space, towards the light
 

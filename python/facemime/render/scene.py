@@ -33,7 +33,7 @@ import numpy as np
 from facemime.errors import InvalidInputError
 from facemime.render.texture_map import render_mesh_into
 from facemime.shared_constants import BORDER_STEPS, EDGE_MARGIN, RINGS, SLOW
-from facemime.track.motion import apply, robust_similarity
+from facemime.types.similarity import apply, robust_similarity
 
 #: (distance from the face's centre as a multiple of the outline's, share of the head's motion
 #: followed) per ring: the first reaches over the hair and ears and moves with the head; the

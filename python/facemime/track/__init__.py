@@ -3,7 +3,7 @@
 The public entry point is :class:`facemime.track.Tracker`, fed one frame at a time.
 """
 
-from facemime.track.contours import CONTOUR_NAMES, FEATURES
 from facemime.track.tracker import FrameResult, Tracker, TrackerParams
+from facemime.types.contours import CONTOUR_NAMES, FEATURES
 
 __all__ = ["CONTOUR_NAMES", "FEATURES", "FrameResult", "Tracker", "TrackerParams"]

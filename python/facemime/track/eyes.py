@@ -25,11 +25,10 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from facemime.animate.deform import head_plane
-from facemime.model.head import HeadModel
 from facemime.render.bilinear import sample_affine
-from facemime.render.projection import Pose, project
 from facemime.shared_constants import DENSITY, EYES, IRIS_RADIUS, IRIS_U, IRIS_V, SPAN_U, SPAN_V
+from facemime.types.head import HeadModel
+from facemime.types.pose import Pose, head_plane, project
 
 #: How far above the key frame's upper lid, and below its lower lid, the trials are compared.
 REACH_UP = 0.15
@@ -301,7 +300,7 @@ class EyeTracker:
         return EyeState(opening, iris, frames, seen, rest)
 
     def look(self, state: EyeState) -> tuple[np.ndarray, np.ndarray]:
-        """The closure (2,) and iris shift (2, 2) of :class:`facemime.animate.look.Look` for a
+        """The closure (2,) and iris shift (2, 2) of :class:`facemime.types.look.Look` for a
         measured ``state``: relative to the key frame (the iris to where the head's turn carries
         the key frame's), an iris not seen or hidden by its lids (:data:`IRIS_HIDDEN`) held where
         it was last seen."""

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from facemime import _core
+from facemime.types.similarity import as_points
 
 WINDOW = 21  # px: side of the square window matched around each point
 LEVELS = 5  # pyramid levels above the frame at most (fewer on small crops)
@@ -17,11 +18,6 @@ EPSILON = 0.03  # px (of the level): stop once a step is shorter
 #: Refuse a point whose window's smaller gradient-matrix eigenvalue over the window area is
 #: below this ((grey levels / px)²); OpenCV's default ``minEigThreshold`` of 1e-4.
 MIN_EIGEN = 1e-4 * 1024
-
-
-def as_points(points: object) -> np.ndarray:
-    """``points`` as the core takes (x, y) points: a C-contiguous (N, 2) float64 array."""
-    return np.ascontiguousarray(points, np.float64).reshape(-1, 2)
 
 
 class FrameFlow:

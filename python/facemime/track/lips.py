@@ -31,8 +31,8 @@ import cv2
 import numpy as np
 
 from facemime import _core
-from facemime.track.contours import POLARITY
-from facemime.track.flow import as_points
+from facemime.types.contours import POLARITY
+from facemime.types.similarity import as_points
 
 #: Side of the square that grows the outer mouth into the skin ring, as a fraction of the mouth width.
 SKIN_RING = 0.3

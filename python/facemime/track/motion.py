@@ -17,8 +17,9 @@ import cv2
 import numpy as np
 
 from facemime import _core
-from facemime.track.flow import EPSILON, ITERATIONS, LEVELS, MIN_EIGEN, WINDOW, as_points
+from facemime.track.flow import EPSILON, ITERATIONS, LEVELS, MIN_EIGEN, WINDOW
 from facemime.track.match import gray_crop
+from facemime.types.similarity import FIT_ROUNDS, IDENTITY, as_points, compose, robust_similarity
 
 #: Rigid zones in face coordinates (s, t) of the first frame: a point is ``c + s·W·u + t·v``
 #: where ``c`` is the centre of the brows, ``v`` runs from it to the centre of the mouth, ``u`` is
@@ -42,7 +43,6 @@ FB_LIMIT = 1.0  # px: forward-backward error above this rejects a point
 #: 0.0003), and made the tracker about 2.5% faster.
 GUIDED_LEVELS = 2
 MIN_POINTS = 6
-FIT_ROUNDS = 10  # rounds of the robust similarity fit at most
 DETECT_MARGIN = 8  # px around the zones for the corner measure (block 5, Sobel 3)
 QUALITY = 0.01  # a corner's measure is above this fraction of the zones' strongest
 CORNER_BLOCK = 5  # px: side of the square over which the corner measure sums gradients
@@ -69,16 +69,6 @@ def zone_polygons(contours: Mapping[str, np.ndarray]) -> list[np.ndarray]:
     return polys
 
 
-def robust_similarity(
-    src: np.ndarray, dst: np.ndarray, limit: float, rounds: int = FIT_ROUNDS
-) -> tuple[np.ndarray, np.ndarray]:
-    """The 2×3 similarity (rotation, uniform scale, translation) mapping ``src`` (N, 2) onto
-    ``dst`` (N, 2) px despite outliers, and the (N,) inlier mask (residual below ``limit`` px).
-    Iteratively reweighted least squares with Tukey's biweight, started from the median
-    displacement; deterministic (``facemime._core.robust_similarity``)."""
-    return _core.robust_similarity(as_points(src), as_points(dst), float(limit), int(rounds))
-
-
 def brow_similarity(src: Mapping[str, np.ndarray], dst: Mapping[str, np.ndarray]) -> np.ndarray:
     """The 2×3 similarity that best maps the brow contours of ``src`` onto those of ``dst``
     (robust least squares over their points)."""
@@ -86,19 +76,6 @@ def brow_similarity(src: Mapping[str, np.ndarray], dst: Mapping[str, np.ndarray]
     a = np.concatenate([src[n] for n in names])
     b = np.concatenate([dst[n] for n in names])
     return robust_similarity(a, b, limit=1.0)[0]
-
-
-def compose(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """The 2×3 transform ``a ∘ b`` (apply ``b`` first; ``facemime._core.compose``)."""
-    return _core.compose(a, b)
-
-
-def apply(m: np.ndarray, pts: np.ndarray) -> np.ndarray:
-    """Apply a 2×3 transform to (N, 2) points."""
-    return pts @ m[:, :2].T + m[:, 2]
-
-
-IDENTITY = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 
 
 class HeadMotion:

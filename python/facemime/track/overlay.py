@@ -7,7 +7,7 @@ from collections.abc import Iterable, Mapping
 import cv2
 import numpy as np
 
-from facemime.track.contours import FEATURES
+from facemime.types.contours import FEATURES
 
 #: Feature -> RGB colour of its curves.
 COLOURS = {

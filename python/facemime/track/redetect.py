@@ -1,5 +1,5 @@
 """The tracker with re-detection: the snakes track every frame, and the face landmark model
-(:mod:`facemime.face`) puts them right on the rare frames where they went astray.
+(:mod:`facemime.networks`) puts them right on the rare frames where they went astray.
 
 A landmark pass is made
 
@@ -41,17 +41,18 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from facemime.errors import NoFaceError
-from facemime.face.finder import find_face, follow_face
-from facemime.face.mesh import reference_points
 from facemime.metrics import curve_error
-from facemime.track.contours import CONTOUR_NAMES, FEATURES
-from facemime.track.motion import HeadMotion, apply, robust_similarity
+from facemime.networks.finder import find_face, follow_face
+from facemime.networks.mesh import reference_points
+from facemime.track.motion import HeadMotion
 from facemime.track.scale import ScaledMotion
 from facemime.track.tracker import FrameResult, Tracker, TrackerParams
+from facemime.types.contours import CONTOUR_NAMES, FEATURES
+from facemime.types.similarity import apply, robust_similarity
 
 #: Lowest detection score while searching for a face lost from a video that showed one:
 #: MediaPipe's own threshold (a human face was found at the start; see
-#: :data:`facemime.face.finder.FACE_SCORE` for why the start asks for more).
+#: :data:`facemime.networks.finder.FACE_SCORE` for why the start asks for more).
 SEARCH_SCORE = 0.5
 #: A frame whose pixels on a sparse grid (every k-th row and column, k the shorter side / 32)
 #: differ from the previous frame's by more than this many levels on average is a cut.

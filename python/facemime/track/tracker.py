@@ -1,4 +1,4 @@
-"""The contour tracker: the eight mouth and brow curves of ``facemime.track.contours`` as
+"""The contour tracker: the eight mouth and brow curves of ``facemime.types.contours`` as
 STB-snakes over one shared knot array, solved jointly each frame after head-motion
 compensation (docs/method.md §1).
 
@@ -48,11 +48,12 @@ from facemime.errors import InvalidInputError
 from facemime.metrics import resample
 from facemime.track import motion
 from facemime.track.brows import BrowSearch
-from facemime.track.contours import CONTOUR_NAMES, FEATURES, POLARITY
 from facemime.track.field import build_field, regions
 from facemime.track.lips import LipSearch
 from facemime.track.mouth import mouth_shift, relocate
 from facemime.track.scale import FrameScale, ScaledMotion
+from facemime.types import similarity
+from facemime.types.contours import CONTOUR_NAMES, FEATURES, POLARITY
 
 OPERATORS = ("directional", "magnitude")
 #: The mouth gets another solver pass only when a knot moved this fraction of a pass's reach.
@@ -72,7 +73,7 @@ class CurveWeights:
     """Energy weights of a curve (docs/method.md §1): tension α, rigidity β (both against the rest
     shape), temporal smoothness τ, image contrast ρ, temporal brightness γ, and the weights of
     the luma and colour (red − green) derivatives in H (their signs come from the edge's
-    polarity, :data:`facemime.track.contours.POLARITY`)."""
+    polarity, :data:`facemime.types.contours.POLARITY`)."""
 
     alpha: float
     beta: float
@@ -503,12 +504,12 @@ class Tracker:
         frame = self._scale.frame(frame)
         p = self.params
         self.frame_index += 1
-        step, ok, flow = motion.IDENTITY, True, None
+        step, ok, flow = similarity.IDENTITY, True, None
         if self._motion is not None:
             step, ok, flow = self._motion.update(
                 frame, self._reported.take(self._brow_knots, axis=0), self._knots if p.knot_flow else None
             )
-        total = self._motion.total if self._motion is not None else motion.IDENTITY
+        total = self._motion.total if self._motion is not None else similarity.IDENTITY
         # Where the flow followed a knot, else where the head's step carries it; the head's
         # scale, and the mouth's downward normal turned with the head.
         start, followed, mouth_unfollowed, scale, down = self._plan.begin(step, total, self._knots, flow)
@@ -679,7 +680,7 @@ class Tracker:
         at least :data:`AGREE` × ``reach`` px (in place; the mouth's motion up and down, an
         opening, is the lip searches' to follow)."""
         mouth = self._mouth_knots
-        shift = mouth_shift(self._prev, frame, self._knots[mouth], motion.apply(step, self._knots[mouth]))
+        shift = mouth_shift(self._prev, frame, self._knots[mouth], similarity.apply(step, self._knots[mouth]))
         if shift is None:
             return
         along = np.array([down[1], -down[0]])
@@ -746,7 +747,7 @@ class Tracker:
         replaces the mouth knots (in place) only when it is no longer lost: confidences at least
         ``lost_response``, shapes sound against the rest knots ``carried``. Returns then the
         mouth features' confidences, else None; and the solver's iterations."""
-        expected = motion.apply(motion.brow_similarity(self._named(self._knots0), self._named(knots)), self._knots0)
+        expected = similarity.apply(motion.brow_similarity(self._named(self._knots0), self._named(knots)), self._knots0)
         upper, lower = self._index["mouth_outer_upper"], self._index["mouth_outer_lower"]
         outer = lambda k: np.concatenate([k[upper], k[lower][::-1]])  # noqa: E731
         polygon = outer(expected)

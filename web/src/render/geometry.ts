@@ -2,7 +2,7 @@
  * The head's geometry, as the Python synthesis computes it: knot offsets spread to every vertex
  * (facemime.animate.deform), lips sealed, lids closed (facemime.animate.eyes.close_lids), the
  * pose shown (facemime.animate.synth.Puppet.pose) and the orthographic projection
- * (facemime.render.projection).
+ * (facemime.types.pose).
  *
  * Model space: x to the subject's left, y up, z towards the camera (model units, millimetres for
  * the built-in head). Image: pixels, x right, y down, (0, 0) the centre of the top-left pixel.
@@ -49,7 +49,7 @@ export function project(vertices: Float64Array, pose: Pose): { points: Float64Ar
   return { points, depth };
 }
 
-/** Distance between the outer eye corners, model units (facemime.fit.placement.model_iod). */
+/** Distance between the outer eye corners, model units (facemime.types.head.model_iod). */
 export function modelIod(m: Model): number {
   const a = m.groups.eye_right[0], b = m.groups.eye_left[4];
   return Math.hypot(m.vertices[3 * a] - m.vertices[3 * b], m.vertices[3 * a + 1] - m.vertices[3 * b + 1]);

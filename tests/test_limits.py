@@ -8,8 +8,9 @@ import pytest
 
 from facemime.cli.main import main
 from facemime.errors import InvalidInputError, ModelFormatError
-from facemime.model import generic_head, load_head, load_wfm
-from facemime.model.head import head_document, head_from_document
+from facemime.head import generic_head
+from facemime.io.head_file import head_document, head_from_document, load_head
+from facemime.io.wfm import load_wfm
 
 
 def grid_wfm(path, side):

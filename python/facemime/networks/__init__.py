@@ -2,10 +2,10 @@
 model (shipped in ``models/``, run by OpenCV's ``cv2.dnn``): the automatic start of fitting and
 tracking, and the tracker's re-detection."""
 
-from facemime.face.detector import Detection, detect_faces
-from facemime.face.finder import FACE_SCORE, Face, find_face, follow_face
-from facemime.face.landmarks import Crop, crop_from_detection, crop_from_landmarks, landmark_pass
-from facemime.face.mesh import FACE_OVAL, POINT_INDICES, reference_points
+from facemime.networks.detector import Detection, detect_faces
+from facemime.networks.finder import FACE_SCORE, Face, find_face, follow_face
+from facemime.networks.landmarks import Crop, crop_from_detection, crop_from_landmarks, landmark_pass
+from facemime.networks.mesh import FACE_OVAL, POINT_INDICES, reference_points
 
 __all__ = [
     "FACE_OVAL",

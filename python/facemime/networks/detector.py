@@ -18,7 +18,7 @@ from functools import cache
 import cv2
 import numpy as np
 
-from facemime.face.network import load_network
+from facemime.networks.network import load_network
 
 #: Side of the detector's square input, pixels.
 INPUT = 128

@@ -1,7 +1,7 @@
 """Finding a human face and its landmarks in an image: detection, then two landmark passes.
 
 The largest detected face is taken. Its landmarks are measured on the detection's crop, then
-again on the crop those landmarks frame (:func:`facemime.face.landmarks.crop_from_landmarks`),
+again on the crop those landmarks frame (:func:`facemime.networks.landmarks.crop_from_landmarks`),
 and the two passes are averaged: on the ten shared videos' first frames and the seven shared
 photos, the mean of the two was closer to the reference than either pass alone or a third pass
 (mean NME of the eye corners / outer lips / inner lips / brows 0.0165 / 0.0115 / 0.0104 / 0.0116
@@ -18,8 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from facemime.errors import NoFaceError
-from facemime.face.detector import Detection, detect_faces
-from facemime.face.landmarks import MIN_FACE_SCORE, crop_from_detection, crop_from_landmarks, landmark_pass
+from facemime.networks.detector import Detection, detect_faces
+from facemime.networks.landmarks import MIN_FACE_SCORE, crop_from_detection, crop_from_landmarks, landmark_pass
 
 #: Lowest detection score of a human face. MediaPipe keeps detections from 0.5, which takes the
 #: shared photos of a monkey (0.78) and a dog (0.75) for faces (the landmark model then scores

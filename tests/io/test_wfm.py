@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from facemime.errors import InputFileError, ModelFormatError
-from facemime.model import load_wfm
+from facemime.io.wfm import load_wfm
 
 
 def test_candide3_loads_completely(candide_path):

@@ -14,8 +14,8 @@ from collections.abc import Mapping
 import numpy as np
 
 from facemime.errors import InvalidInputError
-from facemime.model.head import HeadModel
-from facemime.track.contours import CONTOUR_NAMES
+from facemime.types.contours import CONTOUR_NAMES
+from facemime.types.head import HeadModel
 
 #: Single points -> (model group, position in the group).
 POINTS = {

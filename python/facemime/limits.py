@@ -10,7 +10,7 @@ variable (a whole number):
 - ``FACEMIME_MAX_VERTICES`` (200,000), ``FACEMIME_MAX_TRIANGLES`` (400,000),
   ``FACEMIME_MAX_MODEL_BYTES`` (256 MiB) and ``FACEMIME_MAX_UNIT_VALUES`` (20,000,000:
   deformation units × vertices): a head model (``.json``, ``.wfm``, the model inside an actor),
-  checked as its counts are read (:mod:`facemime.model.head`).
+  checked as its counts are read (:mod:`facemime.io.head_file`).
 
 Head poses read from a file (an actor's, a track's frames, a stream's starting pose) must lie within
 :func:`pose_in_range`'s fixed bounds, far beyond any real picture's.

@@ -7,7 +7,7 @@ import cv2
 import numpy as np
 
 from facemime.errors import InvalidInputError
-from facemime.model.head import HeadModel
+from facemime.types.head import HeadModel
 
 SKIN = (224, 172, 142)
 BROW = (78, 52, 38)
@@ -22,7 +22,7 @@ LASHES = (40, 28, 26)
 def painted_texture(model: HeadModel, size: int = 512) -> np.ndarray:
     """A (size, size, 3) uint8 RGB texture painted at ``model.uv`` from its vertex groups.
 
-    >>> from facemime.model import generic_head
+    >>> from facemime.head import generic_head
     >>> painted_texture(generic_head(), 64).shape
     (64, 64, 3)
     """

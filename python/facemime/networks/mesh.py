@@ -1,7 +1,7 @@
 """Which of the Face Mesh's 468 landmarks mark facemime's reference points and contours.
 
 The index lists of the eight contours are those of the shared data's README
-(:data:`facemime.track.contours.FACE_MESH_INDICES`); the eye corners, nose tip and chin follow
+(:data:`facemime.types.contours.FACE_MESH_INDICES`); the eye corners, nose tip and chin follow
 the same numbering, and the face outline is the Face Mesh's face oval, clockwise on screen from
 the top of the forehead like the model's ``face_outline``.
 """
@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from facemime.track.contours import from_face_mesh
+from facemime.types.contours import from_face_mesh
 
 #: Single reference points -> Face Mesh index.
 POINT_INDICES = {
@@ -68,7 +68,7 @@ FACE_OVAL = (
 
 
 def reference_points(landmarks: np.ndarray) -> dict[str, np.ndarray]:
-    """facemime's reference points (:mod:`facemime.fit.points`) from one face's Face Mesh
+    """facemime's reference points (:mod:`facemime.types.points`) from one face's Face Mesh
     landmarks, a (468 or 478, 2+) array in pixels: name -> (K, 2) float64 pixels.
 
     >>> points = reference_points(np.arange(478 * 2, dtype=float).reshape(478, 2))

@@ -6,12 +6,12 @@ import cv2
 import numpy as np
 import pytest
 
-from facemime.face import Crop, crop_from_detection, crop_from_landmarks, find_face, landmark_pass
-from facemime.face.mesh import POINT_INDICES, reference_points
-from facemime.fit.points import GROUPS
 from facemime.io.photo import read_photo
 from facemime.io.video import VideoReader
 from facemime.metrics import curve_error
+from facemime.networks import Crop, crop_from_detection, crop_from_landmarks, find_face, landmark_pass
+from facemime.networks.mesh import POINT_INDICES, reference_points
+from facemime.types.points import GROUPS
 
 
 def group_nmes(points, reference, iod):

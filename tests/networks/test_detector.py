@@ -4,8 +4,8 @@ network outputs, the search windows, and the shipped model on real photos."""
 import numpy as np
 import pytest
 
-from facemime.face.detector import INPUT, Detection, anchors, decode, detect_faces, suppress, windows
 from facemime.io.photo import read_photo
+from facemime.networks.detector import INPUT, Detection, anchors, decode, detect_faces, suppress, windows
 
 
 def test_anchors_are_the_two_grids_of_the_short_range_model():

@@ -1,4 +1,4 @@
-"""The face models shipped with facemime (``facemime/face/models``, see its README for their
+"""The face models shipped with facemime (``facemime/networks/models``, see its README for their
 origin, licence and checksums), loaded by OpenCV's ``cv2.dnn`` once per thread: a network holds
 its input and its layers' buffers, so two threads running one network at once corrupt each
 other's pass (OpenCV 5.1 stops with an assertion about a buffer's shape)."""
@@ -31,7 +31,7 @@ def _read(name: str) -> cv2.dnn.Net:
     """Load the shipped model ``name``; a :class:`FacemimeError` in one line where it cannot be."""
     if name not in MODELS:
         raise FacemimeError(f"unknown face model {name!r}; shipped: {', '.join(MODELS)}")
-    with resources.as_file(resources.files("facemime.face") / "models" / name) as path:
+    with resources.as_file(resources.files("facemime.networks") / "models" / name) as path:
         if not path.is_file():
             raise FacemimeError(f"the face model {name} is missing from the installed package; reinstall facemime")
         try:

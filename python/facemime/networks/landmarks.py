@@ -2,7 +2,7 @@
 input), run by OpenCV's ``cv2.dnn``.
 
 The model sees a square crop of the face, turned so that the eyes are level. The first crop
-comes from a detection (:mod:`facemime.face.detector`: its box grown 1.5 times, turned by its
+comes from a detection (:mod:`facemime.networks.detector`: its box grown 1.5 times, turned by its
 eye keypoints, as MediaPipe does); the next from the landmarks themselves (their extent along
 and across the line of the outer eye corners, grown 1.5 times), which frames the face the way
 the model was trained on.
@@ -19,8 +19,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from facemime.face.detector import Detection
-from facemime.face.network import load_network
+from facemime.networks.detector import Detection
+from facemime.networks.network import load_network
 
 #: Side of the landmark model's square input, pixels.
 INPUT = 192

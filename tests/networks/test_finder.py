@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from facemime.errors import FacemimeError, NoFaceError
-from facemime.face import find_face
-from facemime.face.network import MODELS, load_network
 from facemime.io.photo import read_photo
+from facemime.networks import find_face
+from facemime.networks.network import MODELS, load_network
 
 
 @pytest.mark.parametrize("name", ["lp_s22", "lp_s25", "lp_s39"])  # a monkey, a dog, a cat
@@ -57,7 +57,7 @@ def test_the_shipped_models_are_the_files_their_readme_names():
     import re
     from importlib import resources
 
-    folder = resources.files("facemime.face") / "models"
+    folder = resources.files("facemime.networks") / "models"
     rows = re.findall(r"\| `([\w.]+\.tflite)` \| (\d+) \| `([0-9a-f]{64})` \|", (folder / "README.md").read_text())
     assert sorted(name for name, _, _ in rows) == sorted(MODELS)
     for name, size, digest in rows:

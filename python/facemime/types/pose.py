@@ -96,3 +96,16 @@ def project(vertices: np.ndarray, pose: Pose) -> tuple[np.ndarray, np.ndarray]:
     points[:, 0] = pose.tx + pose.scale * rotated[:, 0]
     points[:, 1] = pose.ty - pose.scale * rotated[:, 1]
     return points, pose.scale * rotated[:, 2]
+
+
+def head_plane(points: np.ndarray, depth: np.ndarray, pose: Pose) -> np.ndarray:
+    """Model-space (x, y) of image ``points`` (K, 2) px seen in ``pose``, each at its model
+    depth ``depth`` (K,): the inverse of the orthographic projection for points of known z."""
+    r = rotation_matrix(pose.yaw, pose.pitch, pose.roll)
+    # (u - tx - s·r02·z, v - ty + s·r12·z) = s·[[r00, r01], [-r10, -r11]] (x, y), inverted.
+    det = pose.scale * (r[1, 0] * r[0, 1] - r[0, 0] * r[1, 1])
+    inverse = np.array([[-r[1, 1], -r[0, 1]], [r[1, 0], r[0, 0]]]) / det
+    rhs = np.column_stack(
+        [points[:, 0] - pose.tx - pose.scale * r[0, 2] * depth, points[:, 1] - pose.ty + pose.scale * r[1, 2] * depth]
+    )
+    return rhs @ inverse.T

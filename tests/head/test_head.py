@@ -5,9 +5,10 @@ import numpy as np
 import pytest
 
 from facemime.errors import InputFileError, ModelFormatError
-from facemime.model import REQUIRED_GROUPS, generic_head, load_head
-from facemime.model.head import HEAD_FORMAT
+from facemime.head import generic_head
+from facemime.io.head_file import HEAD_FORMAT, load_head
 from facemime.shared_constants import CONTOUR_GROUPS
+from facemime.types.head import REQUIRED_GROUPS
 
 SNAKE_KNOTS = {
     "mouth_outer_upper": 11,
@@ -92,7 +93,7 @@ def test_unknown_unit_is_named(head):
 def model_doc():
     from importlib import resources
 
-    return json.loads(resources.files("facemime.model").joinpath("data/generic_head.json").read_text())
+    return json.loads(resources.files("facemime.head").joinpath("data/generic_head.json").read_text())
 
 
 @pytest.mark.parametrize(

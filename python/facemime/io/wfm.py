@@ -13,7 +13,7 @@ facemime's outward, counter-clockwise winding. The unit stays CANDIDE's own (abo
 the face height).
 
 Models over the input limits (vertices, triangles, file bytes; ``FACEMIME_MAX_VERTICES``,
-``FACEMIME_MAX_TRIANGLES``, ``FACEMIME_MAX_MODEL_BYTES``, see :mod:`facemime.model.head`) are
+``FACEMIME_MAX_TRIANGLES``, ``FACEMIME_MAX_MODEL_BYTES``, see :mod:`facemime.io.head_file`) are
 refused: a too-large file before it is read, a too-large vertex or face count as soon as its
 count line is read, before the rest of the file is split into lines.
 """
@@ -23,11 +23,13 @@ from __future__ import annotations
 import io
 import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from facemime.errors import InvalidInputError, ModelFormatError
-from facemime.model.head import HeadModel, check_model_count, read_model_file
+from facemime.io.head_file import check_model_count, read_model_file
+from facemime.types.head import HeadModel
 
 _SECTIONS = (
     "VERTEX LIST",
@@ -58,7 +60,7 @@ class _Lines:
         self.pos += 1
         return self.lines[self.pos - 1][1]
 
-    def numbers(self, count: int, kind: type) -> list:
+    def numbers(self, count: int, kind: type) -> list[Any]:
         parts = self.next().split()
         try:
             if len(parts) != count:
@@ -93,7 +95,7 @@ class _Lines:
         return np.array([self.numbers(columns, kind) for _ in range(rows)], dtype=dtype).reshape(-1, columns)
 
     def count(self) -> int:
-        (n,) = self.numbers(1, int)
+        n = int(self.numbers(1, int)[0])
         if n < 0:
             raise self.fail(f"negative count {n}")
         return n
