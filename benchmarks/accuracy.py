@@ -46,7 +46,7 @@ import numpy as np
 from facemime.io.video import VideoReader
 from facemime.metrics import group_nme, pooled_summary, resample, summarize
 from facemime.networks.finder import follow_face
-from facemime.track import TrackerParams
+from facemime.track.params import TrackerParams
 from facemime.track.redetect import FaceTracker, Redetection
 from facemime.types.contours import CONTOUR_NAMES, GROUPS, from_face_mesh
 

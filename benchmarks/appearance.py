@@ -36,7 +36,7 @@ import classic_codecs
 from facemime.animate.deform import Deformer
 from facemime.animate.synth import Puppet
 from facemime.codec.appearance import Appearance
-from facemime.codec.files import analyse, encode_clip, with_appearance
+from facemime.codec.clip import analyse, encode_clip, with_appearance
 from facemime.codec.stream import MotionDecoder, Settings
 from facemime.io.video import VideoReader
 from facemime.types.head import model_iod

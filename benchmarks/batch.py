@@ -4,7 +4,7 @@ and (``--simulate``) the Dask scheduler's overhead per task, from many small syn
     python benchmarks/batch.py [--rounds 2]            # speed-up, 1 vs 2 workers, same run
     python benchmarks/batch.py --simulate [--tasks 2000 --task-ms 5 --per-frame-ms 4.6]
 
-Speed-up: ``facemime track``'s work (:func:`facemime.batch.run_batch`, ``what="track"``) on the
+Speed-up: ``facemime track``'s work (:func:`facemime.app.batch.run_batch`, ``what="track"``) on the
 ten shared videos, on a local cluster of 1 then 2 single-threaded workers (started and warmed up
 before the clock starts: the cluster's start is a fixed cost, not the per-video rate), rounds
 alternating; reported as frames/s and the ratio of the medians. Beside it: the CPU time of
@@ -51,8 +51,7 @@ def warm(client) -> None:
     """Import the tracker in every worker (as the first task would) before timing."""
 
     def load() -> None:
-        import facemime.batch.worker
-        import facemime.track.video  # noqa: F401
+        pass
 
     client.run(load)
 
@@ -72,7 +71,7 @@ def batch_once(videos: list[Path], workers: int) -> tuple[float, int, float]:
     warmed-up cluster."""
     from distributed import Client
 
-    from facemime.batch import run_batch
+    from facemime.app.batch import run_batch
 
     with tempfile.TemporaryDirectory() as tmp, cluster(workers) as c, Client(c) as client:
         warm(client)

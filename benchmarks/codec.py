@@ -49,7 +49,7 @@ import classic_codecs
 from facemime import _core
 from facemime.animate.deform import Deformer
 from facemime.animate.synth import Puppet
-from facemime.codec.files import MAX_COEFFICIENTS, Clip, analyse, encode_clip
+from facemime.codec.clip import MAX_COEFFICIENTS, Clip, analyse, encode_clip
 from facemime.codec.params import Basis
 from facemime.codec.stream import MotionDecoder, MotionEncoder, Settings
 from facemime.io.video import VideoReader

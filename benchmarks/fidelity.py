@@ -44,7 +44,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from facemime.animate.analysis import Analysis
 from facemime.animate.synth import Puppet
-from facemime.codec.files import Clip, encode_clip
+from facemime.codec.clip import Clip, encode_clip
 from facemime.codec.stream import Settings
 from facemime.io.video import VideoReader
 from facemime.types.head import model_iod

@@ -17,10 +17,11 @@ import cv2
 import numpy as np
 
 from facemime.errors import FacemimeError, NoFaceError
-from facemime.fit.placement import frontal_pose
+from facemime.fit.adjust import frontal_pose
 from facemime.head.generic import generic_head
-from facemime.track.match import locate
-from facemime.track.tracker import Tracker, TrackerParams
+from facemime.track.params import TrackerParams
+from facemime.track.template import locate
+from facemime.track.tracker import Tracker
 from facemime.types.contours import CONTOUR_NAMES
 from facemime.types.head import HeadModel, model_eye_centres, model_iod
 from facemime.types.points import GROUPS, ReferencePoints, model_chain

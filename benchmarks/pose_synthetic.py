@@ -36,7 +36,7 @@ import numpy as np
 from facemime.animate.analysis import Analysis
 from facemime.animate.deform import Deformer
 from facemime.animate.synth import key_frame, scene_mesh, synthesize
-from facemime.fit.run import fit_actor
+from facemime.fit.actor import fit_actor
 from facemime.io.photo import read_photo
 from facemime.types.contours import CONTOUR_NAMES
 

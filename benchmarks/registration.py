@@ -34,9 +34,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from facemime.animate.synth import key_frame, scene_mesh
-from facemime.fit.run import fit_actor
+from facemime.fit.actor import fit_actor
 from facemime.io.video import VideoReader
-from facemime.render.texture_map import render_mesh_into
+from facemime.render.raster import render_mesh_into
 from facemime.types.pose import project
 from receiver import luma, masks, psnr, video_arguments
 from receiver import measure as decode_scores

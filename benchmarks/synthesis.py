@@ -55,10 +55,10 @@ import numpy as np
 
 from facemime.animate.analysis import Analysis
 from facemime.animate.departure import DEPARTS_AT, departure
-from facemime.animate.run import SideBySide, run_video
 from facemime.animate.synth import Puppet, key_frame, synthesize
+from facemime.app.run import SideBySide, run_video
 from facemime.io.video import VideoReader
-from facemime.render.texture_map import render_mesh_into
+from facemime.render.raster import render_mesh_into
 from facemime.types.contours import from_face_mesh
 from facemime.types.head import model_iod
 from facemime.types.pose import project

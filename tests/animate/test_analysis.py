@@ -4,8 +4,8 @@ import numpy as np
 
 from facemime.animate.analysis import Analysis
 from facemime.animate.synth import key_frame, scene_mesh, synthesize
-from facemime.demo import SIZE, astronaut_photo
-from facemime.fit.run import fit_actor
+from facemime.app.demo import SIZE, astronaut_photo
+from facemime.fit.actor import fit_actor
 from facemime.io.video import VideoReader
 from facemime.metrics import group_nme
 from facemime.types.contours import GROUPS, from_face_mesh

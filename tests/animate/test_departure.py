@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from facemime.animate.departure import DEPARTS_AT, FACE_GROWTH, departure
-from facemime.animate.run import SideBySide
+from facemime.app.run import SideBySide
 from facemime.io.video import VideoReader
 
 SIZE = (320, 240)

@@ -15,7 +15,7 @@ from facemime.animate.landmark_pose import (
     camera_points,
     procrustes,
 )
-from facemime.fit.placement import fit_model
+from facemime.fit.adjust import fit_model
 from facemime.head import generic_head
 from facemime.io.video import VideoReader
 from facemime.networks.finder import find_face, follow_face

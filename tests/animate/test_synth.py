@@ -163,7 +163,7 @@ def test_another_actor_plays_in_its_own_picture_moved_as_the_source_moves(actor,
     import cv2
 
     from facemime.fit.actor import smear_texture
-    from facemime.fit.placement import fit_model
+    from facemime.fit.adjust import fit_model
     from facemime.shared_constants import BACKGROUND
 
     frame, points, _ = lp_d0

@@ -11,9 +11,8 @@ from pathlib import Path
 import cloudpickle
 import pytest
 
-from facemime.batch import run_batch
+from facemime.app.batch import default_task, run_batch
 from facemime.batch.manifest import Manifest
-from facemime.batch.worker import default_task
 
 # The tasks below go to the workers by value (the workers cannot import this module).
 cloudpickle.register_pickle_by_value(sys.modules[__name__])

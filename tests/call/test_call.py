@@ -19,7 +19,7 @@ from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
 from cli.test_cli import run
-from facemime.call import Call
+from facemime.app.call import Call
 from facemime.call.sender import FileSource, Sender
 from facemime.call.server import MAX_MESSAGE
 from facemime.codec.stream import MotionDecoder

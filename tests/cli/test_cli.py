@@ -28,7 +28,7 @@ def run(capsys, *args):
 
 
 def test_demo_fits_animates_tracks_back_and_resynthesises(tmp_path, capsys):
-    from facemime.demo import FILES
+    from facemime.app.demo import FILES
 
     code, out, err = run(capsys, "demo", "--out", str(tmp_path / "d"))
     assert code == 0, err

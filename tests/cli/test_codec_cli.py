@@ -65,7 +65,7 @@ def test_encode_reports_the_motions_rate_and_the_actors_bytes(clip, tmp_path, ca
 
 
 def test_a_stream_naming_its_actor_decodes_only_with_that_actor(clip, shared, tmp_path, capsys):
-    from facemime.codec.files import analyse
+    from facemime.codec.clip import analyse
 
     own, other = tmp_path / "own.actor", tmp_path / "other.actor"
     save_actor(own, analyse(clip).actor)

@@ -291,13 +291,13 @@ def test_sigterm_stops_a_run_and_leaves_nothing(shared, tmp_path, command):
 
 
 def test_a_failed_demo_leaves_no_folder_it_made(tmp_path, capsys, monkeypatch):
-    import facemime.demo
+    import facemime.app.demo
     from facemime.errors import InvalidInputError
 
     def fail(*args, **kwargs):
         raise InvalidInputError("stopped on purpose")
 
-    monkeypatch.setattr(facemime.demo, "Analysis", fail)
+    monkeypatch.setattr(facemime.app.demo, "analysed", fail)
     one_line_error(*run(capsys, "demo", "--out", str(tmp_path / "d")), "stopped on purpose")
     assert listing(tmp_path) == []
     (tmp_path / "kept").mkdir()

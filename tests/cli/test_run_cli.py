@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from facemime.animate.motion_file import read_motion
-from facemime.animate.run import SideBySide
+from facemime.app.run import SideBySide
 from facemime.errors import InputFileError
 from facemime.io.video import VideoReader, VideoWriter
 from facemime.metrics import group_nme

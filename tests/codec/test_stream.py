@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from facemime import _core
-from facemime.codec.files import analyse, encode_clip
+from facemime.codec.clip import analyse, encode_clip
 from facemime.codec.params import LOOK_KINDS, Basis, pose_vector, topology_id
 from facemime.codec.stream import LOOK_STEPS, MotionDecoder, MotionEncoder, Settings, StreamError
 from facemime.errors import InvalidInputError

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from facemime.animate.deform import Deformer
-from facemime.export import export_track
+from facemime.app.export import export_track
 from facemime.head import generic_head
 from facemime.types.head import model_iod
 from facemime.types.pose import Pose
@@ -79,7 +79,7 @@ def generic_export(tmp_path_factory) -> tuple[Path, Path]:
 def real_export(shared, actor, tmp_path_factory) -> tuple[Path, Path, Path]:
     """(track, .actor, .glb): ``facemime run`` on lp_d0's first 12 frames, exported on the actor
     fitted on its first frame."""
-    from facemime.animate.run import run_video
+    from facemime.app.run import run_video
     from facemime.io.actor_file import save_actor
     from facemime.io.video import VideoWriter
 

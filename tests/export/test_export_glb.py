@@ -11,7 +11,8 @@ import pytest
 
 from cli.test_cli import run
 from facemime.animate.expressions import Expressions
-from facemime.export import export_track, load_performance
+from facemime.app.export import export_track
+from facemime.export import load_performance
 from facemime.export.animation import node_keys
 from facemime.fit.actor import generic_actor
 from facemime.io.actor_file import load_actor

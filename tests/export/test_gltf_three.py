@@ -25,7 +25,7 @@ from facemime.animate.motion_file import read_motion
 from facemime.animate.synth import Puppet, synthesize
 from facemime.export import glb_bytes, load_performance
 from facemime.io.actor_file import load_actor
-from facemime.render.texture_map import coverage
+from facemime.render.raster import coverage
 from facemime.shared_constants import BACKGROUND
 from facemime.types.pose import Pose, project
 

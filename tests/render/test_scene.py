@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from facemime.errors import InvalidInputError
+from facemime.render.raster import coverage
 from facemime.render.scene import SceneMesh
-from facemime.render.texture_map import coverage
 from facemime.shared_constants import BORDER_STEPS, EDGE_MARGIN, RINGS
 
 #: (picture size, centre of the face outline, its half-axes): a landscape picture with the face in

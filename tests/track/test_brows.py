@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 
 from facemime.metrics import curve_error, group_nme
-from facemime.track import CONTOUR_NAMES, Tracker, TrackerParams
+from facemime.track import CONTOUR_NAMES, Tracker
 from facemime.track.brows import BrowSearch
+from facemime.track.params import TrackerParams
 from facemime.track.synthetic import SKIN, band_face
 from facemime.types.contours import GROUPS
 

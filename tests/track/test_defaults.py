@@ -6,9 +6,8 @@ default updates this table, with the measurement that justified it."""
 
 import dataclasses
 
-from facemime.track import TrackerParams
-from facemime.track import tracker as tracker_module
-from facemime.track.tracker import CurveWeights
+from facemime.track import params as params_module
+from facemime.track.params import CurveWeights, TrackerParams
 
 DEFAULTS = {
     "mouth": CurveWeights(alpha=30.0, beta=24.0, tau=2.0, rho=1.0, gamma=0.0, luma=1.0, chroma=0.5),
@@ -54,9 +53,9 @@ def test_every_default_setting_is_the_tuned_one():
 
 
 def test_the_gates_the_defaults_were_tuned_with():
-    # The solver's extra-pass gate and the mouth patch's reach gate (TrackerParams's docstring).
-    assert tracker_module.FAST == 0.6
-    assert tracker_module.AGREE == 1.0
+    # The solver's extra-pass gate and the mouth patch's reach gate (docs/tracker.md, the settings).
+    assert params_module.FAST == 0.6
+    assert params_module.AGREE == 1.0
 
 
 def test_with_changes_one_setting_and_keeps_the_rest():

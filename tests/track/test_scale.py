@@ -6,7 +6,8 @@ import pytest
 
 from facemime.io.video import VideoReader
 from facemime.metrics import group_nme
-from facemime.track import Tracker, TrackerParams
+from facemime.track import Tracker
+from facemime.track.params import TrackerParams
 from facemime.track.scale import FrameScale
 from facemime.types.contours import GROUPS, from_face_mesh
 

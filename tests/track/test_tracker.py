@@ -5,7 +5,8 @@ import pytest
 
 from facemime.errors import InvalidInputError
 from facemime.metrics import curve_error, group_nme
-from facemime.track import CONTOUR_NAMES, FEATURES, Tracker, TrackerParams
+from facemime.track import CONTOUR_NAMES, FEATURES, Tracker
+from facemime.track.params import TrackerParams
 from facemime.track.synthetic import band_face
 from facemime.types.contours import GROUPS
 

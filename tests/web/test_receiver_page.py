@@ -10,8 +10,8 @@ import pytest
 
 from facemime.animate.deform import Deformer
 from facemime.animate.synth import Puppet
+from facemime.app.coding import encode_video
 from facemime.codec.appearance import Appearance
-from facemime.codec.files import encode_video
 from facemime.codec.params import look_from_extras, pose_from_vector
 from facemime.codec.stream import MotionDecoder, Settings
 from facemime.shared_constants import NO_FACE_DIM

@@ -25,8 +25,7 @@ import pytest
 
 from facemime.animate.eyes import LookPainter
 from facemime.fit import fit_model
-from facemime.fit.actor import generic_actor, smear_texture
-from facemime.fit.run import fit_actor
+from facemime.fit.actor import fit_actor, generic_actor, smear_texture
 from facemime.head import generic_head
 from facemime.io.video import VideoReader
 from facemime.networks.mesh import reference_points

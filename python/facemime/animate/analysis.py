@@ -23,6 +23,7 @@ again by a fit of the actor on the frame at most once in :data:`ANCHOR_EVERY` fr
 from __future__ import annotations
 
 import time
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -32,13 +33,13 @@ from facemime.animate.deform import Deformer
 from facemime.animate.landmark_pose import LandmarkPose, PoseFilter
 from facemime.animate.pose import PoseTracker
 from facemime.errors import NoFaceError
-from facemime.fit.placement import fit_model
-from facemime.fit.run import find_points, fit_actor, init_contours
+from facemime.fit.actor import find_points, fit_actor, init_contours
+from facemime.fit.adjust import fit_model
 from facemime.networks.finder import follow_face
 from facemime.networks.mesh import reference_points
 from facemime.track.eyes import EyeTracker
+from facemime.track.params import TrackerParams
 from facemime.track.redetect import FaceTracker
-from facemime.track.tracker import TrackerParams
 from facemime.types.actor import Actor
 from facemime.types.contours import FEATURES
 from facemime.types.head import model_iod
@@ -228,3 +229,20 @@ def start_analysis(frame: np.ndarray, video: str, **options: Any) -> Analysis:
         return Analysis(frame, f"the first frame of {video}", **options)
     except NoFaceError as e:
         raise NoFaceError(f"{e}; the video must start with a frontal face") from None
+
+
+def analysed(
+    frames: Iterable[np.ndarray], video: str, **options: Any
+) -> Iterator[tuple[np.ndarray, Analysis, FrameMotion]]:
+    """Each of ``frames`` (RGB, (H, W, 3) uint8) with the video's :class:`Analysis` and that
+    frame's :class:`FrameMotion`: the first frame starts the analysis (:func:`start_analysis`:
+    its one message for a first frame without a face), each later one updates it, re-detecting
+    a face that was lost. ``video`` names the video in messages; ``options`` are
+    :class:`Analysis`'s. The analysis is the same object on every frame."""
+    analysis = None
+    for frame in frames:
+        if analysis is None:
+            analysis = start_analysis(frame, video, **options)
+            yield frame, analysis, analysis.last
+        else:
+            yield frame, analysis, analysis.update(frame)

@@ -17,8 +17,8 @@ import numpy as np
 from facemime.animate.deform import Deformer, mouth_width
 from facemime.animate.eyes import LookPainter
 from facemime.errors import InvalidInputError
+from facemime.render.raster import fill, render_mesh_into
 from facemime.render.scene import SceneMesh
-from facemime.render.texture_map import fill, render_mesh_into
 from facemime.shared_constants import (
     BACKGROUND,
     CAVITY,

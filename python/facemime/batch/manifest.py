@@ -94,7 +94,7 @@ def _check_video(path: Path, frames: int) -> None:
 def _summarise_stream(path: Path) -> dict[str, Any]:
     """Frames and frames with a lost feature of a ``.fmstream`` decoded to its end (the motion
     only: nothing is drawn)."""
-    from facemime.codec.files import read_stream
+    from facemime.codec.clip import read_stream
     from facemime.codec.stream import MotionDecoder
 
     decoder = MotionDecoder(name=str(path))

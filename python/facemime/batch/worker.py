@@ -62,23 +62,6 @@ def pin_threads() -> None:
     threadpool_limits(1)
 
 
-def default_task(video: Path, results: list[Path], what: str) -> list[str]:
-    """The work of ``facemime track`` (``what="track"``), ``run`` (``"run"``: the track JSON and
-    the side-by-side video) or ``encode`` (``"encode"``: the stream) on one video, writing over
-    results left incomplete by an earlier batch."""
-    if what == "track":
-        from facemime.track.video import track_video
-
-        return track_video(video, None, results[0], force=True).warnings
-    if what == "run":
-        from facemime.animate.run import run_video
-
-        return run_video(video, results[1], None, results[0], force=True).warnings
-    from facemime.codec.files import encode_video
-
-    return encode_video(video, results[0], force=True).warnings
-
-
 def declared_frames(video: Path) -> int:
     """The frames the video's container declares (or its duration × rate; 0 when unreadable)."""
     import av
@@ -100,12 +83,12 @@ def process(
     results: list[str],
     what: str,
     timeout_per_frame: float | None,
-    task: Task | None = None,
+    task: Task,
     start_seconds: float = START_SECONDS,
 ) -> dict[str, Any]:
-    """Run ``task`` (default :func:`default_task`) on ``video`` within ``start_seconds`` +
-    ``timeout_per_frame`` s × its declared frames (None: no limit), check the results and return
-    its manifest line (see :mod:`facemime.batch.manifest`)."""
+    """Run ``task`` (the command's work, :func:`facemime.app.batch.default_task`) on ``video``
+    within ``start_seconds`` + ``timeout_per_frame`` s × its declared frames (None: no limit),
+    check the results and return its manifest line (see :mod:`facemime.batch.manifest`)."""
     pin_threads()
     t0 = time.perf_counter()
     path, paths = Path(video), [Path(p) for p in results]
@@ -114,7 +97,7 @@ def process(
     limit = None if timeout_per_frame is None else start_seconds + timeout_per_frame * frames
     watchdog = _Watchdog(limit, name) if limit is not None else None
     try:
-        warnings = (task or default_task)(path, paths, what)
+        warnings = task(path, paths, what)
         if watchdog is not None:
             watchdog.finish()
         record.update(status="done", **summarise(paths, what), error=None, results=result_sizes(paths))

@@ -22,7 +22,7 @@ import numpy as np
 
 from facemime import _core
 from facemime.animate.analysis import FrameMotion, start_analysis
-from facemime.codec.files import Clip, encode_clip
+from facemime.codec.clip import Clip, encode_clip
 from facemime.codec.params import Basis, pose_vector
 from facemime.codec.stream import DEFAULT_QUALITY, LADDER, MotionEncoder, Settings
 from facemime.errors import InputFileError, InvalidInputError

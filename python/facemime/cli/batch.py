@@ -56,7 +56,7 @@ def batch(
     (--scheduler). A rerun skips the videos whose results are complete and redoes the rest; a
     video that fails is recorded in OUT/manifest.jsonl and the batch goes on. Exit status 3 when
     some videos failed or timed out."""
-    from facemime.batch import print_progress, run_batch
+    from facemime.app.batch import print_progress, run_batch
 
     update, stop = print_progress()
     try:

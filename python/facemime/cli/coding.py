@@ -60,7 +60,7 @@ def encode(
     """Analyse the face in VIDEO and write its motion as a facemime stream: a couple of kilobits
     a second, plus the actor once. A TRACK.json (from run, or expression weights written by hand)
     is coded from its recorded motion instead, at its size and frame rate (no --appearance)."""
-    from facemime.codec.files import encode_video
+    from facemime.app.coding import encode_video
     from facemime.codec.stream import DEFAULT_QUALITY, Settings
     from facemime.errors import InvalidInputError
 
@@ -96,7 +96,7 @@ def encode(
 @force_option
 def decode(stream: Path, actor_file: Path | None, out_file: Path, mask_only: bool, force: bool) -> None:
     """Synthesise the face of a facemime STREAM into a video, with no access to the source video."""
-    from facemime.codec.files import decode_stream
+    from facemime.app.coding import decode_stream
 
     result = decode_stream(stream, out_file, actor_file, force, mask_only)
     click.echo(str(out_file))
@@ -168,7 +168,7 @@ def call(
     the video's end, or with Ctrl-C."""
     import webbrowser
 
-    from facemime.call import Call
+    from facemime.app.call import Call
     from facemime.io.actor_file import load_actor
 
     actor = load_actor(actor_file) if actor_file is not None else None

@@ -50,7 +50,7 @@ def model_preview(model: Path | None, out_file: Path, force: bool) -> None:
 def fit(source: Path, frame: int, points_file: Path | None, out_file: Path, force: bool) -> None:
     """Fit the generic head to the frontal face in IMAGE_OR_VIDEO: reference points, elastic
     adjustment, texture; write the actor file and a preview PNG."""
-    from facemime.fit.run import fit_file
+    from facemime.app.fit import fit_file
 
     run = fit_file(source, out_file, frame, points_file, force)
     for w in run.warnings:
@@ -78,7 +78,7 @@ def fit(source: Path, frame: int, points_file: Path | None, out_file: Path, forc
 @force_option
 def track(video: Path, init: Path | None, out_file: Path, overlay: Path | None, force: bool) -> None:
     """Track the mouth and eyebrow contours through VIDEO with STB-snakes."""
-    from facemime.track.video import track_video
+    from facemime.app.track import track_video
 
     run = track_video(video, init, out_file, overlay, force)
     for w in run.warnings:

@@ -54,8 +54,8 @@ def run(
     in the actor's own scene (the picture it was fitted on). A TRACK.json (from run, or expression
     weights written by hand) is played instead: its synthesised picture alone, at its size and
     frame rate, with the motion options added; --track and --weights need a video."""
-    from facemime.animate.run import run_track, run_video
     from facemime.animate.synth import UserMotion
+    from facemime.app.run import run_track, run_video
     from facemime.errors import InvalidInputError
 
     user = UserMotion(yaw=yaw, pitch=pitch, roll=roll, zoom=zoom, gain=gain)
@@ -110,8 +110,8 @@ def view(source: Path, actor_file: Path | None, port: int, no_browser: bool, mas
     Stop with Ctrl-C."""
     import webbrowser
 
+    from facemime.app.view import HELP, Viewer, make_server
     from facemime.io.actor_file import load_actor
-    from facemime.viewer import HELP, Viewer, make_server
 
     actor = load_actor(actor_file) if actor_file is not None else None
     with Viewer(source, actor, mask_only) as viewer:
@@ -139,7 +139,7 @@ def export(track: Path, actor_file: Path | None, out_file: Path, force: bool) ->
     """Export the performance of TRACK.json (from facemime run) as a glTF 2.0 file for Blender,
     three.js, Unity or Unreal: the actor's textured mesh in metres, y up, its named expression
     controls (ARKit names) as morph targets, and their weights and the head pose per frame."""
-    from facemime.export import export_track
+    from facemime.app.export import export_track
 
     result = export_track(track, out_file, actor_file, force)
     click.echo(str(result.path))
@@ -164,7 +164,7 @@ def demo(out_dir: Path, force: bool) -> None:
     """Run the main job on built-in data: fit the astronaut photo, animate her with a scripted
     performance, track it back and re-synthesise it on her and on a second face; write the videos
     and report.html."""
-    from facemime.demo import run_demo
+    from facemime.app.demo import run_demo
 
     result = run_demo(out_dir, force)
     for f in result.files:

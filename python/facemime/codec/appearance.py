@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from facemime.render.texture_map import render_mesh_into
+from facemime.render.raster import render_mesh_into
 from facemime.shared_constants import EYES
 from facemime.types.head import HeadModel
 from facemime.types.pose import Pose, project, rotation_matrix

@@ -21,7 +21,6 @@ are not in the file.
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -32,12 +31,11 @@ import numpy as np
 from facemime import __version__
 from facemime.animate.motion_file import read_motion
 from facemime.animate.replay import track_settings
-from facemime.errors import InputFileError, InvalidInputError
+from facemime.errors import InvalidInputError
 from facemime.export.animation import POSE_KEYS, node_keys
 from facemime.export.gltf import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, Glb
 from facemime.fit.actor import generic_actor
 from facemime.io.contours_json import TRACK_FORMAT, ContourFileError, load_document
-from facemime.io.outputs import check_outputs, write_bytes
 from facemime.types.actor import Actor
 from facemime.types.head import model_iod
 
@@ -213,40 +211,3 @@ def load_performance(track: str | Path, actor: Actor | None = None) -> Performan
     poses = np.array([[f["pose"][k] for k in POSE_KEYS] for f in frames])
     poses[:, 3] *= ratio
     return Performance(actor, names, np.asarray(ex.fields, np.float64), index / fps, weights, poses, size)
-
-
-@dataclass(frozen=True)
-class ExportResult:
-    """What an export wrote: ``path``, ``frames``, ``controls`` (morph targets), ``bytes`` and
-    ``seconds`` (wall time, reading the track to writing the file)."""
-
-    path: Path
-    frames: int
-    controls: int
-    bytes: int
-    seconds: float
-
-
-def export_track(
-    track: str | Path, out: str | Path, actor: str | Path | Actor | None = None, force: bool = False
-) -> ExportResult:
-    """Write the performance of ``track`` (``facemime.track/1`` from ``facemime run``) on
-    ``actor`` (an ``.actor`` file or an :class:`Actor`; default the generic head) to ``out``
-    (``.glb``); an existing ``out`` is refused unless ``force``."""
-    from facemime.io.actor_file import load_actor
-
-    t0 = time.perf_counter()
-    out = Path(out)
-    if out.suffix.lower() != ".glb":
-        raise InvalidInputError(f"the output must end in .glb, got {out.name!r}")
-    actor_path = actor if isinstance(actor, (str, Path)) else None
-    check_outputs([out], force, inputs=[track, actor_path])
-    if not Path(track).is_file():
-        raise InputFileError(
-            f"track file {track} does not exist" if not Path(track).exists() else f"track file {track} is not a file"
-        )
-    chosen = load_actor(actor_path) if actor_path is not None else actor
-    perf = load_performance(track, chosen)
-    data = glb_bytes(perf)
-    write_bytes(out, data)
-    return ExportResult(out, len(perf.times), len(perf.names), len(data), time.perf_counter() - t0)

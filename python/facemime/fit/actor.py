@@ -8,15 +8,18 @@ texture's top-left corner; texel (i, j) has its centre at ((i + 0.5) / W, (j + 0
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import cv2
 import numpy as np
 
-from facemime.errors import InvalidInputError
-from facemime.fit.placement import Fit
+from facemime.errors import InvalidInputError, NoFaceError
+from facemime.fit.adjust import Fit, fit_model
+from facemime.fit.auto import AutoPoints, auto_points
 from facemime.head.generic import generic_head
 from facemime.head.texture import painted_texture
 from facemime.types.actor import Actor
+from facemime.types.contours import CONTOUR_NAMES
 from facemime.types.head import HeadModel
 from facemime.types.points import ReferencePoints
 from facemime.types.pose import Pose, project
@@ -69,3 +72,39 @@ def generic_actor(size: tuple[int, int] = (512, 512)) -> Actor:
     (width, height) pixels."""
     head = generic_head()
     return Actor(head, painted_texture(head, 512), Pose.framing(head.vertices, size, 0.8))
+
+
+def find_points(photo: np.ndarray, name: str) -> tuple[AutoPoints, list[str]]:
+    """The reference points of the largest face of ``photo`` ((H, W, 3) uint8 RGB) and warnings
+    (several faces); ``name`` names the photo in them and in the
+    :class:`~facemime.errors.NoFaceError` raised where there is no face."""
+    try:
+        found = auto_points(photo)
+    except NoFaceError:
+        raise NoFaceError(f"no face found in {name}") from None
+    faces = found.face.faces
+    return found, [f"{faces} faces found in {name}; fitting the largest"] if faces > 1 else []
+
+
+def fit_actor(
+    photo: np.ndarray, name: str, points: dict | None = None, frame: int = 0, model: HeadModel | None = None
+) -> tuple[Actor, list[str], float]:
+    """Fit ``model`` (default: the generic head) to ``photo`` ((H, W, 3) uint8 RGB) on the given
+    validated reference ``points`` or, without them, on points found automatically. ``name`` is
+    the photo's file name, for messages and the actor's metadata. Returns the actor, warnings
+    (several faces) and the final contour residual (pixels)."""
+    model = model or generic_head()
+    warnings: list[str] = []
+    if points is None:
+        found, warnings = find_points(photo, name)
+        points = found.points
+    fit = fit_model(model, points)
+    source = {"file": Path(name).name, "frame": int(frame), "width": int(photo.shape[1]), "height": int(photo.shape[0])}
+    return smear_texture(model, photo, fit, points, source), warnings, float(fit.residuals[-1])
+
+
+def init_contours(actor: Actor) -> dict[str, np.ndarray]:
+    """The eight tracker contours of ``actor``: its mouth and brow vertices projected onto its
+    source photo, name -> (K, 2) float64 pixels."""
+    points = project(actor.model.vertices, actor.pose)[0]
+    return {n: points[actor.model.groups[n]] for n in CONTOUR_NAMES}

@@ -76,7 +76,8 @@ def actor_bytes(actor: Actor, texture: str = "png", quality: int = 90) -> bytes:
     1-100)."""
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
-        z.writestr("actor.json", actor_json(actor))
+        # ZipInfo entries are dated 1980-01-01: the same actor gives the same bytes, whenever written
+        z.writestr(zipfile.ZipInfo("actor.json"), actor_json(actor), zipfile.ZIP_DEFLATED)
         for what, image in (("texture", actor.texture), ("scene", actor.scene)):
             if image is not None:
                 data = _encoded(image, what, texture, quality)

@@ -10,7 +10,7 @@ import cv2
 import numpy as np
 
 from facemime.errors import InvalidInputError
-from facemime.render.texture_map import render_mesh
+from facemime.render.raster import render_mesh
 from facemime.types.head import HeadModel
 from facemime.types.pose import Pose, project, rotation_matrix
 

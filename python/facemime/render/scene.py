@@ -31,7 +31,7 @@ import cv2
 import numpy as np
 
 from facemime.errors import InvalidInputError
-from facemime.render.texture_map import render_mesh_into
+from facemime.render.raster import render_mesh_into
 from facemime.shared_constants import BORDER_STEPS, EDGE_MARGIN, RINGS, SLOW
 from facemime.types.similarity import apply, robust_similarity
 

@@ -3,7 +3,9 @@
 The public entry point is :class:`facemime.track.Tracker`, fed one frame at a time.
 """
 
-from facemime.track.tracker import FrameResult, Tracker, TrackerParams
+from facemime.track.knots import FrameResult
+from facemime.track.params import TrackerParams
+from facemime.track.tracker import Tracker
 from facemime.types.contours import CONTOUR_NAMES, FEATURES
 
 __all__ = ["CONTOUR_NAMES", "FEATURES", "FrameResult", "Tracker", "TrackerParams"]

@@ -4,7 +4,7 @@ A brow raised fast, or a head that jumps between frames (a video that dropped fr
 brow further than the snakes reach (δ0/(1−σ) px per frame) and than the optical flow follows:
 the snakes then settle on the eyelid's crease or on bare skin and the brow's edge response
 collapses. Such a brow is looked for again by matching the first frame's brow, gray and scaled
-with the head, over a window around where the head motion put it (:mod:`facemime.track.match`).
+with the head, over a window around where the head motion put it (:mod:`facemime.track.template`).
 Coordinates are (x, y) pixels, origin at the centre of the top-left pixel, y down.
 """
 
@@ -13,7 +13,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from facemime.track.match import crop_box, find, gray_crop
+from facemime.track.template import crop_box, find, gray_crop
 
 #: The template is the box of the brow's knots grown by this fraction of the brow's width.
 MARGIN = 0.12

@@ -18,7 +18,7 @@ import numpy as np
 
 from facemime import _core
 from facemime.track.flow import EPSILON, ITERATIONS, LEVELS, MIN_EIGEN, WINDOW
-from facemime.track.match import gray_crop
+from facemime.track.template import gray_crop
 from facemime.types.similarity import FIT_ROUNDS, IDENTITY, as_points, compose, robust_similarity
 
 #: Rigid zones in face coordinates (s, t) of the first frame: a point is ``c + s·W·u + t·v``

@@ -6,14 +6,14 @@ that drops frames) deforms faster than the flow's windows follow: most mouth kno
 forward-backward check and stay where the head motion puts them, often more than the snakes'
 reach (δ0/(1−σ) px) from the lips. The mouth region as a whole still looks much as it did in the
 previous frame: matching that region, gray, around where the head motion put it
-(:mod:`facemime.track.match`) measures how far the mouth moved beyond the head; the tracker
+(:mod:`facemime.track.template`) measures how far the mouth moved beyond the head; the tracker
 moves the knots the flow lost by its part along the mouth line (an opening, up and down, is
 left to the lip searches).
 
 A mouth that slid off the lips (onto the cheek, after a cut between takes) can hold an edge
 there and stay, flagged lost. After a lost frame (the tracker's ``mouth_relocate``) the lips are
 looked for by their colour: the first frame's outer mouth, placed where the brows put it, is
-slid and scaled over the lip score (:func:`facemime.track.match.locate`) within most of a mouth
+slid and scaled over the lip score (:func:`facemime.track.template.locate`) within most of a mouth
 width sideways, half a width down the face (a dropping jaw) and a fifth up (the upper lip is
 borne by the skull: further up lie the nostrils), and kept only where it is clearly more
 lip-coloured, against the skin around it, than the tracked mouth.
@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from facemime import _core
-from facemime.track.match import Placement, crop_box, find, gray_crop, locate
+from facemime.track.template import Placement, crop_box, find, gray_crop, locate
 
 #: The template is the box of the previous frame's mouth knots grown by this fraction of the
 #: mouth's width (some skin around the lips: measured on the six videos, 0.1 followed the mouth

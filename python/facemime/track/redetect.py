@@ -44,9 +44,11 @@ from facemime.errors import NoFaceError
 from facemime.metrics import curve_error
 from facemime.networks.finder import find_face, follow_face
 from facemime.networks.mesh import reference_points
+from facemime.track.knots import FrameResult
 from facemime.track.motion import HeadMotion
+from facemime.track.params import TrackerParams
 from facemime.track.scale import ScaledMotion
-from facemime.track.tracker import FrameResult, Tracker, TrackerParams
+from facemime.track.tracker import Tracker
 from facemime.types.contours import CONTOUR_NAMES, FEATURES
 from facemime.types.similarity import apply, robust_similarity
 

@@ -38,239 +38,24 @@ Coordinates are (x, y) pixels, origin at the centre of the top-left pixel, y dow
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
-from typing import Any
 
 import numpy as np
 
 from facemime import _core, validate
 from facemime.errors import InvalidInputError
-from facemime.metrics import resample
 from facemime.track import motion
 from facemime.track.brows import BrowSearch
 from facemime.track.field import build_field, regions
+from facemime.track.knots import FrameResult, check_contours, layout, rgb_frame
 from facemime.track.lips import LipSearch
-from facemime.track.mouth import mouth_shift, relocate
+from facemime.track.params import CENTRING, FAST, NARROWEST, OPERATORS, TrackerParams
 from facemime.track.scale import FrameScale, ScaledMotion
+from facemime.track.searches import Searches
 from facemime.types import similarity
 from facemime.types.contours import CONTOUR_NAMES, FEATURES, POLARITY
 
-OPERATORS = ("directional", "magnitude")
-#: The mouth gets another solver pass only when a knot moved this fraction of a pass's reach.
-FAST = 0.6
-#: Fraction of the inner mouth's sideways drift from the centre of the outer mouth removed per frame.
-CENTRING = 0.3
-#: The inner mouth's width may shrink to this fraction of its rest width before it counts as lost.
-NARROWEST = 0.25
-#: A match (a brow found again, the mouth's region followed) that puts a knot coordinate this
-#: many solver reaches (δ0/(1−σ)) from where the knots were moves them; a nearer one tells the
-#: snakes nothing new.
-AGREE = 1.0
 
-
-@dataclass(frozen=True)
-class CurveWeights:
-    """Energy weights of a curve (docs/method.md §1): tension α, rigidity β (both against the rest
-    shape), temporal smoothness τ, image contrast ρ, temporal brightness γ, and the weights of
-    the luma and colour (red − green) derivatives in H (their signs come from the edge's
-    polarity, :data:`facemime.types.contours.POLARITY`)."""
-
-    alpha: float
-    beta: float
-    tau: float
-    rho: float = 1.0
-    gamma: float = 0.0
-    luma: float = 1.0
-    chroma: float = 0.0
-
-
-@dataclass(frozen=True)
-class TrackerParams:
-    """Tracker settings. Defaults were tuned on the six shared videos (benchmarks/accuracy.py).
-
-    Distances are pixels. ``lip_keep``: each lip keeps at least this fraction of its first-frame
-    thickness (repulsion between the outer and inner curves; the inner curves never cross).
-    ``gap_weight``: weight of those minimum gaps. ``brow_weight``: weight holding each brow's
-    upper-to-lower thickness at its first-frame value (scaled with the head). ``mouth_knots``,
-    ``brow_knots``: knots per curve (None: the init's own points). ``knot_flow``: start each knot where the
-    optical flow carries it (when the flow passes its forward-backward check) rather than where the head
-    motion alone puts it. ``lost_response``: a feature is lost when its edge response falls below this
-    fraction of the first frame's.
-    ``calibration_passes``: solver runs on the first frame that measure how far the image edges
-    lie from the given contours (0: no correction). ``mouth_affine``: how far each mouth
-    feature's rest shape follows the affine map that best carries it onto the knots' starting
-    positions (0: the first frame's shape moved by the head only; 1: any affine change is free),
-    so that a mouth narrowing into an "O" or opening wide is not pulled back to its neutral
-    shape. ``mouth_passes``: solver passes per frame for the mouth at most, each moving a knot
-    at most δ0/(1−σ), so a fast-opening mouth can be followed; a pass follows only when a mouth
-    knot moved :data:`FAST` of that reach in the previous one (the brows keep the first pass).
-    ``lip_reach``: a mouth knot the flow could not follow (its forward-backward check failed)
-    starts at the lip edge found on a lip-colour score within ± this fraction of the mouth's
-    width along its curve's normal (:mod:`facemime.track.lips`; 0: off); ``lip_step``: the
-    smallest such edge, in skin standard deviations per px. ``brow_search``: a brow one of whose
-    curves' edge response falls below this fraction of the first frame's (or whose shape
-    degenerates) is looked for again by matching the first frame's brow around where the head
-    motion put it (:mod:`facemime.track.brows`; 0: off).
-    A brow the match left weak on the eyelid's crease below a brow raised fast (lp_d6 frames
-    858-917 from the reference start, once also tried higher up the face here) is put right by
-    the landmark model's checks (:class:`facemime.track.redetect.FaceTracker`): with them,
-    trying it higher changed no track of the ten videos from the reference, the automatic and
-    four noisy starts, and was removed.
-    ``inner_search``: an inner mouth still lost once a lost mouth was looked for
-    (``mouth_relocate``) is looked for again: each of its curves in turn is moved up and down
-    the face by 1 to this many solver reaches (δ0/(1−σ)) and
-    the inner mouth settled from there by a solver pass, the outer mouth staying; the placement
-    with the highest confidence, when higher than before, is kept if the inner mouth then
-    holds its edges, and it is then not lost (0: off). Measured on lp_d6, whose wide, fast
-    mouth over teeth and tongue loses the inner lips (stuck on the teeth or the tongue 10 to
-    20 px from the lip edge), over 24 starts from the reference with 0.2 px of noise: lost
-    frames 5.4 → 1.0 per start, failure rates of the six videos outer 0.23 → 0.28%, inner
-    0.19 → 0.22%; from lp_d6's automatic start with noise, 8 starts: frames with an outer mouth
-    NME above 0.1, 58.0 → 44.1 per start, inner 16.9 → 15.8, lost 14.1 → 3.6. Searched before
-    the lost mouth's relocation, it kept that relocation from repairing a drifting mouth (one
-    start of 24: 7.9% outer failures, unflagged); an earlier form of the search applied to the
-    outer mouth settled outer lips on wrong edges (outer failures 0.13 → 0.48% over 12
-    starts). ``mouth_patch``: when fewer than this
-    fraction of the mouth's knots pass the flow's forward-backward check, the previous frame's
-    mouth region is matched around where the head motion put it, and the knots the flow lost
-    start moved along the mouth line by how far it moved that way beyond the head, when that is
-    at least :data:`AGREE` solver reaches (:mod:`facemime.track.mouth`; 0: off). Measured on the
-    six videos, 0.3 to 0.7 track alike; without the reach gate, 0.6 raised the outer mouth's
-    failures to 2.5%, and moved up and down too, an opening mouth dragged its upper lip down.
-    ``mouth_relocate``: a mouth lost this many frames in a row is looked for by its lip colour
-    around where the brows put it (:func:`facemime.track.mouth.relocate`; 0: off), and settled
-    there by a solver pass; a mouth that then holds its edges is not lost, one that does not
-    stays where it was. Measured on lp_d6, whose mouth a grimace moves 32 px sideways within a
-    frame: at 1 rather than 5, and settled, its frames with an outer mouth NME above 0.1 went
-    from 13 to 4 (inner 15 to 9) and its frames with a lost feature from 10 to 2; the other five
-    videos never lose their mouth. Such single-start counts on lp_d6 swing with 0.2 px of noise
-    on the start (see :data:`facemime.track.mouth.RELOCATE_REACH`): over eight starts, leaving
-    an unsettled mouth where it was rather than where its lip colour was found took the outer
-    mouth's frames above 0.1 from 9.9 to 6.8 per start (inner 14.2 to 10.6), its lost frames
-    from 6.0 to 4.5, and made no start worse.
-    ``face_width``: a face whose brows are wider than this (outer width, px, on the first
-    frame) is tracked on frames shrunk to make them this wide, its contours reported in the
-    frame's pixels (:mod:`facemime.track.scale`; None: never). The pixel settings above were
-    tuned on faces 159 to 236 px wide. Measured on five shared videos enlarged 2×: without
-    shrinking, the outer mouth's mean NME on lp_d3, lp_d12 and vr_2 was 0.074 to 0.082 with
-    18 to 30% failures; shrunk to 240 px, 0.015 to 0.029 (lp_d12, with 3.3% failures). 200 px
-    did as well there, but shrinking lp_d3 at its own size (235 px) to it doubled its brow error.
-    ``iterations``, ``tol``: each solver pass runs at most ``iterations`` steps, and a feature
-    stops early once its own energy changes by less than ``tol`` between steps (0: never;
-    measured on the six videos, stopping at 1e-4 raised the outer mouth's failure rate from 2.9%
-    to 6.9%, as features stopped short of their edges).
-    """
-
-    mouth: CurveWeights = CurveWeights(alpha=30.0, beta=24.0, tau=2.0, rho=1.0, gamma=0.0, chroma=0.5)
-    mouth_inner: CurveWeights = CurveWeights(alpha=8.0, beta=12.0, tau=2.0, rho=1.0, gamma=0.0, luma=0.5, chroma=1.0)
-    brows: CurveWeights = CurveWeights(alpha=30.0, beta=24.0, tau=2.0, rho=1.0, gamma=0.0, chroma=0.0)
-    operator: str = "directional"
-    points_per_segment: int = 3
-    delta0: float = 1.5
-    sigma: float = 0.75
-    iterations: int = 15
-    tol: float = 0.0
-    smoothing: float = 1.5
-    lip_keep: float = 0.5
-    gap_weight: float = 0.5
-    brow_weight: float = 0.05
-    mouth_knots: int | None = None
-    brow_knots: int | None = None
-    motion: bool = True
-    knot_flow: bool = True
-    lost_response: float = 0.1
-    calibration_passes: int = 3
-    mouth_affine: float = 0.7
-    mouth_passes: int = 2
-    lip_reach: float = 0.3
-    lip_step: float = 0.3
-    brow_search: float = 0.3
-    inner_search: int = 3
-    mouth_patch: float = 0.5
-    mouth_relocate: int = 1
-    face_width: float | None = 240.0
-
-    @property
-    def reach(self) -> float:
-        """The farthest a solver pass moves a knot coordinate, δ0/(1−σ) px."""
-        return self.delta0 / (1.0 - self.sigma)
-
-    def with_(self, **changes: Any) -> TrackerParams:
-        """A copy with some settings changed."""
-        return replace(self, **changes)
-
-
-@dataclass
-class FrameResult:
-    """One frame's output: ``contours`` name -> (N, 2) float64 pixels; ``confidence`` feature ->
-    0..1; ``lost`` features flagged in this frame (a lost brow is reported where the brow search
-    matched it, or else on its rest shape);
-    ``iterations`` the solver ran; ``motion_ok`` whether the head motion was measured;
-    ``redetected`` whether the face landmark model put the contours right on this frame
-    (:class:`facemime.track.redetect.FaceTracker`)."""
-
-    index: int
-    contours: dict[str, np.ndarray]
-    confidence: dict[str, float]
-    lost: list[str] = field(default_factory=list)
-    iterations: int = 0
-    motion_ok: bool = True
-    redetected: bool = False
-
-
-def _layout(contours: Mapping[str, np.ndarray], params: TrackerParams) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """Shared knot array and each contour's knot indices; mouth corners are shared."""
-    knots: list[np.ndarray] = []
-    index: dict[str, np.ndarray] = {}
-    for feature, (up, low) in FEATURES.items():
-        count = params.mouth_knots if feature.startswith("mouth") else params.brow_knots
-        u, lo = (np.asarray(contours[n], np.float64) for n in (up, low))
-        if count is None and len(u) != len(lo):
-            count = max(len(u), len(lo))
-        if count is not None:
-            u, lo = resample(u, count), resample(lo, count)
-        base = sum(len(k) for k in knots)
-        if feature.startswith("mouth"):
-            ends = (u[[0, -1]] + lo[[0, -1]]) / 2.0
-            u, lo = u.copy(), lo.copy()
-            u[[0, -1]] = ends
-            knots += [u, lo[1:-1]]
-            index[up] = np.arange(base, base + len(u))
-            index[low] = np.concatenate([[base], np.arange(base + len(u), base + 2 * len(u) - 2), [base + len(u) - 1]])
-        else:
-            knots += [u, lo]
-            index[up] = np.arange(base, base + len(u))
-            index[low] = np.arange(base + len(u), base + 2 * len(u))
-    return np.concatenate(knots), index
-
-
-def _check_contours(contours: Mapping[str, object], width: int, height: int) -> dict[str, np.ndarray]:
-    if not isinstance(contours, Mapping):
-        raise InvalidInputError(
-            f"contours must be a mapping of contour name to (N, 2) points, got {type(contours).__name__}"
-        )
-    missing = [n for n in CONTOUR_NAMES if n not in contours]
-    if missing:
-        raise InvalidInputError(f"contours lack {', '.join(missing)}")
-    out = {}
-    for n in CONTOUR_NAMES:
-        pts = validate.float_array(f"contour {n}", contours[n], (None, 2))
-        if len(pts) < 2:
-            raise InvalidInputError(f"contour {n} needs at least 2 points, got {len(pts)}")
-        if (pts < -0.5).any() or (pts[:, 0] > width - 0.5).any() or (pts[:, 1] > height - 0.5).any():
-            raise InvalidInputError(f"contour {n} has points outside the {width}x{height} image")
-        out[n] = pts
-    return out
-
-
-def _rgb(name: str, frame: object) -> np.ndarray:
-    img = validate.image(name, frame)
-    if img.ndim != 3 or img.shape[2] != 3:
-        raise InvalidInputError(f"{name} must be an (H, W, 3) RGB image, got shape {img.shape}")
-    return img
-
-
-class Tracker:
+class Tracker(Searches):
     """Tracks the mouth and brow contours frame by frame; usable on a live camera.
 
     Parameters
@@ -296,13 +81,13 @@ class Tracker:
     def __init__(self, frame: np.ndarray, contours: Mapping[str, np.ndarray], params: TrackerParams | None = None):
         self.params = p = params or TrackerParams()
         validate.choice("operator", p.operator, OPERATORS)
-        frame = _rgb("frame", frame)
-        contours = _check_contours(contours, frame.shape[1], frame.shape[0])
+        frame = rgb_frame("frame", frame)
+        contours = check_contours(contours, frame.shape[1], frame.shape[0])
         self._scale = FrameScale(frame.shape[1], frame.shape[0], motion.face_frame(contours)[3], p.face_width)
         frame = self._scale.frame(frame)
         contours = {n: self._scale.to_work(c) for n, c in contours.items()}
         self.width, self.height = self._scale.work  # px: the frames the snakes see
-        self._knots0, self._index = _layout(contours, p)
+        self._knots0, self._index = layout(contours, p)
         self._down0 = self._mouth_down(self._knots0)
         self._features = {
             f: np.unique(np.concatenate([self._index[n] for n in names])) for f, names in FEATURES.items()
@@ -497,7 +282,7 @@ class Tracker:
 
     def update(self, frame: np.ndarray) -> FrameResult:
         """Track one more frame, (H, W, 3) uint8 RGB of the first frame's size."""
-        frame = _rgb("frame", frame)
+        frame = rgb_frame("frame", frame)
         if frame.shape[1::-1] != self._scale.size:
             width, height = self._scale.size
             raise InvalidInputError(f"frame size changed from {width}x{height} to {frame.shape[1]}x{frame.shape[0]}")
@@ -618,159 +403,11 @@ class Tracker:
     def _knots_of(self, contours: Mapping[str, np.ndarray]) -> np.ndarray:
         """The knots, in the frames the snakes see, that lay out all eight ``contours`` ((x, y)
         pixels of the frame) as the first frame's were laid out."""
-        contours = _check_contours(contours, *self._scale.size)
-        knots, _ = _layout({n: self._scale.to_work(c) for n, c in contours.items()}, self.params)
+        contours = check_contours(contours, *self._scale.size)
+        knots, _ = layout({n: self._scale.to_work(c) for n, c in contours.items()}, self.params)
         if len(knots) != len(self._knots):
             raise InvalidInputError(f"contours give {len(knots)} knots, the tracker has {len(self._knots)}")
         return knots
-
-    def _search_brow(
-        self,
-        frame: np.ndarray,
-        feature: str,
-        search: BrowSearch,
-        knots: np.ndarray,
-        start: np.ndarray,
-        rest: np.ndarray,
-        down: np.ndarray,
-        targets: np.ndarray,
-        carried: np.ndarray,
-        scale: float,
-        conf: float,
-        shape_ok: bool,
-    ) -> tuple[float, bool, np.ndarray, int]:
-        """Look for a brow whose edge or shape was lost (``brow_search``) around where the head
-        motion put it (``start``): when the match moves its knots at least :data:`AGREE` solver
-        reaches, the brow is settled there by a solver pass and kept (in ``knots``, in place)
-        when its confidence rose or its shape (``shape_ok`` against ``carried``) was unsound.
-        Returns the brow's confidence and shape check then, where it goes should it be lost (the
-        match, else ``carried``), and the solver's iterations."""
-        p, idx = self.params, self._features[feature]
-        found = search.find(frame, scale, start[idx])
-        fallback, iters = carried, 0
-        if found is not None:
-            fallback = knots.copy()
-            fallback[idx] = found
-            if np.abs(found - knots[idx]).max() >= AGREE * p.reach:
-                again, iters, again_resp = self._solve(
-                    self._field(frame, fallback, ((idx, 1),)),
-                    fallback,
-                    rest,
-                    down,
-                    targets,
-                    self._feature_curves[feature],
-                )
-                conf_again = self._confidences(again_resp)[feature]
-                if conf_again > conf or not shape_ok:
-                    knots[idx], conf = again[idx], conf_again
-                    shape_ok = self._shape_ok(knots, carried, feature)
-        return conf, shape_ok, fallback, iters
-
-    def _mouth_sideways(
-        self,
-        frame: np.ndarray,
-        start: np.ndarray,
-        followed: np.ndarray,
-        step: np.ndarray,
-        down: np.ndarray,
-        reach: float,
-    ) -> None:
-        """Move the mouth knots the flow lost (``followed`` False) along the mouth line by how far
-        the previous frame's mouth region moved that way beyond the head's ``step``, when that is
-        at least :data:`AGREE` × ``reach`` px (in place; the mouth's motion up and down, an
-        opening, is the lip searches' to follow)."""
-        mouth = self._mouth_knots
-        shift = mouth_shift(self._prev, frame, self._knots[mouth], similarity.apply(step, self._knots[mouth]))
-        if shift is None:
-            return
-        along = np.array([down[1], -down[0]])
-        sideways = float(shift @ along)
-        if abs(sideways) >= AGREE * reach:
-            start[mouth[~followed[mouth]]] += sideways * along
-
-    def _search_inner(
-        self,
-        frame: np.ndarray,
-        knots: np.ndarray,
-        rest: np.ndarray,
-        down: np.ndarray,
-        targets: np.ndarray,
-        carried: np.ndarray,
-        conf: float,
-    ) -> tuple[float | None, int]:
-        """Look for a lost inner mouth (``inner_search``): each inner curve in turn, upper first, is
-        moved along ``down`` by ±1 to ±``inner_search`` solver reaches and the inner mouth settled
-        from there by a solver pass in which the outer mouth stays; the placement that gives the
-        inner mouth the highest confidence (``conf``: its confidence now) is kept when higher than
-        before. The inner knots are replaced (in place) when the inner mouth then
-        holds its edges (confidence at least ``lost_response``, shape sound against
-        ``carried``). Returns its confidence then, else None; and the solver's iterations."""
-        p = self.params
-        reach = p.reach
-        inner = self._features["mouth_inner"]
-        # One field for every trial: a trial moves a knot at most inner_search reaches and its
-        # pass one more.
-        image = self._field(frame, knots, ((self._mouth_knots, p.inner_search + 1),))
-        held = np.ones(len(knots), bool)
-        held[inner] = False
-        placed, best, iters = knots.copy(), conf, 0
-        for name in FEATURES["mouth_inner"]:
-            idx, found = self._index[name][1:-1], None
-            for steps in range(-p.inner_search, p.inner_search + 1):
-                if steps == 0:
-                    continue
-                trial = placed.copy()
-                trial[idx] += steps * reach * down
-                settled, more, resp = self._solve(image, trial, rest, down, targets, self._mouth_curves, held)
-                iters += more
-                if (trial_conf := self._confidences(resp)["mouth_inner"]) > best:
-                    found, best = settled[inner], trial_conf
-            if found is not None:
-                placed[inner] = found
-        if best >= p.lost_response and self._shape_ok(placed, carried, "mouth_inner"):
-            knots[inner] = placed[inner]
-            return best, iters
-        return None, iters
-
-    def _relocate_mouth(
-        self,
-        frame: np.ndarray,
-        lips: LipSearch,
-        knots: np.ndarray,
-        carried: np.ndarray,
-        down: np.ndarray,
-        targets: np.ndarray,
-    ) -> tuple[dict[str, float] | None, int]:
-        """Look for the mouth, lost for ``mouth_relocate`` frames, where its lip colour (``lips``'s) is found
-        near where the brows put the first frame's mouth, in that mouth's shape, and let one
-        solver pass (the frame's ``down`` and gap ``targets``) settle it there. The settled mouth
-        replaces the mouth knots (in place) only when it is no longer lost: confidences at least
-        ``lost_response``, shapes sound against the rest knots ``carried``. Returns then the
-        mouth features' confidences, else None; and the solver's iterations."""
-        expected = similarity.apply(motion.brow_similarity(self._named(self._knots0), self._named(knots)), self._knots0)
-        upper, lower = self._index["mouth_outer_upper"], self._index["mouth_outer_lower"]
-        outer = lambda k: np.concatenate([k[upper], k[lower][::-1]])  # noqa: E731
-        polygon = outer(expected)
-        if lips.colour is None:  # no lip colour to look for (then the search is not active either)
-            return None, 0
-        found = relocate(frame, lips.colour, polygon, outer(knots), down)
-        if found is None:
-            return None, 0
-        mouth = self._mouth_knots
-        placed = knots.copy()
-        placed[mouth] = found.apply(expected[mouth], polygon.mean(axis=0))
-        rest = self._mouth_rest(carried, placed)
-        settled, iters, resp = self._solve(
-            self._field(frame, placed, ((mouth, 1),)), placed, rest, down, targets, self._mouth_curves
-        )
-        self._centre_inner(settled, rest, down)
-        features = ("mouth_outer", "mouth_inner")
-        confidence = {f: c for f, c in self._confidences(resp).items() if f in features}
-        if all(confidence[f] >= self.params.lost_response and self._shape_ok(settled, carried, f) for f in features):
-            knots[mouth] = settled[mouth]
-            self._mouth_lost_for = 0
-            return confidence, iters
-        return None, iters
 
     def _centre_inner(self, knots: np.ndarray, rest: np.ndarray, down: np.ndarray) -> None:
         """Slide the inner mouth along the mouth line by :data:`CENTRING` of its drift from

@@ -2,7 +2,7 @@
  * WebGL2 drawing of a synthesised frame, in the Python renderer's order
  * (facemime.animate.synth.synthesize): the scene warped (or a plain background), the mouth
  * interior blended in, then the face mesh, back-facing triangles culled and the rest drawn far
- * to near by mean depth (the painter's algorithm of facemime.render.texture_map), sampled
+ * to near by mean depth (the painter's algorithm of facemime.render.raster), sampled
  * bilinearly.
  *
  * Positions come in image pixels (x right, y down, (0, 0) the centre of the top-left pixel);

@@ -119,7 +119,7 @@ export class Synthesizer {
 }
 
 /** The front-facing triangles (counter-clockwise in the image, y down) far to near by mean
- * depth, a stable sort (facemime.render.texture_map's painter order). */
+ * depth, a stable sort (facemime.render.raster's painter order). */
 export function paintersOrder(points: Float64Array, depth: Float64Array, triangles: Uint32Array): Uint32Array {
   const order: [number, number][] = [];
   for (let f = 0; f < triangles.length / 3; f++) {

@@ -198,3 +198,17 @@ def test_a_scene_whose_source_picture_is_huge_or_of_another_shape_is_refused(act
     with pytest.raises(ActorFileError, match=message) as e:
         load_actor(path)
     assert "\n" not in str(e.value) and str(path) in str(e.value)
+
+
+def test_the_same_actor_gives_the_same_bytes_whenever_it_is_written(monkeypatch):
+    # An actor embedded in a stream is part of its bytes: encoding a video twice gives one file.
+    import time
+
+    from facemime.fit.actor import generic_actor
+    from facemime.io.actor_file import actor_bytes
+
+    actor = generic_actor((64, 64))
+    monkeypatch.setattr(time, "time", lambda: 1.0e9)
+    first = actor_bytes(actor)
+    monkeypatch.setattr(time, "time", lambda: 1.7e9)
+    assert actor_bytes(actor) == first

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from facemime.errors import InvalidInputError
-from facemime.track.match import find, gray_crop
+from facemime.track.template import find, gray_crop
 
 
 def test_gray_crops_are_opencv_grey_levels(lp_d0):

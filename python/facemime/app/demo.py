@@ -24,12 +24,11 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from facemime.animate.analysis import Analysis
-from facemime.animate.run import pose_dict
+from facemime.animate.analysis import analysed
 from facemime.animate.synth import Puppet, key_frame, scene_mesh, synthesize
-from facemime.fit.actor import generic_actor
+from facemime.app.run import pose_dict
+from facemime.fit.actor import fit_actor, generic_actor
 from facemime.fit.preview import preview_sheet
-from facemime.fit.run import fit_actor
 from facemime.io import VideoWriter, write_image
 from facemime.io.actor_file import actor_bytes
 from facemime.io.contours_json import track_document, write_json
@@ -173,8 +172,11 @@ def _demo(files: list[Path], paths: list[Path], seconds: float) -> DemoResult:
 
     # 3. Track it back.
     t0 = time.perf_counter()
-    analysis = Analysis(frames[0], "the performance", fps=FPS)
-    motions = [analysis.last] + [analysis.update(f) for f in track(frames[1:], count - 1, "tracking")]
+    analysis, motions = None, []
+    for _, current, m in analysed(track(frames, count, "tracking"), "the performance", fps=FPS):
+        analysis = current
+        motions.append(m)
+    assert analysis is not None  # the performance has frames
     timing["analyse (fit, track, pose)"] = time.perf_counter() - t0
     nme = {}
     for group, names in GROUPS.items():

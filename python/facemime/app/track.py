@@ -15,9 +15,10 @@ from facemime.io.contours_json import read_init, track_document, write_json
 from facemime.io.outputs import Outputs
 from facemime.io.video import CODECS, VideoReader, VideoWriter
 from facemime.progress import track as progress
+from facemime.track.knots import FrameResult
 from facemime.track.overlay import draw_contours
+from facemime.track.params import TrackerParams
 from facemime.track.redetect import FaceTracker, Redetection
-from facemime.track.tracker import FrameResult, TrackerParams
 from facemime.types.contours import FEATURES
 
 

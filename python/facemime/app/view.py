@@ -30,7 +30,7 @@ import textwrap
 import threading
 import time
 from collections import deque
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from contextlib import closing, suppress
 from http import HTTPStatus
 from http.client import LineTooLong
@@ -42,13 +42,13 @@ from urllib.parse import parse_qs, urlparse
 import cv2
 import numpy as np
 
-from facemime.animate.analysis import start_analysis
+from facemime.animate.analysis import analysed
 from facemime.animate.replay import FPS_RANGE, load_replay
 from facemime.animate.synth import Puppet, UserMotion
 from facemime.errors import FacemimeError, InputFileError, InvalidInputError
 from facemime.io.video import VideoReader
 from facemime.local_only import addressed_here
-from facemime.render.texture_map import fill
+from facemime.render.raster import fill
 from facemime.shared_constants import BACKGROUND
 from facemime.track.overlay import draw_contours
 from facemime.types.actor import Actor
@@ -104,6 +104,17 @@ class Viewer:
         self._frames = self._play()
         self._shown = next(self._frames)
 
+    def _one_size(self, frames: Iterable[np.ndarray]) -> Iterator[np.ndarray]:
+        """``frames``, refused in one line from the first whose size is not the video's."""
+        for n, frame in enumerate(frames):
+            if frame.shape[:2] != self.size[::-1]:
+                raise InputFileError(
+                    f"video {self.source} changes its frame size from {self.size[0]}x"
+                    f"{self.size[1]} to {frame.shape[1]}x{frame.shape[0]} at frame {n}; "
+                    "the viewer plays one frame size"
+                )
+            yield frame
+
     def _play(self) -> Iterator[tuple[np.ndarray | None, Pose, np.ndarray, Puppet]]:
         """(left panel or None, pose, knot offsets, look, puppet) per frame, looping forever."""
         while True:
@@ -111,17 +122,11 @@ class Viewer:
                 for m in self._motions:
                     yield None, m.pose, m.offsets, m.look, self._puppet
                 continue
-            analysis = None
             with VideoReader(self.source) as reader:
-                for n, frame in enumerate(reader):
-                    if frame.shape[:2] != self.size[::-1]:
-                        raise InputFileError(
-                            f"video {self.source} changes its frame size from {self.size[0]}x"
-                            f"{self.size[1]} to {frame.shape[1]}x{frame.shape[0]} at frame {n}; "
-                            "the viewer plays one frame size"
-                        )
-                    if analysis is None:
-                        analysis = start_analysis(frame, str(self.source), fps=self.fps)
+                for n, (frame, analysis, m) in enumerate(
+                    analysed(self._one_size(reader), str(self.source), fps=self.fps)
+                ):
+                    if n == 0:
                         puppet = Puppet(
                             self._actor or analysis.actor,
                             analysis.deformer.feature_sizes(),
@@ -129,9 +134,6 @@ class Viewer:
                             analysis.actor.pose,
                             self._mask_only,
                         )
-                        m = analysis.last
-                    else:
-                        m = analysis.update(frame)
                     yield (
                         (draw_contours(frame, m.contours, m.lost) if m.face else frame),
                         m.pose,

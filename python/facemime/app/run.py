@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from facemime.animate.analysis import Analysis, start_analysis
+from facemime.animate.analysis import Analysis, analysed
 from facemime.animate.departure import DEPARTS_AT, departure
 from facemime.animate.expressions import Expressions
 from facemime.animate.synth import Puppet, UserMotion
@@ -31,10 +31,10 @@ from facemime.io.contours_json import TrackWriter
 from facemime.io.outputs import Outputs, write_text
 from facemime.io.video import CODECS, VideoReader, VideoWriter
 from facemime.progress import track as progress
-from facemime.render.texture_map import fill
+from facemime.render.raster import fill
 from facemime.shared_constants import BACKGROUND, NO_FACE_DIM, POSE_FIELDS
 from facemime.track.overlay import draw_contours
-from facemime.track.tracker import TrackerParams
+from facemime.track.params import TrackerParams
 from facemime.types.actor import Actor
 from facemime.types.head import model_iod
 from facemime.types.pose import Pose, project
@@ -114,18 +114,24 @@ class SideBySide:
         #: Per frame, the expression weights (E,) solved from its offsets and look.
         self.weights: list[np.ndarray] = []
 
-    def __iter__(self) -> Iterator[np.ndarray]:
-        seconds, canvas, synth, puppet = self.seconds, None, None, None
+    def _timed_frames(self) -> Iterator[np.ndarray]:
+        """The source's frames, the time spent waiting for each added to ``seconds["decode"]``."""
         stream = iter(self._frames)
         while True:
             t0 = time.perf_counter()
             frame = next(stream, None)
-            seconds["decode"] += time.perf_counter() - t0
+            self.seconds["decode"] += time.perf_counter() - t0
             if frame is None:
-                break
+                return
+            yield frame
+
+    def __iter__(self) -> Iterator[np.ndarray]:
+        seconds, canvas, synth, puppet = self.seconds, None, None, None
+        frames = analysed(self._timed_frames(), self._name, params=self._params, fps=self._fps)
+        for frame, analysis, motion in frames:
             h, w = frame.shape[:2]
             if self.analysis is None:
-                self.analysis = start_analysis(frame, self._name, params=self._params, fps=self._fps)
+                self.analysis = analysis
                 actor = self.analysis.actor
                 driven = actor if self._target is None else self._target
                 puppet = Puppet(
@@ -136,10 +142,7 @@ class SideBySide:
                 outline = actor.model.groups["face_outline"]
                 canvas = np.empty((h, 2 * w, 3), np.uint8)
                 synth = np.empty((h, w, 3), np.uint8)
-                motion = self.analysis.last
                 solver = Expressions.of(actor.model).solver()
-            else:
-                motion = self.analysis.update(frame)
             assert puppet is not None and synth is not None and canvas is not None  # made on the first frame
             t1 = time.perf_counter()
             if puppet.scene is None:

@@ -1,0 +1,50 @@
+"""`facemime export`: the performance of a track file on an actor, written as binary glTF
+(:mod:`facemime.export.performance`)."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from facemime.errors import InputFileError, InvalidInputError
+from facemime.export.performance import glb_bytes, load_performance
+from facemime.io.outputs import check_outputs, write_bytes
+from facemime.types.actor import Actor
+
+
+@dataclass(frozen=True)
+class ExportResult:
+    """What an export wrote: ``path``, ``frames``, ``controls`` (morph targets), ``bytes`` and
+    ``seconds`` (wall time, reading the track to writing the file)."""
+
+    path: Path
+    frames: int
+    controls: int
+    bytes: int
+    seconds: float
+
+
+def export_track(
+    track: str | Path, out: str | Path, actor: str | Path | Actor | None = None, force: bool = False
+) -> ExportResult:
+    """Write the performance of ``track`` (``facemime.track/1`` from ``facemime run``) on
+    ``actor`` (an ``.actor`` file or an :class:`Actor`; default the generic head) to ``out``
+    (``.glb``); an existing ``out`` is refused unless ``force``."""
+    from facemime.io.actor_file import load_actor
+
+    t0 = time.perf_counter()
+    out = Path(out)
+    if out.suffix.lower() != ".glb":
+        raise InvalidInputError(f"the output must end in .glb, got {out.name!r}")
+    actor_path = actor if isinstance(actor, (str, Path)) else None
+    check_outputs([out], force, inputs=[track, actor_path])
+    if not Path(track).is_file():
+        raise InputFileError(
+            f"track file {track} does not exist" if not Path(track).exists() else f"track file {track} is not a file"
+        )
+    chosen = load_actor(actor) if isinstance(actor, (str, Path)) else actor
+    perf = load_performance(track, chosen)
+    data = glb_bytes(perf)
+    write_bytes(out, data)
+    return ExportResult(out, len(perf.times), len(perf.names), len(data), time.perf_counter() - t0)

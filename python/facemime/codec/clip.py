@@ -1,0 +1,183 @@
+"""``facemime encode`` and ``facemime decode``: a face video to an ``.fmstream`` file, and an
+``.fmstream`` file (with the actor it carries or names) to a video of the synthesised face.
+
+Encoding analyses the whole video first (fit, track, head pose, knot offsets), learns the basis
+of the knots' motion from this clip (its principal directions; sent once, in the header), picks
+each parameter's starting table from the clip, then codes the frames. With a target rate, it
+takes the finest quality whose motion fits. With an appearance budget, it reads the video again
+and puts appearance updates (:mod:`facemime.codec.appearance`) between the packets. A track
+file (``.json``: from ``facemime run``, or expression weights written by hand) is coded from its
+recorded motion instead of analysing a video (:func:`track_clip`). Decoding needs only the
+stream and, when the stream does not carry it, the actor.
+"""
+
+from __future__ import annotations
+
+import io
+import time
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from facemime import _core
+from facemime.animate.analysis import FrameMotion, analysed
+from facemime.animate.deform import Deformer
+from facemime.animate.synth import Puppet
+from facemime.codec.appearance import AppearanceSender
+from facemime.codec.params import Basis, pose_vector
+from facemime.codec.stream import LADDER, MotionDecoder, MotionEncoder, Settings
+from facemime.errors import InputFileError
+from facemime.io.video import VideoReader
+from facemime.progress import track as progress
+from facemime.types.actor import Actor
+from facemime.types.head import model_iod
+from facemime.types.look import Look
+
+SUFFIX = ".fmstream"
+#: Largest stream file read, bytes.
+MAX_STREAM_BYTES = 1 << 30
+#: A stream file is refused when it conceals more than this many frames per frame decoded (and a
+#: minute besides): sequence numbers that jump far ahead would otherwise make hours of video.
+MAX_CONCEALED_RATIO = 10
+#: The largest appearance budget, kbit/s (more is a video codec's business).
+MAX_APPEARANCE = 1000.0
+#: The most basis vectors any quality uses (the clip's basis is learned once at this size).
+MAX_COEFFICIENTS = max(m for _, m in LADDER)
+
+
+@dataclass
+class Clip:
+    """A video's analysis: its actor, frame rate, size (width, height) and per-frame motion."""
+
+    actor: Actor
+    fps: float
+    size: tuple[int, int]
+    motion: list[FrameMotion]
+    warnings: list[str]
+    seconds: float
+
+
+def analyse(video: str | Path, actor: Actor | None = None) -> Clip:
+    """Fit (or place ``actor``), track and measure every frame of ``video``."""
+    t0 = time.perf_counter()
+    with VideoReader(video) as reader:
+        analysis, motion = None, []
+        frames = progress(reader, reader.frames or None, "analysing")
+        for _, current, m in analysed(frames, str(video), actor=actor, fps=reader.fps):
+            analysis = current
+            motion.append(m)
+        if analysis is None:
+            raise InputFileError(f"video {video} has no frames")
+        return Clip(
+            actor or analysis.actor,
+            reader.fps,
+            (reader.width, reader.height),
+            motion,
+            list(analysis.warnings) + list(reader.warnings),
+            time.perf_counter() - t0,
+        )
+
+
+def track_clip(track: str | Path, actor: Actor | None = None) -> Clip:
+    """The motion of the ``facemime.track/1`` file ``track`` as a clip, on ``actor`` (default:
+    the generic painted head) as ``view`` plays it (:mod:`facemime.animate.replay`): the track's
+    size and frame rate, its motion measured on the actor itself."""
+    from facemime.animate.replay import load_replay
+
+    t0 = time.perf_counter()
+    replay = load_replay(track, actor)
+    if not any(m.face for m in replay.motion):
+        raise InputFileError(f"track {track} has no frame with a face")
+    return Clip(replay.actor, replay.fps, replay.size, replay.in_actor_units(), [], time.perf_counter() - t0)
+
+
+def _look(frame: FrameMotion) -> Look:
+    # a frame's look; neutral for motion made without one (FrameMotion before it had a look)
+    return getattr(frame, "look", None) or Look()
+
+
+def encode_clip(
+    clip: Clip, settings: Settings, carry_actor: bool, basis: Basis | None = None
+) -> tuple[bytes, bytes, list[bytes]]:
+    """The stream of an analysed clip: (header, actor chunk or b"", packets). ``basis``: the
+    clip's (default: learned from it, at the settings' size). The stream carries the frames'
+    looks (format version 2) when a frame with a face has a look that is not neutral; otherwise
+    it is a version-1 stream."""
+    faces = [m for m in clip.motion if m.face]
+    m = settings.basis_size
+    if basis is None:
+        basis = Basis.learn(np.array([f.offsets for f in faces]).reshape(len(faces), -1, 2), m)
+    basis = Basis(basis.raw[:m])
+    look = any(np.any(_look(f).vector() != 0) for f in faces)
+    steps = settings.steps(m, look)
+    values = np.array(
+        [
+            np.concatenate([pose_vector(f.pose), basis.coefficients(f.offsets)] + ([_look(f).vector()] if look else []))
+            for f in faces
+        ]
+    )
+    classes = _core.choose_classes(steps, settings.hysteresis, values.reshape(len(faces), len(steps)))
+    enc = MotionEncoder(
+        clip.actor, clip.fps, clip.size, basis, settings, carry_actor, classes, reference=clip.motion[0].pose, look=look
+    )
+    packets = [enc.push(f.face, f.lost, f.pose, f.offsets, _look(f) if look else None).data for f in clip.motion]
+    packets.append(enc.finish())
+    start = enc.start()
+    return enc.header, start[len(enc.header) :], [p for p in packets if p]
+
+
+def with_appearance(
+    video: str | Path,
+    clip: Clip,
+    header: bytes,
+    actor_chunk: bytes,
+    packets: list[bytes],
+    settings: Settings,
+    budget: float,
+) -> tuple[list[bytes], AppearanceSender]:
+    """``packets`` with appearance updates (:mod:`facemime.codec.appearance`) of at most
+    ``budget`` kbit/s put before the packet holding each update's first frame: ``video`` is read
+    again, each frame laid onto the texture through what the receiver draws (the stream decoded
+    here). Returns the chunks and the sender (its texture is the receiver's at the end)."""
+    decoder = MotionDecoder(None if actor_chunk else clip.actor)
+    decoded = decoder.push(header + actor_chunk + b"".join(packets)) + decoder.finish()
+    held = decoder.actor  # the actor as the receiver holds it: its texture as the stream carries it
+    puppet = Puppet(held, Deformer(held.model).feature_sizes(), model_iod(held.model), mask_only=True)
+    sender = AppearanceSender(held.model, held.texture, budget, clip.fps)
+    per_packet = settings.framing(clip.fps)[0]
+    before: dict[int, list[bytes]] = {}
+    with VideoReader(video) as reader:
+        for i, (frame, f) in enumerate(zip(progress(reader, len(decoded), "appearance"), decoded)):
+            if f.face and not f.concealed:
+                payload = sender.update(i, frame, puppet.vertices(f.offsets, look=f.look), puppet.pose(f.pose))
+                if payload is not None:
+                    before.setdefault(i // per_packet, []).append(_core.appearance_chunk(payload))
+    return [c for k, p in enumerate(packets) for c in before.get(k, []) + [p]], sender
+
+
+def scene_bytes(actor_chunk: bytes) -> int:
+    """Bytes of the scene image inside a stream's actor chunk (``docs/bitstream.md``: tag, seq,
+    LEB128 length, payload = the actor file, CRC-32); 0 without a chunk or a scene."""
+    if not actor_chunk:
+        return 0
+    at = 3
+    while actor_chunk[at] & 0x80:  # the length's bytes
+        at += 1
+    with zipfile.ZipFile(io.BytesIO(actor_chunk[at + 1 : -4])) as z:
+        return sum(i.compress_size for i in z.infolist() if i.filename.startswith("scene."))
+
+
+def read_stream(path: str | Path) -> bytes:
+    """The bytes of a stream file (one-line errors for a missing, unreadable or huge file)."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputFileError(f"stream {path} does not exist" if not path.exists() else f"stream {path} is not a file")
+    size = path.stat().st_size
+    if size > MAX_STREAM_BYTES:
+        raise InputFileError(f"stream {path} is {size} bytes, more than the {MAX_STREAM_BYTES} allowed")
+    try:
+        return path.read_bytes()
+    except OSError as e:
+        raise InputFileError(f"cannot read {path}: {e.strerror or e}") from None
