@@ -25,7 +25,8 @@ import cv2
 import numpy as np
 
 from facemime.head import generic_head, painted_texture
-from facemime.render import Pose, fill, project, render_mesh_into
+from facemime.render import fill, render_mesh_into
+from facemime.types.pose import Pose, project
 
 SIZES = ((128, 128), (640, 480))
 BACKGROUND = 30  # grey level

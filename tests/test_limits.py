@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from facemime.cli.main import main
+from cli.test_cli import run
 from facemime.errors import InvalidInputError, ModelFormatError
 from facemime.head import generic_head
 from facemime.io.head_file import head_document, head_from_document, load_head
@@ -24,14 +24,6 @@ def grid_wfm(path, side):
     lines += ["# FACE LIST:", str(len(faces))] + [" ".join(map(str, f)) for f in faces] + ["# END OF FILE:", ""]
     path.write_text("\n".join(lines))
     return path
-
-
-def run(capsys, *args):
-    with pytest.raises(SystemExit) as exc:
-        main(list(args))
-        raise SystemExit(0)
-    out, err = capsys.readouterr()
-    return exc.value.code or 0, out, err
 
 
 def test_wfm_just_over_the_vertex_limit_is_refused(tmp_path, monkeypatch):

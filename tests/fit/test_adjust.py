@@ -5,9 +5,10 @@ import pytest
 
 from facemime import _core
 from facemime.errors import InvalidInputError
-from facemime.fit import check_points, fit_model, frontal_pose
+from facemime.fit import fit_model, frontal_pose
 from facemime.head import generic_head
 from facemime.metrics import curve_error
+from facemime.types.points import check_points
 from facemime.types.pose import project
 
 

@@ -3,7 +3,8 @@ import pytest
 
 from facemime.errors import InvalidInputError
 from facemime.head import generic_head, painted_texture
-from facemime.render import Pose, coverage, fill, project, render_mesh, render_mesh_into
+from facemime.render import coverage, fill, render_mesh, render_mesh_into
+from facemime.types.pose import Pose, project
 
 RNG = np.random.default_rng(7)
 

@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 
 from facemime.metrics import curve_error, group_nme
-from facemime.track import CONTOUR_NAMES, Tracker
+from facemime.track import Tracker
 from facemime.track.brows import BrowSearch
 from facemime.track.params import TrackerParams
 from facemime.track.synthetic import SKIN, band_face
-from facemime.types.contours import GROUPS
+from facemime.types.contours import CONTOUR_NAMES, GROUPS
 
 BROWS = [n for n in CONTOUR_NAMES if n.startswith("brow")]
 

@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 
 from facemime.metrics import curve_error, group_nme
-from facemime.track import CONTOUR_NAMES, Tracker
+from facemime.track import Tracker
 from facemime.track.lips import lip_colour
 from facemime.track.mouth import mouth_shift, relocate
 from facemime.track.params import TrackerParams
 from facemime.track.synthetic import LIP, SKIN, band_face
 from facemime.track.template import find
-from facemime.types.contours import GROUPS
+from facemime.types.contours import CONTOUR_NAMES, GROUPS
 
 MOUTH = [n for n in CONTOUR_NAMES if n.startswith("mouth")]
 

@@ -5,10 +5,10 @@ import pytest
 
 from facemime.errors import InvalidInputError
 from facemime.metrics import curve_error, group_nme
-from facemime.track import CONTOUR_NAMES, FEATURES, Tracker
+from facemime.track import Tracker
 from facemime.track.params import TrackerParams
 from facemime.track.synthetic import band_face
-from facemime.types.contours import GROUPS
+from facemime.types.contours import CONTOUR_NAMES, FEATURES, GROUPS
 
 
 def sequence(steps, **per_step):

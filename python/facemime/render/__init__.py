@@ -1,7 +1,7 @@
-"""Synthesis (docs/method.md §3): orthographic projection, back-face culling, far-to-near order and
-per-triangle affine texture mapping, the last three in the Rust core."""
+"""Synthesis (docs/method.md §3): back-face culling, far-to-near order and per-triangle affine
+texture mapping, in the Rust core, of vertices projected by :func:`facemime.types.pose.project`;
+the scene around the face and views of a head."""
 
 from facemime.render.raster import RenderStats, coverage, fill, render_mesh, render_mesh_into
-from facemime.types.pose import Pose, project, rotation_matrix
 
-__all__ = ["Pose", "RenderStats", "coverage", "fill", "project", "render_mesh", "render_mesh_into", "rotation_matrix"]
+__all__ = ["RenderStats", "coverage", "fill", "render_mesh", "render_mesh_into"]

@@ -6,6 +6,5 @@ The public entry point is :class:`facemime.track.Tracker`, fed one frame at a ti
 from facemime.track.knots import FrameResult
 from facemime.track.params import TrackerParams
 from facemime.track.tracker import Tracker
-from facemime.types.contours import CONTOUR_NAMES, FEATURES
 
-__all__ = ["CONTOUR_NAMES", "FEATURES", "FrameResult", "Tracker", "TrackerParams"]
+__all__ = ["FrameResult", "Tracker", "TrackerParams"]

@@ -63,7 +63,7 @@ class Tracker(Searches):
     frame : (H, W, 3) uint8 array
         The RGB frame the contours were drawn on.
     contours : mapping of str to (N, 2) float array
-        All eight contours of ``facemime.track.CONTOUR_NAMES``, (x, y) pixels, image-left to
+        All eight contours of ``facemime.types.contours.CONTOUR_NAMES``, (x, y) pixels, image-left to
         image-right; the two curves of each mouth contour share their end points.
     params : TrackerParams, optional
 

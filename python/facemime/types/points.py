@@ -3,7 +3,7 @@
 Points are (x, y) pixels of the photo, x right, y down, (0, 0) at the centre of the top-left
 pixel. Each name maps to a chain of generic-head vertices (``model_chain``): a single point is a
 chain of one vertex, a curve is ordered like the model group of the same name (image-left to
-image-right for the mouth and brow curves of :data:`facemime.track.CONTOUR_NAMES`, clockwise
+image-right for the mouth and brow curves of :data:`facemime.types.contours.CONTOUR_NAMES`, clockwise
 from the forehead top for ``face_outline``).
 """
 
