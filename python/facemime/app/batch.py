@@ -20,7 +20,7 @@ from typing import Any
 
 from facemime.batch.cluster import dashboard_link, open_client
 from facemime.batch.inputs import Item, list_videos
-from facemime.batch.manifest import RESULTS, Manifest, is_complete, result_paths
+from facemime.batch.manifest import RESULTS, Manifest, result_paths
 from facemime.batch.worker import START_SECONDS, TIMEOUT_EVENT, Task, process
 from facemime.errors import InvalidInputError
 from facemime.io.outputs import OutputFileError
@@ -48,33 +48,6 @@ class BatchResult:
     seconds: float = 0.0
     manifest: Path | None = None
     dashboard: str | None = None
-
-
-def check_task(
-    name: str,
-    video: str,
-    results: list[str],
-    what: str,
-    timeout_per_frame: float | None,
-    task: Task,
-    previous: dict[str, Any] | None,
-    start_seconds: float,
-) -> dict[str, Any]:
-    """A worker's task for one video: the earlier manifest line, marked ``skipped``, when the
-    results it describes are complete and valid; otherwise the line of a new run
-    (:func:`facemime.batch.worker.process`)."""
-    paths = [Path(p) for p in results]
-    if previous is not None and is_complete(previous, Path(video), paths, what):
-        return {**previous, "skipped": True}
-    _remove_temporaries(paths)
-    return process(name, video, results, what, timeout_per_frame, task, start_seconds)
-
-
-def _remove_temporaries(paths: list[Path]) -> None:
-    """Remove the temporary files an earlier, killed run of this video left beside its results."""
-    for p in paths:
-        for tmp in p.parent.glob(f".{p.stem}.*.part{p.suffix}") if p.parent.is_dir() else ():
-            tmp.unlink(missing_ok=True)
 
 
 def run_batch(
@@ -170,7 +143,7 @@ def _submit(
 ) -> Any:
     results = [str(p) for p in result_paths(out_dir, item.name, what)]
     return client.submit(
-        check_task,
+        process,
         item.name,
         str(item.path),
         results,

@@ -14,7 +14,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from facemime.batch.manifest import result_sizes, source_stamp, summarise
+from facemime.batch.manifest import is_complete, result_sizes, source_stamp, summarise
 from facemime.errors import FacemimeError
 from facemime.io.video import VideoReader
 
@@ -77,6 +77,13 @@ def declared_frames(video: Path) -> int:
         return 0
 
 
+def _remove_temporaries(paths: list[Path]) -> None:
+    """Remove the temporary files an earlier, killed run of this video left beside its results."""
+    for p in paths:
+        for tmp in p.parent.glob(f".{p.stem}.*.part{p.suffix}") if p.parent.is_dir() else ():
+            tmp.unlink(missing_ok=True)
+
+
 def process(
     name: str,
     video: str,
@@ -84,14 +91,20 @@ def process(
     what: str,
     timeout_per_frame: float | None,
     task: Task,
+    previous: dict[str, Any] | None = None,
     start_seconds: float = START_SECONDS,
 ) -> dict[str, Any]:
-    """Run ``task`` (the command's work, :func:`facemime.app.batch.default_task`) on ``video``
-    within ``start_seconds`` + ``timeout_per_frame`` s × its declared frames (None: no limit),
-    check the results and return its manifest line (see :mod:`facemime.batch.manifest`)."""
+    """The manifest line (see :mod:`facemime.batch.manifest`) of one video: ``previous``, its
+    earlier line, marked ``skipped`` when the results it describes are complete and valid;
+    otherwise that of a new run of ``task`` (the command's work,
+    :func:`facemime.app.batch.default_task`) on ``video`` within ``start_seconds`` +
+    ``timeout_per_frame`` s × its declared frames (None: no limit), its results checked."""
+    path, paths = Path(video), [Path(p) for p in results]
+    if previous is not None and is_complete(previous, path, paths, what):
+        return {**previous, "skipped": True}
+    _remove_temporaries(paths)
     pin_threads()
     t0 = time.perf_counter()
-    path, paths = Path(video), [Path(p) for p in results]
     record: dict[str, Any] = {"video": name, "path": video, "what": what, "source": source_stamp(path)}
     frames = declared_frames(path) if timeout_per_frame is not None else 0
     limit = None if timeout_per_frame is None else start_seconds + timeout_per_frame * frames
