@@ -36,6 +36,28 @@ MAX_POSE_ANGLE, POSE_SCALES, MAX_POSE_POSITION = 360.0, (1e-3, 1e4), 1e6
 def pose_in_range(yaw: float, pitch: float, roll: float, scale: float, tx: float, ty: float) -> bool:
     """Whether a head pose's values are finite and within the limits above.
 
+    Parameters
+    ----------
+    yaw
+        Degrees, at most :data:`MAX_POSE_ANGLE` either way.
+    pitch
+        Degrees, at most :data:`MAX_POSE_ANGLE` either way.
+    roll
+        Degrees, at most :data:`MAX_POSE_ANGLE` either way.
+    scale
+        Pixels per model unit, within :data:`POSE_SCALES`.
+    tx
+        Image x of the model origin, pixels, at most :data:`MAX_POSE_POSITION` either way.
+    ty
+        Image y of the model origin, pixels, at most :data:`MAX_POSE_POSITION` either way.
+
+    Returns
+    -------
+    bool
+        True when every value is finite and within its limit.
+
+    Examples
+    --------
     >>> pose_in_range(10.0, 0.0, 2.0, 1.9, 250.0, 240.0), pose_in_range(0.0, 0.0, 0.0, 1e300, 0.0, 0.0)
     (True, False)
     """
@@ -59,7 +81,18 @@ DEFAULTS = {
 
 
 def limit(name: str) -> int:
-    """The limit ``name`` (a key of :data:`DEFAULTS`), from the environment when set there."""
+    """An input limit, from the environment when set there.
+
+    Parameters
+    ----------
+    name
+        The limit's environment variable, a key of :data:`DEFAULTS`.
+
+    Returns
+    -------
+    int
+        The variable's value (a positive whole number), else the default.
+    """
     value = os.environ.get(name)
     if value is None:
         return DEFAULTS[name]
@@ -77,8 +110,20 @@ os.environ.setdefault("OPENCV_IO_MAX_IMAGE_PIXELS", str(limit("FACEMIME_MAX_IMAG
 
 
 def image_size(data: bytes) -> tuple[int, int] | None:
-    """(width, height) from the header of a PNG, JPEG, WebP or BMP file (its first bytes; a
-    JPEG's size may sit after its metadata, up to the first 256 KiB); None for other data."""
+    """The size an image file's header declares, for PNG, JPEG, WebP and BMP files.
+
+    Parameters
+    ----------
+    data
+        The file's first bytes (a JPEG's size may sit after its metadata, up to the first
+        256 KiB).
+
+    Returns
+    -------
+    tuple of (int, int) or None
+        (width, height) pixels; None for other data, or a JPEG whose frame header lies beyond
+        ``data``.
+    """
     if len(data) >= 24 and data[:8] == b"\x89PNG\r\n\x1a\n":
         return int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")  # the IHDR size
     if len(data) >= 30 and data[:4] == b"RIFF" and data[8:12] == b"WEBP":
@@ -111,7 +156,13 @@ def image_size(data: bytes) -> tuple[int, int] | None:
 
 
 def check_image_file(path: Path) -> None:
-    """Refuse an image file whose header declares more pixels than the policy allows."""
+    """Refuse an image file whose header declares more pixels than the policy allows.
+
+    Parameters
+    ----------
+    path
+        The image file; its first 256 KiB are read.
+    """
     try:
         with open(path, "rb") as f:
             head = f.read(256 << 10)
@@ -127,8 +178,21 @@ def check_image_file(path: Path) -> None:
 
 
 def parse_json(text: str | bytes, where: str) -> Any:
-    """Parse JSON ``text``; a document nested too deeply for the parser is refused in one line
-    (``ValueError`` with the reason, like a malformed one)."""
+    """Parse JSON text; a document nested too deeply for the parser is refused in one line
+    (``ValueError`` with the reason, like a malformed one).
+
+    Parameters
+    ----------
+    text
+        The JSON document.
+    where
+        Names the document (its file) in the refusal of one nested too deeply.
+
+    Returns
+    -------
+    Any
+        The parsed document.
+    """
     try:
         return json.loads(text)
     except RecursionError:
@@ -136,7 +200,21 @@ def parse_json(text: str | bytes, where: str) -> Any:
 
 
 def read_json_text(path: Path, what: str) -> bytes:
-    """The bytes of the JSON ``what`` file ``path``, refused when larger than the policy allows."""
+    """The bytes of a JSON file, refused when larger than the policy allows
+    (``FACEMIME_MAX_JSON_BYTES``).
+
+    Parameters
+    ----------
+    path
+        The file.
+    what
+        The kind of file (``"init"``, ``"track"``, ``"points"``), named in error messages.
+
+    Returns
+    -------
+    bytes
+        The whole file.
+    """
     if not path.is_file():
         raise InputFileError(
             f"{what} file {path} does not exist" if not path.exists() else f"{what} file {path} is not a file"

@@ -15,11 +15,27 @@ NAMES = r"(?:127\.0\.0\.1|localhost)"
 
 
 def addressed_here(hosts: Sequence[str], origins: Sequence[str], port: int) -> bool:
-    """Whether a request may be answered by a server on 127.0.0.1:``port``, given the values of
-    its ``Host`` headers (exactly one: this machine's name, with this port or none) and of its
-    ``Origin`` headers (none, or one: ``http://`` this machine's name and this port); names are
-    matched without regard to case.
+    """Whether a request may be answered by a server on 127.0.0.1:``port``; names are matched
+    without regard to case.
 
+    Parameters
+    ----------
+    hosts
+        The values of the request's ``Host`` headers: there must be exactly one, this machine's
+        name (``127.0.0.1`` or ``localhost``) with ``port`` or with no port.
+    origins
+        The values of its ``Origin`` headers: none, or one that is ``http://``, this machine's
+        name and ``port``.
+    port
+        The TCP port the server listens on.
+
+    Returns
+    -------
+    bool
+        True when the request may be answered, False when it must be refused (403).
+
+    Examples
+    --------
     >>> addressed_here(["localhost:8765"], ["http://127.0.0.1:8765"], 8765)
     True
     >>> addressed_here(["127.0.0.1:8765"], ["http://localhost:3000"], 8765)

@@ -19,6 +19,20 @@ FAILURE_NME = 0.10
 def resample(curve: np.ndarray, n: int = SAMPLES) -> np.ndarray:
     """``n`` points equally spaced in arc length along a polyline, both ends included.
 
+    Parameters
+    ----------
+    curve
+        (M, 2) float array, M >= 2: the polyline's (x, y) vertices, pixels.
+    n
+        How many points to take.
+
+    Returns
+    -------
+    (n, 2) float64 array
+        The points, (x, y) pixels, from the first vertex of ``curve`` to its last.
+
+    Examples
+    --------
     >>> resample(np.array([[0.0, 0.0], [4.0, 0.0]]), 5)[:, 0].tolist()
     [0.0, 1.0, 2.0, 3.0, 4.0]
     """
@@ -39,7 +53,21 @@ def _distance_to_polyline(points: np.ndarray, line: np.ndarray) -> np.ndarray:
 
 
 def curve_error(pred: object, ref: np.ndarray) -> float:
-    """Symmetric mean curve distance in pixels; +inf when ``pred`` is missing or malformed."""
+    """Symmetric mean curve distance: the mean of the two directions' mean sample distances.
+
+    Parameters
+    ----------
+    pred
+        The predicted curve: (M, 2) array-like of (x, y) pixels, or None when missing.
+    ref
+        (M, 2) float array, M >= 2: the reference curve's (x, y) pixels.
+
+    Returns
+    -------
+    float
+        The distance, pixels; +inf when ``pred`` is missing or malformed (not (M >= 2, 2), or a
+        non-finite coordinate).
+    """
     if pred is None:
         return float("inf")
     p = np.asarray(pred, dtype=np.float64)
@@ -54,14 +82,47 @@ def curve_error(pred: object, ref: np.ndarray) -> float:
 def group_nme(
     pred: Mapping[str, object] | None, ref: Mapping[str, np.ndarray], names: Sequence[str], iod: float
 ) -> float:
-    """Mean NME of the curves ``names`` of one frame (+inf if any is missing)."""
+    """Mean NME of some curves of one frame.
+
+    Parameters
+    ----------
+    pred
+        The frame's predicted curves by name, each (M, 2) (x, y) pixels; None when the frame has
+        none.
+    ref
+        The frame's reference curves by name, each (M, 2) float array of (x, y) pixels.
+    names
+        The curves to score (each must be in ``ref``).
+    iod
+        The frame's inter-ocular distance (outer eye corners), pixels.
+
+    Returns
+    -------
+    float
+        The mean of the curves' :func:`curve_error` divided by ``iod`` (no unit); +inf if any
+        predicted curve is missing or malformed.
+    """
     pred = pred or {}
     return float(np.mean([curve_error(pred.get(n), ref[n]) for n in names])) / iod
 
 
 def summarize(per_frame: np.ndarray) -> dict[str, float]:
-    """mean, median, p90, failure rate and drift of one video's per-frame NMEs (frame order,
-    +inf for failures to produce a curve)."""
+    """Summary statistics of one video's per-frame NMEs.
+
+    Parameters
+    ----------
+    per_frame
+        (F,) float array: the NME of each frame, in frame order; +inf where a curve was not
+        produced.
+
+    Returns
+    -------
+    dict of str -> float
+        ``mean`` (of the finite values), ``median`` and ``p90`` (of all, +inf included),
+        ``failure_rate`` (share of frames above :data:`FAILURE_NME` or not finite) and ``drift``
+        (mean of the last third of the frames less that of the first third, finite values);
+        NaN where there are no frames (``drift``: fewer than 3).
+    """
     v = np.asarray(per_frame, dtype=np.float64)
     finite = v[np.isfinite(v)]
     third = len(v) // 3
@@ -77,8 +138,21 @@ def summarize(per_frame: np.ndarray) -> dict[str, float]:
 
 
 def pooled_summary(per_video: Sequence[np.ndarray]) -> dict[str, float]:
-    """Summary over several videos, each weighing the same: mean, failure rate and drift are
-    means of the per-video values; median and p90 are weighted percentiles of all frames."""
+    """Summary over several videos, each weighing the same.
+
+    Parameters
+    ----------
+    per_video
+        Per video, its (F,) float array of per-frame NMEs (as :func:`summarize` takes); videos
+        without frames are skipped.
+
+    Returns
+    -------
+    dict of str -> float
+        The keys of :func:`summarize`: ``mean``, ``failure_rate`` and ``drift`` are means of the
+        per-video values (NaN ones skipped); ``median`` and ``p90`` are percentiles of all frames,
+        each weighted by 1 / its video's frame count.
+    """
     summaries = [summarize(v) for v in per_video if len(v)]
     out = {k: float(np.nanmean([s[k] for s in summaries])) for k in ("mean", "failure_rate", "drift")}
     values = np.concatenate([np.asarray(v, np.float64) for v in per_video if len(v)])

@@ -13,7 +13,23 @@ T = TypeVar("T")
 
 
 def track(items: Iterable[T], total: int | None, description: str) -> Iterator[T]:
-    """Iterate over ``items`` with a progress bar labelled ``description``."""
+    """Iterate over ``items`` with a progress bar, on stderr and only when stderr is a terminal
+    (the bar is removed when the iteration ends).
+
+    Parameters
+    ----------
+    items
+        What to iterate over.
+    total
+        How many items there are, for the bar's count and time left; None when unknown.
+    description
+        The bar's label.
+
+    Yields
+    ------
+    T
+        Each of ``items`` in turn, unchanged.
+    """
     if not sys.stderr.isatty():
         yield from items
         return

@@ -18,8 +18,24 @@ def _describe(a: object) -> str:
 
 
 def float_array(name: str, a: object, shape: tuple[int | None, ...]) -> np.ndarray:
-    """``a`` as a C-contiguous float64 array of the given shape (None = any size), all finite.
+    """An argument as a C-contiguous float64 array of a given shape, all finite.
 
+    Parameters
+    ----------
+    name
+        The argument's name, for the error message.
+    a
+        The value given: anything numpy converts to a numeric array.
+    shape
+        The expected shape, one entry per dimension; None: any size.
+
+    Returns
+    -------
+    float64 array
+        ``a`` converted (``a`` itself when it already was such an array).
+
+    Examples
+    --------
     >>> float_array("points", [[0, 1], [2, 3]], (None, 2)).dtype
     dtype('float64')
     """
@@ -37,7 +53,24 @@ def float_array(name: str, a: object, shape: tuple[int | None, ...]) -> np.ndarr
 
 
 def index_array(name: str, a: object, columns: int, count: int) -> np.ndarray:
-    """``a`` as a C-contiguous (F, columns) uint32 array of indices into ``count`` items."""
+    """An argument as a C-contiguous array of indices, e.g. triangles.
+
+    Parameters
+    ----------
+    name
+        The argument's name, for the error message.
+    a
+        The value given: a 2-D integer array (or anything numpy converts to one).
+    columns
+        The number of indices per row.
+    count
+        The number of items indexed (vertices); every index must be below it.
+
+    Returns
+    -------
+    (F, columns) uint32 array
+        ``a`` converted.
+    """
     arr = np.asarray(a)
     if arr.ndim != 2 or arr.shape[1] != columns:
         raise InvalidInputError(f"{name} must have shape (F, {columns}), got {_describe(arr)}")
@@ -50,7 +83,20 @@ def index_array(name: str, a: object, columns: int, count: int) -> np.ndarray:
 
 
 def image(name: str, a: object) -> np.ndarray:
-    """``a`` as a C-contiguous uint8 image, (H, W) gray or (H, W, C) with C in 1..4."""
+    """An argument as a C-contiguous uint8 image.
+
+    Parameters
+    ----------
+    name
+        The argument's name, for the error message.
+    a
+        The value given: a uint8 numpy array, (H, W) gray or (H, W, C) with C in 1..4, not empty.
+
+    Returns
+    -------
+    (H, W) or (H, W, C) uint8 array
+        ``a`` itself when it is C-contiguous, else a contiguous copy.
+    """
     if not isinstance(a, np.ndarray) or a.dtype != np.uint8:
         raise InvalidInputError(f"{name} must be a uint8 numpy array (H, W) or (H, W, C), got {_describe(a)}")
     if a.ndim not in (2, 3) or (a.ndim == 3 and not 1 <= a.shape[2] <= 4) or 0 in a.shape:
@@ -59,7 +105,21 @@ def image(name: str, a: object) -> np.ndarray:
 
 
 def image_size(name: str, size: object) -> tuple[int, int]:
-    """``size`` as a (width, height) pair of positive ints within the core's limits."""
+    """An argument as an image size within the core's limits.
+
+    Parameters
+    ----------
+    name
+        The argument's name, for the error message.
+    size
+        The value given: two numbers int() takes, (width, height) pixels.
+
+    Returns
+    -------
+    tuple of (int, int)
+        (width, height) pixels, each positive and at most ``_core.MAX_IMAGE_SIDE``, their
+        product at most ``_core.MAX_IMAGE_PIXELS``.
+    """
     try:
         if not isinstance(size, Iterable):
             raise TypeError
@@ -77,7 +137,22 @@ def image_size(name: str, size: object) -> tuple[int, int]:
 
 
 def choice(name: str, value: object, allowed: tuple[str, ...]) -> str:
-    """``value`` if it is one of ``allowed``."""
+    """An argument that must be one of a few names.
+
+    Parameters
+    ----------
+    name
+        The argument's name, for the error message.
+    value
+        The value given.
+    allowed
+        The names accepted.
+
+    Returns
+    -------
+    str
+        ``value``, when it is one of ``allowed``.
+    """
     if value not in allowed:
         raise InvalidInputError(f"{name} must be one of {', '.join(map(repr, allowed))}, got {value!r}")
     return str(value)

@@ -554,3 +554,18 @@ def test_a_call_of_a_video_shorter_than_its_warm_up_fails_and_records_nothing(sh
         "facemime: error: two.mp4 has 2 frames, fewer than the 50 of warm-up the call analyses before it streams"
     )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["two.mp4"]
+
+
+def test_a_head_model_with_a_short_nose_is_previewed(tmp_path, capsys):
+    """A head of one's own may have as few nose vertices as the checks allow (7): its preview is
+    drawn, without the painted nostrils a facemime head's ten-vertex nose has."""
+    from facemime.head import generic_head
+    from facemime.io.head_file import head_document
+    from facemime.types.head import MIN_GROUP_SIZES
+
+    doc = head_document(generic_head())
+    doc["groups"]["nose"] = doc["groups"]["nose"][: MIN_GROUP_SIZES["nose"]]
+    (tmp_path / "h.json").write_text(json.dumps(doc))
+    code, _out, err = run(capsys, "model-preview", str(tmp_path / "h.json"), "--out", str(tmp_path / "p.png"))
+    assert code == 0, err
+    assert (tmp_path / "p.png").stat().st_size > 0

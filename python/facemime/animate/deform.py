@@ -31,8 +31,20 @@ BROWS = tuple(n for n in CONTOUR_GROUPS if n.startswith("brow"))
 
 
 def mouth_width(model: HeadModel, vertices: np.ndarray) -> float:
-    """Distance between the mouth's corners (the ends of the outer lips) of ``vertices`` (N, 3),
-    a pose of ``model``'s, in the model's (x, y) plane, model units."""
+    """Distance between the mouth's corners (the outer lips' ends) in the model's (x, y) plane.
+
+    Parameters
+    ----------
+    model
+        The head model whose ``mouth_outer_upper`` group names the corners.
+    vertices
+        (N, 3) float array: a shape of ``model``'s (its own vertices or deformed ones), model units.
+
+    Returns
+    -------
+    float
+        The corner-to-corner distance, model units.
+    """
     first, last = model.groups["mouth_outer_upper"][[0, -1]]
     return float(np.hypot(*(vertices[last, :2] - vertices[first, :2])))
 
@@ -40,9 +52,15 @@ def mouth_width(model: HeadModel, vertices: np.ndarray) -> float:
 class Deformer:
     """Drives one head model by the eight tracked contours.
 
-    ``knots`` are the model's contour vertices (the mouth corners shared by the upper and lower
-    curves counted once), in a fixed order; ``weights`` (N, K) spreads their offsets to all N
-    vertices.
+    ``knots`` (K,) are the model's contour vertices' indices (the mouth corners shared by the
+    upper and lower curves counted once), in ascending order; ``weights`` (N, K) spreads their
+    offsets to all N vertices.
+
+    Parameters
+    ----------
+    model
+        The head model, with the eight contour groups and ``eye_left`` and ``eye_right`` (raises
+        :class:`~facemime.errors.InvalidInputError` when it lacks one).
     """
 
     def __init__(self, model: HeadModel):
@@ -91,8 +109,21 @@ class Deformer:
         return weights
 
     def knot_positions(self, contours: Mapping[str, np.ndarray], pose: Pose) -> np.ndarray:
-        """The knots' model-space (x, y) (K, 2) where the image ``contours`` (name -> (M, 2) px,
-        resampled to the model's group lengths) put them, seen in ``pose``."""
+        """The knots' model-space (x, y) where the image contours put them, seen in a pose.
+
+        Parameters
+        ----------
+        contours
+            Name -> (M, 2) float array of (x, y) pixels for each of the eight contours (resampled to
+            its model group's length where M differs; either direction along the curve).
+        pose
+            The head pose the contours are seen in; each point is taken at its knot's model depth.
+
+        Returns
+        -------
+        (K, 2) float64 array
+            Each knot's model (x, y), model units; a knot on two curves (a mouth corner) averaged.
+        """
         g, v = self.model.groups, self.model.vertices
         points = []
         for name in CONTOUR_GROUPS:
@@ -109,18 +140,46 @@ class Deformer:
         return pts / self._member_counts[:, None]
 
     def vertices(self, offsets: np.ndarray, gain: float = 1.0) -> np.ndarray:
-        """The model's vertices moved by knot ``offsets`` (K, 2) model units times ``gain`` (the
-        exaggeration): (N, 3) float64."""
+        """The model's vertices moved by knot offsets, spread by :attr:`weights`.
+
+        Parameters
+        ----------
+        offsets
+            (K, 2) float array: each knot's (x, y) offset, model units.
+        gain
+            Factor on the offsets (the exaggeration).
+
+        Returns
+        -------
+        (N, 3) float64 array
+            The moved vertices, model units; z as the model's.
+        """
         out = self.model.vertices.copy()
         out[:, :2] += gain * (self.weights @ offsets)
         return out
 
     def sealed(self, vertices: np.ndarray, closed: float) -> np.ndarray:
-        """``vertices`` (N, 3) with the lips shut where the inner lips lie closer than ``closed``
-        times the mouth's width (corner to corner, model units), measured across the corner
-        line; above that the gap opens from nothing to its full size at twice ``closed``, so the
-        opening never jumps. The inner-lip knots meet halfway and the other vertices follow
-        them like offsets (:meth:`vertices`)."""
+        """The vertices with the lips shut where the inner lips lie closer than a share of the
+        mouth's width.
+
+        The gap between the inner lips is measured across the corner line; above ``closed`` times
+        the mouth's width it opens from nothing to its full size at twice that, so the opening
+        never jumps. The inner-lip knots meet halfway and the other vertices follow them like
+        offsets (:meth:`vertices`).
+
+        Parameters
+        ----------
+        vertices
+            (N, 3) float array: the model's vertices as deformed, model units.
+        closed
+            The gap below which the lips shut, a share of the mouth's width (corner to corner).
+
+        Returns
+        -------
+        (N, 3) float64 array
+            A sealed copy; ``vertices`` itself where the inner lips' knot counts differ or the
+            mouth has no width.
+        """
         g = self.model.groups
         upper, lower = self._inner
         corners = g["mouth_outer_upper"][[0, -1]]
@@ -141,9 +200,15 @@ class Deformer:
         return out
 
     def feature_sizes(self) -> np.ndarray:
-        """Per knot, the width of its feature (the mouth's corner-to-corner distance for mouth
-        knots, the brow's length for brow knots), model units: the scale motion is measured in
-        when it is carried from one actor to another."""
+        """Per knot, the width of its feature: the scale motion is measured in when it is carried
+        from one actor to another.
+
+        Returns
+        -------
+        (K,) float64 array
+            The mouth's corner-to-corner distance for mouth knots, the brow's length (end to end,
+            in (x, y)) for brow knots, model units.
+        """
         g, v = self.model.groups, self.model.vertices
         sizes = np.zeros(len(self.knots))
         for name in CONTOUR_GROUPS:

@@ -61,9 +61,23 @@ def _hull(outline: np.ndarray, factor: float, shape: tuple[int, int]) -> np.ndar
 
 
 def departure(real: np.ndarray, synth: np.ndarray, outline: np.ndarray) -> float:
-    """How much ``real`` departs from ``synth`` ((H, W, 3) uint8 RGB of one size), 0..1 (the
-    larger share of departed pixels of the two regions, see the module docstring), the face's
-    outline now at ``outline`` ((A, 2) pixels)."""
+    """How much a real frame departs from its synthesis.
+
+    Parameters
+    ----------
+    real
+        (H, W, 3) uint8 RGB: the frame.
+    synth
+        (H, W, 3) uint8 RGB: its synthesis, the same size.
+    outline
+        (A, 2) float array: the face outline's (x, y) pixels on this frame.
+
+    Returns
+    -------
+    float
+        0..1: the larger share of departed pixels of the two regions (around the face and inside
+        it, see the module docstring).
+    """
     h, w = real.shape[:2]
     size = (max(1, w // SHRINK), max(1, h // SHRINK))
     seen, made = _shrunk(real, size), _shrunk(synth, size)

@@ -147,9 +147,21 @@ def _side(s: np.ndarray, sign: float) -> np.ndarray:
 
 
 def unit_patterns(model: HeadModel, deformer: Deformer | None = None) -> np.ndarray:
-    """(E, K, 2) knot offsets at weight 1 in units of each knot's feature size (mouth width,
-    brow length): the patterns before :meth:`Deformer.feature_sizes` scales them. Rows of the
-    blinks are zero."""
+    """The controls' knot patterns at weight 1, before :meth:`Deformer.feature_sizes` scales them.
+
+    Parameters
+    ----------
+    model
+        The head model (the generic head or an actor's, which has its groups).
+    deformer
+        ``model``'s :class:`Deformer`, whose knots the patterns are of; None: one is made.
+
+    Returns
+    -------
+    (E, K, 2) float64 array
+        Knot (x, y) offsets per control in the order of :data:`NAMES`, in units of each knot's
+        feature size (mouth width, brow length); the blinks' rows are zero.
+    """
     d = deformer or Deformer(model)
     g, v = model.groups, model.vertices
     slot = {int(k): i for i, k in enumerate(d.knots)}
@@ -218,8 +230,14 @@ def unit_patterns(model: HeadModel, deformer: Deformer | None = None) -> np.ndar
 
 @functools.cache
 def generic_unit_patterns() -> np.ndarray:
-    """:func:`unit_patterns` of the generic head (read-only): the patterns of any actor fitted
-    from it, times its feature sizes."""
+    """:func:`unit_patterns` of the generic head: the patterns of any actor fitted from it, times
+    its feature sizes.
+
+    Returns
+    -------
+    (E, K, 2) float64 array
+        Read-only, computed once.
+    """
     from facemime.head import generic_head
 
     return _frozen(unit_patterns(generic_head()))
@@ -243,7 +261,18 @@ class Expressions:
 
     @classmethod
     def of(cls, model: HeadModel) -> Expressions:
-        """The controls of ``model`` (the generic head or an actor's, which has its groups)."""
+        """The controls of a head model.
+
+        Parameters
+        ----------
+        model
+            The generic head or an actor's model (which has its groups).
+
+        Returns
+        -------
+        Expressions
+            Its patterns and fields, model units, read-only.
+        """
         d = Deformer(model)
         patterns = unit_patterns(model, d) * d.feature_sizes()[None, :, None]
         fields = np.zeros((len(NAMES), len(model.vertices), 3))
@@ -260,23 +289,66 @@ class Expressions:
         return np.array([n not in BLINKS for n in self.names])
 
     def offsets(self, weights: np.ndarray) -> np.ndarray:
-        """Knot offsets (T, K, 2) model units of ``weights`` (T, E) (or (E,) -> (K, 2))."""
+        """The knot offsets of expression weights.
+
+        Parameters
+        ----------
+        weights
+            (T, E) or (E,) float array: weights in the order of ``names``.
+
+        Returns
+        -------
+        (T, K, 2) or (K, 2) float64 array
+            Knot (x, y) offsets, model units.
+        """
         w = np.asarray(weights, np.float64)
         return np.tensordot(w, self.patterns, axes=([-1], [0]))
 
     def closure(self, weights: np.ndarray) -> np.ndarray:
-        """Lid closures (T, 2) (right eye, left eye, as ``Look.closure``) of ``weights`` (T, E)
-        (or (E,) -> (2,))."""
+        """The lid closures of expression weights.
+
+        Parameters
+        ----------
+        weights
+            (T, E) or (E,) float array: weights in the order of ``names``.
+
+        Returns
+        -------
+        (T, 2) or (2,) float64 array
+            The blinks' weights: right eye, left eye, as ``Look.closure``.
+        """
         w = np.asarray(weights, np.float64)
         return np.stack([w[..., self.names.index(n)] for n in BLINKS], axis=-1)
 
     def vertices(self, weights: np.ndarray) -> np.ndarray:
-        """The model's vertices (N, 3) with one frame's ``weights`` (E,) applied to the fields
-        (the morph; the lips are not sealed as :class:`~facemime.animate.synth.Puppet` does)."""
+        """The model's vertices with one frame's weights applied to the fields (the morph; the lips
+        are not sealed as :class:`~facemime.animate.synth.Puppet` does).
+
+        Parameters
+        ----------
+        weights
+            (E,) float array: weights in the order of ``names``.
+
+        Returns
+        -------
+        (N, 3) float64 array
+            The morphed vertices, model units.
+        """
         return self.deformer.model.vertices + np.tensordot(np.asarray(weights, np.float64), self.fields, axes=1)
 
     def solver(self, smooth: float = SMOOTH) -> FrameSolver:
-        """A solver that takes one frame at a time, as :meth:`solve` does all at once."""
+        """A solver that takes one frame at a time, as :meth:`solve` does all at once.
+
+        Parameters
+        ----------
+        smooth
+            Pull towards the previous frame's weights, a fraction of the mean squared pattern norm.
+
+        Returns
+        -------
+        FrameSolver
+            The solver, at its first frame.
+        """
         return FrameSolver(self, smooth)
 
     def _system(self, smooth: float) -> tuple[np.ndarray, np.ndarray, float]:
@@ -287,12 +359,26 @@ class Expressions:
         return a, gram, smooth * float(np.mean(np.diag(gram)))
 
     def solve(self, offsets: np.ndarray, closure: np.ndarray | None = None, smooth: float = SMOOTH) -> np.ndarray:
-        """Weights (T, E) in [0, 1] for knot ``offsets`` (T, K, 2) model units (of this model)
-        and lid ``closure`` (T, 2) (right, left; default open): per frame the bounded least
-        squares fit of the offsets by the patterns, with ``smooth`` (a fraction of the mean
-        squared pattern norm) times the squared distance to the previous frame's weights added.
-        The blinks are the closures clipped to [0, 1] (a lid opened wider than on the key frame
-        is 0)."""
+        """The weights of a sequence of knot offsets and lid closures.
+
+        Per frame the bounded least squares fit of the offsets by the patterns, with ``smooth``
+        times the squared distance to the previous frame's weights added. The blinks are the
+        closures clipped to [0, 1] (a lid opened wider than on the key frame is 0).
+
+        Parameters
+        ----------
+        offsets
+            (T, K, 2) float array: each frame's knot (x, y) offsets, model units (of this model).
+        closure
+            (T, 2) float array: each frame's lid closures (right eye, left eye); None: open.
+        smooth
+            Pull towards the previous frame's weights, a fraction of the mean squared pattern norm.
+
+        Returns
+        -------
+        (T, E) float64 array
+            Weights in [0, 1], in the order of ``names``.
+        """
         o = np.asarray(offsets, np.float64)
         if o.ndim != 3 or o.shape[1:] != self.patterns.shape[1:]:
             raise InvalidInputError(f"offsets must have shape (T, {self.patterns.shape[1]}, 2), got {o.shape}")
@@ -310,7 +396,15 @@ class Expressions:
 
 
 class FrameSolver:
-    """:meth:`Expressions.solve` one frame at a time (``facemime run`` writes weights as it goes)."""
+    """:meth:`Expressions.solve` one frame at a time (``facemime run`` writes weights as it goes).
+
+    Parameters
+    ----------
+    expressions
+        The controls whose weights are solved.
+    smooth
+        Pull towards the previous frame's weights, a fraction of the mean squared pattern norm.
+    """
 
     def __init__(self, expressions: Expressions, smooth: float = SMOOTH):
         self.expressions = expressions
@@ -320,7 +414,20 @@ class FrameSolver:
         self._qp = BoxLeastSquares(gram, lam)
 
     def step(self, offsets: np.ndarray, closure: np.ndarray | None = None) -> np.ndarray:
-        """The weights (E,) of one frame's knot ``offsets`` (K, 2) and lid ``closure`` (2,)."""
+        """The weights of the next frame.
+
+        Parameters
+        ----------
+        offsets
+            (K, 2) float array: the frame's knot (x, y) offsets, model units.
+        closure
+            (2,) float array: the frame's lid closures (right eye, left eye); None: the blinks 0.
+
+        Returns
+        -------
+        (E,) float64 array
+            Weights in [0, 1], in the order of the controls' ``names``.
+        """
         out = np.zeros(len(self.expressions.names))
         out[self._rows] = self._qp.step(np.asarray(offsets, np.float64).reshape(-1) @ self._a)
         if closure is not None:
@@ -329,7 +436,18 @@ class FrameSolver:
         return out
 
     def named(self, weights: np.ndarray) -> dict[str, float]:
-        """The non-zero ``weights`` (E,) as name -> weight, 4 decimals (a track file's ``weights``)."""
+        """One frame's weights as a track file's ``weights`` object.
+
+        Parameters
+        ----------
+        weights
+            (E,) float array: weights in the order of the controls' ``names``.
+
+        Returns
+        -------
+        dict of str to float
+            Name -> weight rounded to 4 decimals, the weights that round to 0 left out.
+        """
         return {n: round(float(x), 4) for n, x in zip(self.expressions.names, weights) if round(float(x), 4) != 0.0}
 
 
@@ -342,7 +460,17 @@ class BoxLeastSquares:
     previous frame's solution and its bounds: a frame mostly takes one or two small solves. It
     is exact (no tolerance on the optimum beyond round-off) and needs no dependency (SciPy's
     ``lsq_linear``, the alternative, is not one of facemime's); 1,000 frames of 23 controls take
-    0.13-0.20 s on one core (the shared videos, best of three; benchmarks/expressions.py)."""
+    0.13-0.20 s on one core (the shared videos, best of three; benchmarks/expressions.py).
+
+    Parameters
+    ----------
+    gram
+        (E, E) float array: G, the Gram matrix of the patterns (symmetric, positive semi-definite).
+    lam
+        λ, the pull towards the previous frame's weights.
+    upper
+        The weights' upper bound.
+    """
 
     def __init__(self, gram: np.ndarray, lam: float, upper: float = 1.0):
         e = gram.shape[0]
@@ -351,8 +479,18 @@ class BoxLeastSquares:
         self.fixed = np.ones(e, bool)  # at a bound; at first all at 0
 
     def step(self, r: np.ndarray) -> np.ndarray:
-        """The next frame's weights (E,) for its ``r`` (E,) (the patterns' dot products with its
-        offsets)."""
+        """The next frame's weights.
+
+        Parameters
+        ----------
+        r
+            (E,) float array: r_t, the patterns' dot products with the frame's offsets.
+
+        Returns
+        -------
+        (E,) float64 array
+            The weights w in [0, ``upper``] (a copy).
+        """
         h, upper, w, fixed = self.h, self.upper, self.w, self.fixed
         b = r + self.lam * w
         for _ in range(6 * len(w)):
@@ -383,6 +521,23 @@ class BoxLeastSquares:
 
 
 def box_qp_sequence(gram: np.ndarray, rhs: np.ndarray, lam: float, upper: float = 1.0) -> np.ndarray:
-    """:meth:`BoxLeastSquares.step` over every row of ``rhs`` (T, E): (T, E) weights."""
+    """:meth:`BoxLeastSquares.step` over every row of ``rhs``, from w_{-1} = 0.
+
+    Parameters
+    ----------
+    gram
+        (E, E) float array: G, the Gram matrix of the patterns.
+    rhs
+        (T, E) float array: r_t per frame, the patterns' dot products with its offsets.
+    lam
+        λ, the pull towards the previous frame's weights.
+    upper
+        The weights' upper bound.
+
+    Returns
+    -------
+    (T, E) float64 array
+        The weights per frame, in [0, ``upper``].
+    """
     solver = BoxLeastSquares(gram, lam, upper)
     return np.array([solver.step(r) for r in rhs]).reshape(len(rhs), gram.shape[0])

@@ -34,8 +34,24 @@ from facemime.types.look import Look
 
 
 def close_lids(vertices: np.ndarray, rings: list[np.ndarray], closure: np.ndarray) -> np.ndarray:
-    """``vertices`` (N, 3) with each eye's upper lid moved ``closure[k]`` of the way to its
-    lower lid (negative: away from it); ``rings`` the two eye rings' vertex indices. A copy."""
+    """The vertices with each eye's upper lid moved part of the way to its lower lid.
+
+    Parameters
+    ----------
+    vertices
+        (N, 3) float array: the model's vertices, model units.
+    rings
+        The eye rings' (8,) vertex indices (:mod:`facemime.track.eyes` says their order), one per
+        eye in the order of ``closure``.
+    closure
+        (2,) float array: per eye, the share of the way its upper-lid vertices move to the lower
+        lid's below them (1: onto them; negative: away from them).
+
+    Returns
+    -------
+    (N, 3) float array
+        A copy of ``vertices`` with the lids moved, model units.
+    """
     out = vertices.copy()
     for ring, c in zip(rings, closure):
         if c:
@@ -46,7 +62,16 @@ def close_lids(vertices: np.ndarray, rings: list[np.ndarray], closure: np.ndarra
 
 class _Eye:
     """One eye of the texture: its region, the region with the iris painted out, the iris patch,
-    its alpha, and the opening's mask."""
+    its alpha, and the opening's mask.
+
+    Parameters
+    ----------
+    texture
+        (H, W, 3) uint8 RGB: the actor's texture (the key frame's face, iris and all).
+    ring_px
+        (8, 2) float array: the eye ring's vertices (corner, 3 upper, corner, 3 lower) in texture
+        pixels, (x, y) with (0, 0) the centre of the top-left texel.
+    """
 
     def __init__(self, texture: np.ndarray, ring_px: np.ndarray):
         frame = EyeFrame.of(ring_px)
@@ -96,8 +121,15 @@ class _Eye:
         self.clean = self.iris + blend * (fill - self.iris)
 
     def paint(self, out: np.ndarray, shift: np.ndarray) -> None:
-        """Paint the eye into ``out`` (the texture's working copy) with the iris shifted by
-        ``shift`` (u, v) eye widths."""
+        """Paint the eye into the texture's working copy, with the iris shifted.
+
+        Parameters
+        ----------
+        out
+            (H, W, 3) uint8 RGB: the texture's working copy, painted in place (the eye's box whole).
+        shift
+            (2,) float array: the iris's shift (u, v), eye widths (:mod:`facemime.types.look`).
+        """
         x0, y0, x1, y1 = self.box
         d = np.asarray(shift, np.float64) @ self.frame.axes  # texture px
         if np.abs(d).max() < PASTE_STILL:
@@ -110,8 +142,14 @@ class _Eye:
 
 
 class LookPainter:
-    """Paints a :class:`~facemime.types.look.Look` on ``actor``: :meth:`vertices` closes the
-    lids, :meth:`texture` moves the irises."""
+    """Paints a :class:`~facemime.types.look.Look` on an actor: :meth:`vertices` closes the lids,
+    :meth:`texture` moves the irises.
+
+    Parameters
+    ----------
+    actor
+        The actor whose eye rings and texture are painted.
+    """
 
     def __init__(self, actor: Actor):
         self.actor = actor
@@ -122,12 +160,35 @@ class LookPainter:
         self._work = actor.texture.copy()
 
     def vertices(self, vertices: np.ndarray, look: Look) -> np.ndarray:
-        """``vertices`` with the lids closed by ``look.closure``."""
+        """The vertices with the lids closed by a look's closure.
+
+        Parameters
+        ----------
+        vertices
+            (N, 3) float array: the actor's model vertices, as deformed, model units.
+        look
+            The look whose ``closure`` closes the lids.
+
+        Returns
+        -------
+        (N, 3) float array
+            A copy with the lids moved (:func:`close_lids`), model units.
+        """
         return close_lids(vertices, self.rings, look.closure)
 
     def texture(self, look: Look) -> np.ndarray:
-        """The actor's texture with the irises shifted by ``look`` (a working copy, valid until
-        the next call)."""
+        """The actor's texture with the irises shifted by a look.
+
+        Parameters
+        ----------
+        look
+            The look whose ``iris`` shifts the irises.
+
+        Returns
+        -------
+        (H, W, 3) uint8 array
+            RGB, the actor's texture's size: a working copy, valid until the next call.
+        """
         out = self._work  # each eye's box is painted whole: the rest stays the actor's texture
         for eye, shift in zip(self._eyes, look.iris):
             eye.paint(out, shift)

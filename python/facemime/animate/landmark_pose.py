@@ -43,8 +43,18 @@ ROUNDS = 3
 
 
 def camera_points(landmarks: np.ndarray) -> np.ndarray:
-    """(N, 3) landmarks (x, y px, depth px smaller = nearer) in camera coordinates (x right, y
-    up, z towards the camera)."""
+    """Landmarks in camera coordinates: ``(x, -y, -depth)``.
+
+    Parameters
+    ----------
+    landmarks
+        (N, 3) float array: (x, y) image pixels and depth, pixels, smaller = nearer the camera.
+
+    Returns
+    -------
+    (N, 3) float64 array
+        Camera coordinates, pixels: x right, y up, z towards the camera.
+    """
     p = np.asarray(landmarks, np.float64)
     return np.column_stack([p[:, 0], -p[:, 1], -p[:, 2]])
 
@@ -52,10 +62,30 @@ def camera_points(landmarks: np.ndarray) -> np.ndarray:
 def procrustes(
     source: np.ndarray, target: np.ndarray, weights: np.ndarray | None = None
 ) -> tuple[float, np.ndarray, np.ndarray]:
-    """The similarity that best maps ``source`` (N, 3) onto ``target`` (N, 3) in the weighted
-    least-squares sense (Umeyama): ``target ≈ scale · source @ rotation.T + translation``, the
-    rotation proper (determinant +1). Returns (scale, rotation (3, 3), translation (3,)).
+    """The similarity that best maps one point set onto another in the weighted least-squares
+    sense (Umeyama): ``target ≈ scale · source @ rotation.T + translation``, the rotation proper
+    (determinant +1).
 
+    Parameters
+    ----------
+    source
+        (N, 3) float array: the points mapped.
+    target
+        (N, 3) float array: where they should land, in order.
+    weights
+        (N,) float array: non-negative weight per point (normalised to sum 1); None: equal.
+
+    Returns
+    -------
+    scale : float
+        Target units per source unit.
+    rotation : (3, 3) float64 array
+        The rotation, determinant +1.
+    translation : (3,) float64 array
+        In target units.
+
+    Examples
+    --------
     >>> r = rotation_matrix(yaw=20, pitch=-10, roll=5)
     >>> src = np.random.default_rng(0).normal(size=(10, 3))
     >>> s, rot, t = procrustes(src, 2 * src @ r.T + [1, 2, 3])
@@ -77,9 +107,21 @@ def procrustes(
 
 
 def angles(rotation: np.ndarray) -> tuple[float, float, float]:
-    """(yaw, pitch, roll) degrees of a rotation ``Rz(roll) @ Rx(pitch) @ Ry(yaw)``
+    """The angles of a rotation ``Rz(roll) @ Rx(pitch) @ Ry(yaw)``
     (:func:`~facemime.types.pose.rotation_matrix`'s convention).
 
+    Parameters
+    ----------
+    rotation
+        (3, 3) float array: a proper rotation matrix.
+
+    Returns
+    -------
+    tuple of (yaw, pitch, roll)
+        Degrees; pitch in [-90, 90], yaw and roll in (-180, 180].
+
+    Examples
+    --------
     >>> np.round(angles(rotation_matrix(yaw=30, pitch=-12, roll=7)), 9).tolist()
     [30.0, -12.0, 7.0]
     """
@@ -95,12 +137,16 @@ class LandmarkPose:
 
     Parameters
     ----------
-    landmarks : (468, 3) float array
-        The key frame's landmarks (x, y px, depth px), where the actor was fitted.
-    pose : Pose
+    landmarks
+        (468, 3) float array: the key frame's Face Mesh landmarks, (x, y) image pixels and depth,
+        pixels (smaller = nearer), where the actor was fitted.
+    pose
         The actor's pose on the key frame.
-    vertices, triangles : (N, 3) float and (F, 3) int arrays
-        The actor's mesh (model units), which sets the lifted points' depth offset.
+    vertices
+        (N, 3) float array: the actor's mesh vertices, model units; with ``triangles`` it sets the
+        lifted points' depth offset.
+    triangles
+        (F, 3) int array: the mesh's triangles, vertex indices.
     """
 
     def __init__(self, landmarks: np.ndarray, pose: Pose, vertices: np.ndarray, triangles: np.ndarray):
@@ -116,7 +162,19 @@ class LandmarkPose:
         self._size = float(np.sqrt(((self.points - self.points.mean(axis=0)) ** 2).sum(axis=1).mean()))
 
     def measure(self, landmarks: np.ndarray) -> Pose:
-        """The pose on a frame whose landmarks are ``landmarks`` ((468, 3) x, y px, depth px)."""
+        """The head pose on a frame.
+
+        Parameters
+        ----------
+        landmarks
+            (468, 3) float array: the frame's Face Mesh landmarks, (x, y) image pixels and depth,
+            pixels (smaller = nearer).
+
+        Returns
+        -------
+        Pose
+            The actor's pose on the frame, in the model's frame (not relative to the key frame).
+        """
         target = camera_points(np.asarray(landmarks, np.float64)[list(RIGID)])
         weights = np.ones(len(target))
         for _ in range(ROUNDS):
@@ -149,7 +207,20 @@ class OneEuro:
         return 1.0 / (1.0 + tau / dt)
 
     def __call__(self, x: np.ndarray, dt: float) -> np.ndarray:
-        """The filtered value of sample ``x`` taken ``dt`` seconds after the last."""
+        """Filter the next sample.
+
+        Parameters
+        ----------
+        x
+            The sample, a float array of the same shape every call.
+        dt
+            Seconds since the last sample (> 0; unused on the first).
+
+        Returns
+        -------
+        float64 array
+            The filtered value, ``x``'s shape (a copy; the first sample as it is).
+        """
         x = np.asarray(x, np.float64)
         if self._x is None or self._dx is None:
             self._x, self._dx = x.copy(), np.zeros_like(x)
@@ -171,7 +242,18 @@ class PoseFilter:
     """Smooths a sequence of poses against the landmark model's frame-to-frame jitter without
     lagging a moving head: a :class:`OneEuro` filter of yaw, pitch, roll (degrees), the scale
     (percent, as 100 ln scale) and the model origin's position (tx, ty in model units at the
-    first pose's scale), so that one setting serves them all. ``fps``: frames a second."""
+    first pose's scale), so that one setting serves them all.
+
+    Parameters
+    ----------
+    fps
+        The poses' rate, frames/s: sets the filter's time step.
+    min_cutoff
+        The cutoff of a still head, Hz.
+    beta
+        How fast the cutoff rises with the head's speed, Hz per degree, per model unit or per
+        percent of scale a second.
+    """
 
     def __init__(self, fps: float, min_cutoff: float = MIN_CUTOFF, beta: float = BETA):
         self._dt = 1.0 / fps
@@ -179,7 +261,18 @@ class PoseFilter:
         self._unit: float | None = None
 
     def __call__(self, pose: Pose) -> Pose:
-        """The filtered pose of the next frame, whose measured pose is ``pose``."""
+        """Filter the next frame's pose.
+
+        Parameters
+        ----------
+        pose
+            The frame's measured pose.
+
+        Returns
+        -------
+        Pose
+            The filtered pose (the first pose as it is).
+        """
         if self._unit is None:
             self._unit = pose.scale
         u = self._unit

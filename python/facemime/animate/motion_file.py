@@ -49,8 +49,25 @@ def _generic_model_block() -> dict[str, Any]:
 
 
 def weights_to_motion(weights: np.ndarray, sizes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(knot offsets (K, 2), lid closures (2,)) of expression ``weights`` (E,) on a face whose
-    knots (the generic head's, as every actor fitted from it) have feature ``sizes`` (K,)."""
+    """The knot offsets and lid closures of one frame's expression weights.
+
+    Parameters
+    ----------
+    weights
+        (E,) float array: the weights, in the order of
+        :data:`~facemime.animate.expressions.NAMES`.
+    sizes
+        (K,) float array: the feature size of each knot of the face (whose knots are the generic
+        head's, as every actor fitted from it), model units; raises ``ValueError`` when K is not
+        the generic head's knot count.
+
+    Returns
+    -------
+    offsets : (K, 2) float64 array
+        Knot (x, y) offsets, model units (those of ``sizes``).
+    closure : (2,) float array
+        Lid closures (right eye, left eye): the blinks' weights.
+    """
     unit = generic_unit_patterns()
     if len(sizes) != unit.shape[1]:
         raise ValueError(
@@ -61,13 +78,33 @@ def weights_to_motion(weights: np.ndarray, sizes: np.ndarray) -> tuple[np.ndarra
 
 
 def read_motion(path: str | Path) -> tuple[dict[str, Any], dict[str, Any], list[dict[str, Any]]]:
-    """Read the motion of a ``facemime.track/1`` file written by ``facemime run``: (video info,
-    the ``model`` block, frames in order as dicts with ``index``, ``face`` (bool), ``pose``
-    (mapping of the six pose values), ``offsets`` ((K, 2) float64 array), ``look`` (a
-    :class:`facemime.types.look.Look`; neutral for files written before it, or without one),
-    ``weights`` ((E,) expression weights, or None) and ``lost`` (the features named lost). A frame with
-    ``weights`` and no ``offsets`` gets its offsets from them, and its lid closures unless its ``look`` gives them
-    (:mod:`facemime.animate.expressions`); a file of such frames needs no ``model`` block."""
+    """Read the motion of a ``facemime.track/1`` file written by ``facemime run`` (or authored).
+
+    A frame with ``weights`` and no ``offsets`` gets its offsets from them, and its lid closures
+    unless its ``look`` gives them (:mod:`facemime.animate.expressions`); a file of such frames
+    needs no ``model`` block. Raises :class:`~facemime.io.contours_json.ContourFileError`, naming
+    the file and the frame, for a malformed one.
+
+    Parameters
+    ----------
+    path
+        The track file.
+
+    Returns
+    -------
+    video : dict
+        The file's ``video`` block (empty where it has none).
+    model : dict
+        The ``model`` block (``knots``, ``feature_sizes``, ...); the generic head's for a file of
+        frames with weights only and no block.
+    frames : list of dict
+        The frames in order, each with ``index`` (the file's, else the frame's position), ``face``
+        (bool), ``pose`` (the six :class:`~facemime.types.pose.Pose` values by name, floats),
+        ``offsets`` ((K, 2) float64 array, model units), ``look`` (a
+        :class:`facemime.types.look.Look`; neutral for files written before it, or without one),
+        ``weights`` ((E,) float64 expression weights, or None) and ``lost`` (the features named
+        lost).
+    """
     doc = load_document(path, "track", TRACK_FORMAT)
     where = str(path)
     model = doc.get("model")

@@ -35,8 +35,30 @@ FPS_RANGE = (0.1, 1000.0)
 
 
 def track_settings(where: str, video: Any, model: dict) -> tuple[tuple[int, int], float, np.ndarray, float | None]:
-    """(width, height), fps, feature sizes and iod (None: absent) of a track file's ``video``
-    and ``model`` blocks, checked: :class:`ContourFileError` names the first wrong field."""
+    """The picture's settings and the measured face's sizes from a track file's ``video`` and
+    ``model`` blocks, checked: :class:`ContourFileError` names the first wrong field.
+
+    Parameters
+    ----------
+    where
+        The file's name, in messages.
+    video
+        The ``video`` block: an object with optional ``width``, ``height`` and ``fps``.
+    model
+        The ``model`` block, with ``knots`` and ``feature_sizes`` lists (as :func:`read_motion`
+        checked) and an optional ``iod``.
+
+    Returns
+    -------
+    size : tuple of (int, int)
+        (width, height) of the picture, pixels; 512x512 where the block gives none.
+    fps : float
+        The frame rate, frames/s; 25 where the block gives none.
+    sizes : (K,) float64 array
+        The measured face's feature size per knot, model units.
+    iod : float or None
+        The measured face's eye-corner distance, model units; None where the block gives none.
+    """
     if not isinstance(video, dict):
         raise ContourFileError(f"{where}: 'video' must be an object (width, height, fps), got {reprlib.repr(video)}")
 
@@ -77,7 +99,8 @@ def track_settings(where: str, video: Any, model: dict) -> tuple[tuple[int, int]
 class Replay:
     """A track file's motion, ready to play: the ``actor`` it drives, the picture's ``size``
     (width, height) and ``fps``, the ``motion`` per frame (in the measured face's units; no
-    contours), and the measured face's feature ``sizes`` (K,) and eye distance ``iod``."""
+    contours), and the measured face's feature ``sizes`` (K,) and eye distance ``iod`` (model
+    units)."""
 
     actor: Actor
     size: tuple[int, int]
@@ -87,12 +110,31 @@ class Replay:
     iod: float
 
     def puppet(self, mask_only: bool = False) -> Puppet:
-        """The actor driven by this motion, in its scene unless ``mask_only`` (or it has none)."""
+        """The actor driven by this motion.
+
+        Parameters
+        ----------
+        mask_only
+            Show the face alone, not in the actor's scene (it is alone anyway without one).
+
+        Returns
+        -------
+        Puppet
+            The actor driven by the motion; in its scene, moved relative to the motion's first
+            pose.
+        """
         return Puppet(self.actor, self.sizes, self.iod, self.motion[0].pose, mask_only)
 
     def in_actor_units(self) -> list[FrameMotion]:
-        """The motion as measured on the actor itself (what a stream carries): offsets scaled per
-        knot and the pose's scale by the eye distances, as :class:`Puppet` does when it plays."""
+        """The motion as measured on the actor itself (what a stream carries).
+
+        Returns
+        -------
+        list of FrameMotion
+            One per frame: offsets scaled per knot by the ratio of the feature sizes, model units of
+            the actor, and the pose's scale by the ratio of the eye distances, as :class:`Puppet`
+            does when it plays.
+        """
         ratio = (Deformer(self.actor.model).feature_sizes() / self.sizes)[:, None]
         scale = self.iod / model_iod(self.actor.model)
         return [
@@ -101,8 +143,22 @@ class Replay:
 
 
 def load_replay(path: str | Path, actor: Actor | None = None) -> Replay:
-    """The motion of the track file at ``path`` on ``actor`` (default: the generic painted head);
-    one-line errors (:class:`ContourFileError`) for a malformed file."""
+    """The motion of a track file on an actor; one-line errors (:class:`ContourFileError`) for a
+    malformed file.
+
+    Parameters
+    ----------
+    path
+        The ``facemime.track/1`` file.
+    actor
+        The actor it drives, with the file's knot count (else
+        :class:`~facemime.errors.InvalidInputError`); None: the generic painted head.
+
+    Returns
+    -------
+    Replay
+        The motion ready to play; its ``iod`` the actor model's where the file gives none.
+    """
     video, model, frames = read_motion(path)
     size, fps, sizes, iod = track_settings(str(path), video, model)
     driven = actor or generic_actor()

@@ -42,8 +42,18 @@ from facemime.types.pose import Pose, project
 
 
 def teeth_uncovered(spread: float) -> float:
-    """How much of the teeth the lips uncover, 0..1, for a mouth whose corners are ``spread``
-    times their rest distance apart (:data:`TEETH_SPREAD`)."""
+    """How much of the teeth the lips uncover (:data:`TEETH_SPREAD`).
+
+    Parameters
+    ----------
+    spread
+        The mouth corners' distance apart, a factor on their rest distance.
+
+    Returns
+    -------
+    float
+        0..1: the share of the teeth's height shown.
+    """
     lo, hi = TEETH_SPREAD
     return float(np.clip((spread - lo) / (hi - lo), 0.0, 1.0))
 
@@ -59,10 +69,21 @@ def _teeth_span(knots: int) -> np.ndarray:
 
 
 def draw_mouth_interior(out: np.ndarray, upper: np.ndarray, lower: np.ndarray, uncovered: float = 1.0) -> None:
-    """Paint the mouth opening bounded by the inner-lip curves ``upper`` and ``lower`` (each
-    (K, 2) px, corner to corner, sharing the corners) into ``out`` in place: the cavity, and the
-    teeth hanging from the upper lip and rising from the lower one, ``uncovered`` (0..1) of their
-    height shown (the upper row at least :data:`UPPER_MIN`)."""
+    """Paint the mouth opening bounded by the inner-lip curves into an image in place: the cavity,
+    and the teeth hanging from the upper lip and rising from the lower one.
+
+    Parameters
+    ----------
+    out
+        (H, W, 3) uint8 RGB: the image, painted in place.
+    upper
+        (K, 2) float array: the upper inner lip's (x, y) pixels, corner to corner.
+    lower
+        (K, 2) float array: the lower inner lip's (x, y) pixels, corner to corner, sharing the
+        corners with ``upper``.
+    uncovered
+        0..1: the share of the teeth's height shown (the upper row at least :data:`UPPER_MIN`).
+    """
     poly = np.concatenate([upper, lower[::-1]])
     lo = np.floor(poly.min(axis=0)).astype(int) - 1
     hi = np.ceil(poly.max(axis=0)).astype(int) + 2
@@ -105,8 +126,19 @@ def draw_mouth_interior(out: np.ndarray, upper: np.ndarray, lower: np.ndarray, u
 
 
 def scene_mesh(actor: Actor) -> SceneMesh | None:
-    """The warp mesh of ``actor``'s scene (its source picture, at that picture's size), or None
-    when the actor has no scene."""
+    """The warp mesh of an actor's scene.
+
+    Parameters
+    ----------
+    actor
+        The actor, whose face outline is placed by its pose on its source picture.
+
+    Returns
+    -------
+    SceneMesh or None
+        The mesh of its source picture, at that picture's size (``source`` width and height,
+        pixels); None when the actor has no scene.
+    """
     if actor.scene is None:
         return None
     anchors = actor.model.groups["face_outline"]
@@ -115,7 +147,22 @@ def scene_mesh(actor: Actor) -> SceneMesh | None:
 
 
 def key_frame(actor: Actor, scene: SceneMesh) -> np.ndarray:
-    """``actor``'s scene image at the size of its ``scene`` mesh (stored smaller when large)."""
+    """An actor's scene image at the size of its scene mesh (the image is stored smaller when
+    large).
+
+    Parameters
+    ----------
+    actor
+        The actor, which has a scene.
+    scene
+        Its :func:`scene_mesh`.
+
+    Returns
+    -------
+    (H, W, 3) uint8 array
+        RGB, ``scene.size``: the actor's own scene image where it is that size, else a resized
+        copy.
+    """
     w, h = scene.size
     if actor.scene.shape[:2] == (h, w):
         return actor.scene
@@ -133,13 +180,38 @@ def synthesize(
     key: np.ndarray | None = None,
     texture: np.ndarray | None = None,
 ) -> np.ndarray:
-    """The actor with ``vertices`` (its model's, deformed) seen in ``pose``: an (H, W, 3) image
-    of ``size`` = (width, height) over ``background`` (a colour or an image of that size), or
-    drawn into ``out`` when given (the background is then what ``out`` holds). With ``scene``
-    (the actor's :func:`scene_mesh`, of this ``size``) and ``key`` (its scene image at that size,
-    :func:`key_frame`), the face is drawn in the actor's scene warped to follow it, and the
-    background is not used. ``texture``: drawn instead of the actor's own (same size: its eyes
-    repainted, :class:`~facemime.animate.eyes.LookPainter`)."""
+    """The actor's textured model, deformed and posed, over a background, with the mouth interior.
+
+    Parameters
+    ----------
+    actor
+        The actor drawn.
+    vertices
+        (N, 3) float array: its model's vertices, deformed, model units.
+    pose
+        The pose they are seen in.
+    size
+        (width, height) of the image, pixels.
+    background
+        An (R, G, B) colour, 0-255 levels, or an (H, W, 3) uint8 RGB image of ``size``; not used
+        with ``out`` (what it holds is the background) or ``scene``.
+    out
+        (H, W, 3) uint8 RGB of ``size`` to draw into; None: a new image.
+    scene
+        The actor's :func:`scene_mesh`, of this ``size``: with ``key``, the face is drawn in the
+        actor's scene, warped to follow it.
+    key
+        (H, W, 3) uint8 RGB: the actor's scene image at ``size`` (:func:`key_frame`); needed with
+        ``scene``.
+    texture
+        (Ht, Wt, 3) uint8 RGB, the size of the actor's texture: drawn instead of it (its eyes
+        repainted, :class:`~facemime.animate.eyes.LookPainter`); None: the actor's own.
+
+    Returns
+    -------
+    (H, W, 3) uint8 array
+        RGB, the synthesised frame: ``out`` when given.
+    """
     w, h = size
     if out is None:
         out = np.empty((h, w, 3), np.uint8)
@@ -182,7 +254,19 @@ class UserMotion:
             raise InvalidInputError(f"exaggeration must be in [0, 10], got {self.gain}")
 
     def changed(self, **deltas: float) -> UserMotion:
-        """A copy with ``deltas`` added (``zoom`` and ``gain`` multiply), kept in range."""
+        """A copy with changes applied, kept in range.
+
+        Parameters
+        ----------
+        **deltas
+            By field name: degrees added to ``yaw``, ``pitch`` or ``roll``, factors multiplying
+            ``zoom`` or ``gain``.
+
+        Returns
+        -------
+        UserMotion
+            The changed motion, each field clipped to its range.
+        """
         v = {k: getattr(self, k) for k in ("yaw", "pitch", "roll", "zoom", "gain")}
         for k, d in deltas.items():
             v[k] = v[k] * d if k in ("zoom", "gain") else v[k] + d
@@ -199,16 +283,29 @@ class UserMotion:
 class Puppet:
     """An actor driven by motion measured on a face (its own or another person's).
 
-    ``source_sizes``: the feature size of each knot on the measured face (see
-    :meth:`Deformer.feature_sizes`) and ``source_iod`` its eye-corner distance, model units;
-    offsets are scaled per feature by the ratio of the two faces' sizes.
+    Offsets are scaled per feature by the ratio of the two faces' feature sizes.
 
     In its scene (the actor has one and ``mask_only`` is False) the actor appears in its own
-    picture, moved from where it sits there by the measured motion relative to ``source_pose``
-    (the measured face's pose on its key frame): turns and tilts add, shifts and zoom scale
-    with the two faces' sizes on screen. Otherwise the face is shown alone where the measured
-    face is, the measured pose's scale multiplied by the ratio of the eye distances so that it
-    keeps the measured face's size on screen.
+    picture, moved from where it sits there by the measured motion relative to ``source_pose``:
+    turns and tilts add, shifts and zoom scale with the two faces' sizes on screen. Otherwise the
+    face is shown alone where the measured face is, the measured pose's scale multiplied by the
+    ratio of the eye distances so that it keeps the measured face's size on screen.
+
+    Parameters
+    ----------
+    actor
+        The actor driven.
+    source_sizes
+        (K,) float array: the feature size of each knot on the measured face (see
+        :meth:`Deformer.feature_sizes`), model units; K must be the actor's knot count (else
+        :class:`~facemime.errors.InvalidInputError`).
+    source_iod
+        The measured face's eye-corner distance, model units.
+    source_pose
+        The measured face's pose on its key frame; None: the actor is posed as without a scene
+        (where the measured face is).
+    mask_only
+        Show the face alone even where the actor has a scene.
     """
 
     def __init__(
@@ -236,12 +333,32 @@ class Puppet:
         self._scale = float(source_iod) / model_iod(actor.model)
 
     def retexture(self, texture: np.ndarray) -> None:
-        """Draw the actor with ``texture`` (its texture as updated, same size) from now on."""
+        """Draw the actor with a new texture from now on.
+
+        Parameters
+        ----------
+        texture
+            (H, W, 3) uint8 RGB: the actor's texture as updated, the same size.
+        """
         self.actor = replace(self.actor, texture=texture)
         self.painter = LookPainter(self.actor)
 
     def pose(self, measured: Pose, user: UserMotion = UserMotion()) -> Pose:
-        """The pose to show the actor in for a ``measured`` pose of the source face."""
+        """The pose to show the actor in.
+
+        Parameters
+        ----------
+        measured
+            The source face's measured pose.
+        user
+            The motion the user adds (turns added, ``zoom`` multiplying the scale).
+
+        Returns
+        -------
+        Pose
+            The actor's pose: in its scene's picture (given a scene and ``source_pose``), else
+            where the measured face is.
+        """
         if self.scene is None or self.source_pose is None:
             shown = replace(measured, scale=measured.scale * self._scale)
         else:
@@ -264,8 +381,24 @@ class Puppet:
         )
 
     def vertices(self, offsets: np.ndarray, user: UserMotion = UserMotion(), look: Look = Look()) -> np.ndarray:
-        """The actor's vertices moved by the source's knot ``offsets`` (K, 2), lips all but
-        touching shown closed (:data:`SEAL`), lids closed by ``look`` (times the user's gain)."""
+        """The actor's vertices moved by the source's knot offsets, lips all but touching shown
+        closed (:data:`SEAL`), lids closed by the look.
+
+        Parameters
+        ----------
+        offsets
+            (K, 2) float array: the knot (x, y) offsets measured on the source face, its model
+            units.
+        user
+            The motion the user adds: its ``gain`` multiplies the offsets and the lid closures.
+        look
+            The look whose ``closure`` closes the lids.
+
+        Returns
+        -------
+        (N, 3) float64 array
+            The actor's model vertices, deformed, model units.
+        """
         vertices = self.deformer.sealed(self.deformer.vertices(offsets * self._ratio, user.gain), SEAL)
         return self.painter.vertices(vertices, Look(look.closure * user.gain))
 
@@ -278,11 +411,33 @@ class Puppet:
         out: np.ndarray | None = None,
         look: Look = Look(),
     ) -> np.ndarray:
-        """The synthesised frame, (H, W, 3) of ``size`` = (width, height), drawn into ``out``
-        when given, with the eyes of ``look``. A scene of another size is drawn at its
-        own and fitted into ``size`` (its aspect kept, the rest :data:`BACKGROUND`); without a
-        scene the face is drawn over what ``out`` holds (or :data:`BACKGROUND`). The vertices and
-        pose drawn are left in :attr:`shown`."""
+        """The synthesised frame. A scene of another size is drawn at its own and fitted into
+        ``size`` (its aspect kept, the rest :data:`BACKGROUND`); without a scene the face is drawn
+        over what ``out`` holds (or :data:`BACKGROUND`). The vertices and pose drawn are left in
+        :attr:`shown`.
+
+        Parameters
+        ----------
+        measured
+            The source face's measured pose.
+        offsets
+            (K, 2) float array: the knot (x, y) offsets measured on the source face, its model
+            units.
+        size
+            (width, height) of the frame, pixels.
+        user
+            The motion the user adds (:meth:`pose`, :meth:`vertices`; its ``gain`` also scales the
+            irises' shifts).
+        out
+            (H, W, 3) uint8 RGB of ``size`` to draw into; None: a new image.
+        look
+            The eyes: lid closures and iris shifts.
+
+        Returns
+        -------
+        (H, W, 3) uint8 array
+            RGB, the frame: ``out`` when given.
+        """
         vertices, pose = self.vertices(offsets, user, look), self.pose(measured, user)
         texture = self.painter.texture(Look(look.closure, look.iris * user.gain))
         self.shown = (vertices, pose)
@@ -308,8 +463,20 @@ class Puppet:
 
 
 def letterbox(image: np.ndarray, out: np.ndarray) -> np.ndarray:
-    """``image`` scaled to fit ``out`` ((H, W, 3) uint8) whole and centred, the margins
-    :data:`BACKGROUND`; returns ``out``."""
+    """An image scaled to fit another whole and centred, the margins :data:`BACKGROUND`.
+
+    Parameters
+    ----------
+    image
+        (h, w, 3) uint8 RGB: the image scaled.
+    out
+        (H, W, 3) uint8 RGB: drawn into, in place.
+
+    Returns
+    -------
+    (H, W, 3) uint8 array
+        ``out``.
+    """
     h, w = out.shape[:2]
     f = min(w / image.shape[1], h / image.shape[0])
     sw, sh = max(1, round(image.shape[1] * f)), max(1, round(image.shape[0] * f))

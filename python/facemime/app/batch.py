@@ -63,13 +63,57 @@ def run_batch(
     on_dashboard: Callable[[str], None] | None = None,
     start_seconds: float = START_SECONDS,
 ) -> BatchResult:
-    """Run ``what`` (track, run or encode) on every video of ``source`` (a folder or a list file,
-    :func:`facemime.batch.inputs.list_videos`) into ``out_dir``, on a local cluster of ``jobs``
-    single-threaded workers or on the Dask ``scheduler`` (``tcp://HOST:PORT``). A task is
-    stopped after ``start_seconds`` + ``timeout_per_frame`` s per frame (None: never); a task whose worker
-    died is retried ``retries`` times (local cluster). ``task``: another per-video function (tests).
-    ``progress`` is called with the result so far after each video; ``on_dashboard`` with the
-    dashboard's address, when there is one."""
+    """Run one command on every video of a folder or list, one Dask task per video. Videos whose
+    results from an earlier batch are complete and valid are skipped; every other video gets a
+    line in ``out_dir/manifest.jsonl`` (:mod:`facemime.batch.manifest`), and one that fails does
+    not stop the batch.
+
+    Parameters
+    ----------
+    source
+        A folder (its video files and those of its subfolders) or a text file listing videos, one
+        path a line (:func:`facemime.batch.inputs.list_videos`); videos inside ``out_dir`` are
+        left out.
+    out_dir
+        The folder for the results, created if missing: per video ``NAME.json`` (track, run),
+        ``NAME.run.mp4`` (run) or ``NAME.fmstream`` (encode), NAME its path relative to
+        ``source`` without the suffix (for a list, its stem); and ``manifest.jsonl``.
+    jobs
+        Worker processes of the local cluster, one thread each (about one per core); at least 1.
+        Unused with ``scheduler``.
+    scheduler
+        The address of a running Dask scheduler to use instead of a local cluster
+        (``tcp://HOST:PORT``); None: a local cluster.
+    what
+        What to make of each video: ``track`` (the track JSON, as ``facemime track``), ``run``
+        (also the side-by-side video, as ``facemime run``) or ``encode`` (the ``.fmstream``, as
+        ``facemime encode``).
+    timeout_per_frame
+        Seconds allowed per frame the video's container declares, after ``start_seconds``, before
+        its task is stopped and recorded as timed out (default 2 s); None: never. Must be
+        positive.
+    retries
+        Times a video whose worker process died is tried again (local cluster; a running
+        scheduler's own setting applies to it); 0 or more.
+    task
+        The work per video, ``task(video, results, what)`` returning warnings; None: the
+        command's (:func:`default_task`). Another is for tests.
+    progress
+        Called with the result so far once the tasks are sent and after each video; None: not
+        called.
+    on_dashboard
+        Called with the Dask dashboard's address, once, when there is one (bokeh installed);
+        None: not called.
+    start_seconds
+        Seconds each task is allowed beyond its per-frame allowance (start-up: loading models,
+        fitting the face; default 30).
+
+    Returns
+    -------
+    BatchResult
+        Videos in the batch, done, skipped, the manifest lines of those failed and timed out,
+        frames done, wall seconds, the manifest file and the dashboard's address.
+    """
     task = task or default_task
     if what not in WHAT:
         raise InvalidInputError(f"what must be one of {', '.join(WHAT)}, got {what!r}")
@@ -212,8 +256,17 @@ def _record(future: Any, item: Item, what: str, timed_out: set[str], retries: in
 
 
 def print_progress() -> tuple[Callable[[BatchResult], None], Callable[[], None]]:
-    """A progress display for :func:`run_batch` on stderr (when it is a terminal): videos done,
-    frames/s overall, time left; returns (the ``progress`` callable, a function that ends it)."""
+    """A progress display for :func:`run_batch` on stderr (when it is a terminal; else it shows
+    nothing): videos done, frames/s overall and failures, time left.
+
+    Returns
+    -------
+    update : callable
+        ``update(result)``, the ``progress`` argument of :func:`run_batch`; starts the display on
+        its first call.
+    stop : callable
+        ``stop()`` ends the display (call it when the batch ends, also on an error).
+    """
     if not sys.stderr.isatty():
         return (lambda r: None), (lambda: None)
     from rich.console import Console
@@ -243,9 +296,24 @@ def print_progress() -> tuple[Callable[[BatchResult], None], Callable[[], None]]
 
 
 def default_task(video: Path, results: list[Path], what: str) -> list[str]:
-    """The work of ``facemime track`` (``what="track"``), ``run`` (``"run"``: the track JSON and
-    the side-by-side video) or ``encode`` (``"encode"``: the stream) on one video, writing over
-    results left incomplete by an earlier batch."""
+    """The work of ``facemime track``, ``run`` or ``encode`` on one video, writing over results
+    left incomplete by an earlier batch.
+
+    Parameters
+    ----------
+    video
+        The video file.
+    results
+        Its result files, in the order of :func:`facemime.batch.manifest.result_paths`: the track
+        JSON (track, run), then the side-by-side video (run); or the stream (encode).
+    what
+        ``track``, ``run`` or ``encode``.
+
+    Returns
+    -------
+    list of str
+        Warnings for the user, one line each.
+    """
     if what == "track":
         from facemime.app.track import track_video
 

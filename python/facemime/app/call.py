@@ -25,7 +25,13 @@ SUFFIX = ".fmstream"
 
 class _Recording:
     """The stream's bytes as sent, written to a temporary file beside ``path`` and put in place
-    by :meth:`close` (kept when the call is stopped: every chunk in it is whole)."""
+    by :meth:`close` (kept when the call is stopped: every chunk in it is whole).
+
+    Parameters
+    ----------
+    path
+        The recording's ``.fmstream`` file.
+    """
 
     def __init__(self, path: Path):
         self.path, self._tmp = path, temporary_sibling(path)
@@ -53,13 +59,50 @@ class _Recording:
 
 
 class Call:
-    """A live call: ``source`` (a video file, or a camera's index), analysed and streamed by a
-    :class:`~facemime.call.sender.Sender` to the clients of a server on 127.0.0.1:``port``.
-    ``record``: an ``.fmstream`` file that gets the stream's bytes as sent (refused when it exists,
-    unless ``force``); ``loop``: play a file again and again; ``web``: the folder of the page
-    (default: the package's). Opening checks the inputs and fits the actor on the first frame;
-    :meth:`start` serves and streams, :meth:`wait` returns when the source has ended, :meth:`close`
-    (or leaving a ``with`` block) stops everything within a second or two."""
+    """A live call: a source analysed and streamed by a :class:`~facemime.call.sender.Sender` to
+    the clients of a server on 127.0.0.1. Opening checks the inputs, binds the port and fits the
+    actor on the first frame (or places the given one; a source without a face fails there, in
+    one line); :meth:`start` serves and streams, :meth:`wait` returns when the source has ended,
+    :meth:`close` (or leaving a ``with`` block) stops everything within a second or two.
+
+    Parameters
+    ----------
+    source
+        A video file (played at its own frame rate), or a camera's index (a whole number, such as
+        ``0``, that names no file).
+    actor
+        The actor to send; None fits one on the first frame. The stream carries it.
+    port
+        The server's TCP port on 127.0.0.1 (default :data:`PORT`, 8766; 0: any free port, see
+        :attr:`port`).
+    quality
+        0 (coarsest) to 10 (finest); None takes the finest whose warm-up frames code within
+        ``rate``.
+    packet_frames
+        Frames per packet, 1-32 (default :data:`PACKET_FRAMES`, 2): more add delay, fewer add bytes
+        of framing.
+    record
+        A file (its name ending in ``.fmstream``) that gets the stream's bytes as sent, put in
+        place by :meth:`close`; None records nothing. Refused when it exists (unless ``force``) or
+        is one of the inputs.
+    force
+        Write over an existing ``record``.
+    loop
+        Play a video file again and again, as one continuing stream.
+    web
+        The folder of the receiver's page and script; None: the package's ``web`` folder.
+    keyframe
+        Seconds between scheduled intra packets (default :data:`KEYFRAME`, 5 s; at least one
+        packet); a receiver can also ask for one.
+    warmup
+        Seconds of analysed frames the motion's basis is learned from before the stream starts
+        (default :data:`WARMUP`, 2 s); they are not streamed.
+    actor_path
+        The file ``actor`` was loaded from, so that ``record`` is refused when it is that file;
+        None when there is none.
+    rate
+        The motion's target rate, kbit/s (default :data:`RATE`, 2), used when ``quality`` is None.
+    """
 
     def __init__(
         self,
@@ -110,25 +153,54 @@ class Call:
 
     @property
     def port(self) -> int:
+        """The TCP port the server is bound to on 127.0.0.1 (the free one chosen for port 0)."""
         assert self.server is not None  # made when the call opens
         return self.server.socket.getsockname()[1]
 
     @property
     def url(self) -> str:
+        """The receiver page's address, ``http://127.0.0.1:PORT/``."""
         return f"http://127.0.0.1:{self.port}/"
 
     # The sender's sink: every chunk to the recording and to the clients.
     def start_stream(self, header: bytes, actor: bytes) -> None:
+        """The stream starts (called by the sender): to the recording and every client.
+
+        Parameters
+        ----------
+        header
+            The stream's header chunk (``docs/bitstream.md``).
+        actor
+            Its actor chunk.
+        """
         if self._recording is not None:
             self._recording.write(header + actor)
         self.hub.start(header, actor)
 
     def packet(self, first: int, arrived: list[float], data: bytes) -> None:
+        """A packet (called by the sender): to the recording and every client.
+
+        Parameters
+        ----------
+        first
+            Index of its first frame, counting the streamed frames from the stream's start.
+        arrived
+            When each of its frames arrived, ms since the epoch.
+        data
+            The packet chunk.
+        """
         if self._recording is not None:
             self._recording.write(data)
         self.hub.packet(first, arrived, data)
 
     def end(self, error: str | None) -> None:
+        """The source has ended (called by the sender): every client gets the end message.
+
+        Parameters
+        ----------
+        error
+            Why, when the source failed; None when it simply ended.
+        """
         self.hub.end(error)
 
     def start(self) -> None:
@@ -139,8 +211,18 @@ class Call:
         self.sender.start()
 
     def wait(self, timeout: float | None = None) -> bool:
-        """Wait for the source to end (``timeout`` s at most); whether it has. Raises what stopped
-        the sender, if anything did."""
+        """Wait for the source to end. Raises what stopped the sender, if anything did.
+
+        Parameters
+        ----------
+        timeout
+            Seconds to wait at most; None waits until the source ends.
+
+        Returns
+        -------
+        bool
+            Whether the sender has ended (the source ended or failed, or the call was stopped).
+        """
         # an Event, not Thread.join: a signal's exception raised within a join can leave the thread
         # marked as ended while it runs on (CPython 3.11)
         ended = self.sender.finished.wait(timeout)

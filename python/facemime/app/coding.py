@@ -76,13 +76,39 @@ def encode_video(
     force: bool = False,
     appearance: float = 0.0,
 ) -> EncodeResult:
-    """Analyse ``video`` and write the stream ``out`` (``.fmstream``); a ``video`` ending in
-    ``.json`` is a track file whose motion is coded instead (:func:`track_clip`). ``actor``: an
-    ``.actor`` file the receiver holds (the stream names it; default: fit one on the first frame,
-    or for a track file the generic painted head, and the stream carries it). ``rate``: the
-    motion's target, kbit/s: the finest quality that fits (``settings.quality`` is then ignored).
-    ``carry_actor``: put the actor in the stream (default: only when it was not given).
-    ``appearance``: kbit/s for appearance updates (0: none; a track file has no appearance)."""
+    """Analyse a video and write its motion as a stream (``docs/bitstream.md``).
+
+    Parameters
+    ----------
+    video
+        The video to analyse; one ending in ``.json`` is a track file whose motion is coded
+        instead (:func:`~facemime.codec.clip.track_clip`), at its size and frame rate.
+    out
+        The stream file to write; its name must end in ``.fmstream``. Refused when it exists
+        (unless ``force``) or is one of the inputs.
+    actor
+        An ``.actor`` file the receiver holds: the stream names it. None fits one on the first
+        frame (for a track file, takes the generic painted head), and the stream carries it.
+    settings
+        How the stream is coded: quality 0-10, seconds between intra packets, seconds of frames
+        per packet (default :class:`~facemime.codec.stream.Settings`: quality 5, 1 s, 0.5 s).
+    rate
+        The motion's target rate, kbit/s: the finest quality that fits is taken and
+        ``settings.quality`` ignored (a warning when even the coarsest does not fit). None:
+        ``settings.quality``.
+    carry_actor
+        Put the actor in the stream; None: only when ``actor`` was not given.
+    force
+        Write over an existing ``out``.
+    appearance
+        kbit/s for appearance updates (the face's look sent again where it changes), 0 to 1000;
+        0: none (a track file has no appearance).
+
+    Returns
+    -------
+    EncodeResult
+        What was written: frames, the quality used, bytes of each part, seconds and warnings.
+    """
     out = Path(out)
     if out.suffix.lower() != SUFFIX:
         raise InvalidInputError(f"the stream must end in {SUFFIX}, got {out.name!r}")
@@ -155,11 +181,31 @@ class DecodeResult:
 def decode_stream(
     stream: str | Path, out: str | Path, actor: str | Path | None = None, force: bool = False, mask_only: bool = False
 ) -> DecodeResult:
-    """Decode ``stream`` and write the synthesised picture to ``out`` (.mp4 or .webm) at the
-    stream's frame rate and size: the face in its actor's scene, or alone with ``mask_only`` (or
-    when the actor has no scene). ``actor``: the ``.actor`` file the stream names when it does
-    not carry it. Frames without a face show the last face dimmed; lost frames repeat the last
-    good one."""
+    """Decode a stream and write the synthesised picture as a video, at the stream's frame rate
+    and size. Frames without a face show the last face dimmed; lost frames repeat the last good
+    one.
+
+    Parameters
+    ----------
+    stream
+        The ``.fmstream`` file to decode.
+    out
+        The video to write, ``.mp4`` (H.264) or ``.webm`` (VP9). Refused when it exists (unless
+        ``force``) or is one of the inputs.
+    actor
+        The ``.actor`` file the stream names, when it does not carry its actor; None otherwise.
+    force
+        Write over an existing ``out``.
+    mask_only
+        Show the face alone on a plain backdrop (0-255 RGB :data:`BACKGROUND`), not in its actor's
+        scene; it is shown so also when the actor has no scene.
+
+    Returns
+    -------
+    DecodeResult
+        Frames written and concealed, the decoder's counts, seconds, appearance updates applied
+        and refused.
+    """
     out = Path(out)
     if out.suffix.lower() not in CODECS:
         raise InvalidInputError(f"the output video must end in .mp4 or .webm, got {out.name!r}")

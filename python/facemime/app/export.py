@@ -28,9 +28,27 @@ class ExportResult:
 def export_track(
     track: str | Path, out: str | Path, actor: str | Path | Actor | None = None, force: bool = False
 ) -> ExportResult:
-    """Write the performance of ``track`` (``facemime.track/1`` from ``facemime run``) on
-    ``actor`` (an ``.actor`` file or an :class:`Actor`; default the generic head) to ``out``
-    (``.glb``); an existing ``out`` is refused unless ``force``."""
+    """Write the performance of a track file on an actor as binary glTF: the head mesh with a
+    morph target per expression control, animated by their weights and the head's pose.
+
+    Parameters
+    ----------
+    track
+        A ``facemime.track/1`` file from ``facemime run`` (or written by hand with weights).
+    out
+        The file to write; its name must end in ``.glb``. Refused when it exists (unless
+        ``force``) or is one of the inputs.
+    actor
+        The head that plays the track: an ``.actor`` file or an :class:`Actor`; None: the generic
+        painted head (see :func:`~facemime.export.performance.load_performance`).
+    force
+        Write over an existing ``out``.
+
+    Returns
+    -------
+    ExportResult
+        The file written, its frames, controls (morph targets) and bytes, and the seconds taken.
+    """
     from facemime.io.actor_file import load_actor
 
     t0 = time.perf_counter()

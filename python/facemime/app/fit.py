@@ -32,9 +32,30 @@ class FitRun:
 def fit_file(
     source: str | Path, out: str | Path, frame: int = 0, points_file: str | Path | None = None, force: bool = False
 ) -> FitRun:
-    """Fit an actor to ``source`` (an image, or frame ``frame`` of a video) and write ``out``
-    (``NAME.actor``) and its preview ``NAME.preview.png``, both or neither; existing files are
-    refused unless ``force``, an input always."""
+    """Fit an actor to a photo and write its actor file and preview, both or neither.
+
+    Parameters
+    ----------
+    source
+        An image file, or a video (any FFmpeg reads) to take frame ``frame`` of.
+    out
+        The actor file to write, ``NAME.actor`` (the suffix is required); its preview sheet goes
+        beside it as ``NAME.preview.png``. Existing files are refused unless ``force``; an input,
+        always.
+    frame
+        0-based index of the video frame to fit to; must be 0 for an image.
+    points_file
+        A ``facemime.points/1`` file of reference points marked on the photo, used instead of
+        finding them (needed where no face is found); None finds them.
+    force
+        Write over existing ``out`` and preview files.
+
+    Returns
+    -------
+    FitRun
+        The actor, the two files written, warnings, the seconds spent finding points and fitting,
+        and the residual (pixels).
+    """
     out = Path(out)
     if out.suffix.lower() != ".actor":
         raise InvalidInputError(f"the actor file name must end in .actor, got {out.name!r}")

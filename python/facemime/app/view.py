@@ -53,6 +53,7 @@ from facemime.shared_constants import BACKGROUND
 from facemime.track.overlay import draw_contours
 from facemime.types.actor import Actor
 from facemime.types.head import model_iod
+from facemime.types.look import Look
 from facemime.types.pose import Pose
 
 #: Key -> the change it makes to the user motion.
@@ -76,12 +77,21 @@ MAX_HEAD = 8192
 
 class Viewer:
     """The viewer's state and frames, without the web server: feed keys with :meth:`key`, take
-    frames (RGB uint8) with :meth:`frame`.
+    frames (RGB uint8) with :meth:`frame`. The source plays in a loop; opening it analyses the
+    first frame. A video is decoded on a thread of its reader's while the viewer plays it:
+    :meth:`close` (or leaving a ``with`` block) stops it.
 
-    ``source``: a video file (analysed live) or a ``facemime.track/1`` file with motion (from
-    ``facemime run``); ``actor``: the face to drive (default: for a video, the face fitted on its
-    first frame; for a track file, the generic head). A video is decoded on a thread of its
-    reader's while the viewer plays it: :meth:`close` (or leaving a ``with`` block) stops it.
+    Parameters
+    ----------
+    source
+        A video file (analysed live, played at its frame rate clamped to 0.1-1000 frames/s) or a
+        ``facemime.track/1`` file with motion (its name ending in ``.json``; from
+        ``facemime run``).
+    actor
+        The face to drive; None: for a video, the face fitted on its first frame; for a track
+        file, the generic painted head.
+    mask_only
+        Show the face alone on a plain backdrop, not in its actor's scene.
     """
 
     def __init__(self, source: str | Path, actor: Actor | None = None, mask_only: bool = False):
@@ -115,13 +125,14 @@ class Viewer:
                 )
             yield frame
 
-    def _play(self) -> Iterator[tuple[np.ndarray | None, Pose, np.ndarray, Puppet]]:
+    def _play(self) -> Iterator[tuple[np.ndarray | None, Pose, np.ndarray, Look, Puppet]]:
         """(left panel or None, pose, knot offsets, look, puppet) per frame, looping forever."""
         while True:
             if self._is_track:
                 for m in self._motions:
                     yield None, m.pose, m.offsets, m.look, self._puppet
                 continue
+            analysis = None
             with VideoReader(self.source) as reader:
                 for n, (frame, analysis, m) in enumerate(
                     analysed(self._one_size(reader), str(self.source), fps=self.fps)
@@ -153,7 +164,21 @@ class Viewer:
         return synth if left is None else np.hstack([left, synth])
 
     def key(self, name: str) -> dict:
-        """Apply key ``name`` (see :data:`KEYS`; also ``r`` and `` ``); returns :meth:`state`."""
+        """Apply a key; an unknown one raises :class:`~facemime.errors.InvalidInputError`.
+
+        Parameters
+        ----------
+        name
+            The key, as the browser names it: one of :data:`KEYS` (arrows turn and tilt by 5
+            degrees, ``q``/``e`` roll by 5 degrees, ``+`` or ``=`` and ``-`` zoom in and out by a
+            factor 1.1, ``x``/``z`` exaggerate by 1.25 or calm by 0.8), ``r`` (reset the user
+            motion) or a space (pause or resume).
+
+        Returns
+        -------
+        dict
+            The new :meth:`state`.
+        """
         with self._lock:
             if name in KEYS:
                 self.user = self.user.changed(**KEYS[name])
@@ -166,7 +191,14 @@ class Viewer:
         return self.state()
 
     def frame(self) -> np.ndarray:
-        """The next frame, drawn with the current user motion (the same moment while paused)."""
+        """The next frame, drawn with the current user motion (the same moment while paused).
+
+        Returns
+        -------
+        (H, 2W, 3) or (H, W, 3) uint8 array
+            RGB: for a video, the original with the tracked contours beside the synthesised
+            picture; for a track file, the synthesised picture alone, at the track's size.
+        """
         with self._lock:
             if not self.paused:
                 self._shown = next(self._frames)
@@ -184,7 +216,15 @@ class Viewer:
         self.close()
 
     def state(self) -> dict:
-        """The user motion and whether playback is paused, as a JSON-ready dict."""
+        """The user motion and whether playback is paused.
+
+        Returns
+        -------
+        dict
+            JSON-ready: ``yaw``, ``pitch``, ``roll`` (degrees added), ``zoom`` (factor on the
+            face's size), ``exaggerate`` (factor on the local deformation; both 4 decimals) and
+            ``paused`` (bool).
+        """
         u = self.user
         return {
             "yaw": u.yaw,
@@ -206,23 +246,63 @@ addEventListener('keydown', async ev => {
 
 
 def jpeg(frame: np.ndarray) -> bytes:
-    """An RGB frame as JPEG bytes."""
+    """Encode a frame as JPEG (quality 85).
+
+    Parameters
+    ----------
+    frame
+        (H, W, 3) uint8 RGB image.
+
+    Returns
+    -------
+    bytes
+        The JPEG file.
+    """
     return cv2.imencode(".jpg", cv2.cvtColor(frame, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, 85])[1].tobytes()
 
 
 def describe(e: BaseException) -> str:
-    """An error as one line: its message, or for an unexpected one its type too."""
+    """An error as one line.
+
+    Parameters
+    ----------
+    e
+        The error.
+
+    Returns
+    -------
+    str
+        Its message, whitespace collapsed; for an unexpected one (not a
+        :class:`~facemime.errors.FacemimeError`), ``unexpected TYPE: message (a bug in facemime)``.
+    """
     text = str(e) if isinstance(e, FacemimeError) else f"unexpected {type(e).__name__}: {e} (a bug in facemime)"
     return " ".join(text.split())
 
 
 def report(e: BaseException) -> None:
-    """Tell an error of the server's threads on stderr, in one line."""
+    """Tell an error of the server's threads on stderr, in one line (``facemime: error: ...``).
+
+    Parameters
+    ----------
+    e
+        The error (see :func:`describe`).
+    """
     print(f"facemime: error: {describe(e)}", file=sys.stderr, flush=True)
 
 
 def message_image(text: str) -> np.ndarray:
-    """An RGB image of ``text`` (ASCII, wrapped), light red on the page's dark grey."""
+    """An image of a message, light red on the page's dark grey.
+
+    Parameters
+    ----------
+    text
+        The message; characters outside ASCII are shown as ``?``, lines wrapped at 64 characters.
+
+    Returns
+    -------
+    (24 + 28 × lines, 760, 3) uint8 array
+        RGB.
+    """
     lines = textwrap.wrap(text.encode("ascii", "replace").decode(), 64) or [""]
     image = np.full((24 + 28 * len(lines), 760, 3), 34, np.uint8)
     for i, line in enumerate(lines):
@@ -234,7 +314,13 @@ class Broadcast:
     """The viewer's frames, as JPEG, for every client at once: one thread plays the viewer at its
     frame rate while anyone watches (:meth:`frames`) and keeps the last :data:`KEEP` frames; an
     error of the viewer's stops playing for good, with ``error`` its one-line message, reported on
-    stderr once."""
+    stderr once.
+
+    Parameters
+    ----------
+    viewer
+        The viewer to play.
+    """
 
     #: Frames kept for clients that fall behind; one further behind skips to the newest frame.
     KEEP = 16
@@ -250,8 +336,16 @@ class Broadcast:
         self._changed = threading.Condition()
 
     def frames(self) -> Iterator[tuple[int, bytes]]:
-        """(number, JPEG) of each frame played from now on, in order, until playing stops (an
-        error, or :meth:`close`)."""
+        """The frames played from now on, in order, until playing stops (an error, or
+        :meth:`close`); a client more than :data:`KEEP` frames behind skips to the newest. Starts
+        the player thread if none runs.
+
+        Yields
+        ------
+        tuple of (int, bytes)
+            The frame's number (counting the frames played since the broadcast began, from 1) and
+            its JPEG file.
+        """
         with self._changed:
             self._watchers += 1
             if self._player is None and not self._closed and self.error is None:
@@ -309,7 +403,13 @@ class Broadcast:
 
 class _Head:
     """A request's reader that gives at most :data:`MAX_HEAD` bytes, in lines (the request line
-    and headers): beyond, it raises :class:`LineTooLong`."""
+    and headers): beyond, it raises :class:`LineTooLong`.
+
+    Parameters
+    ----------
+    rfile
+        The connection's buffered binary reader.
+    """
 
     def __init__(self, rfile: Any):
         self._rfile, self._left = rfile, MAX_HEAD
@@ -326,10 +426,22 @@ class _Head:
 
 
 class ViewerServer(ThreadingHTTPServer):
-    """The viewer's web server (see :func:`make_server`): at most ``max_clients`` connections at
-    once, more are answered 503. Closing it stops the broadcast, cuts every open connection and
-    waits for their threads: no thread of the server outlives it (a process that exits right
-    after, as ``facemime view`` on Ctrl-C, has none left writing to a socket or to stderr)."""
+    """The viewer's web server (see :func:`make_server`), on 127.0.0.1. Closing it stops the
+    broadcast, cuts every open connection and waits for their threads: no thread of the server
+    outlives it (a process that exits right after, as ``facemime view`` on Ctrl-C, has none left
+    writing to a socket or to stderr).
+
+    Parameters
+    ----------
+    port
+        The TCP port to listen on (0: any free port).
+    handler
+        The request handler class (:func:`make_server`'s).
+    broadcast
+        The frames the clients are sent.
+    max_clients
+        The most connections served at once; more are answered 503.
+    """
 
     daemon_threads = False  # joined by server_close (ThreadingMixIn), once their connections are cut
 
@@ -341,6 +453,16 @@ class ViewerServer(ThreadingHTTPServer):
         self._open_lock = threading.Lock()
 
     def process_request(self, request: Any, client_address: Any) -> None:
+        """Serve a connection on a thread of its own, or answer 503 and close it when
+        ``max_clients`` are being served.
+
+        Parameters
+        ----------
+        request
+            The connection's socket.
+        client_address
+            The client's (host, port).
+        """
         if not self._slots.acquire(blocking=False):
             with suppress(OSError):
                 request.sendall(
@@ -354,6 +476,15 @@ class ViewerServer(ThreadingHTTPServer):
         super().process_request(request, client_address)
 
     def process_request_thread(self, request: Any, client_address: Any) -> None:
+        """Serve a connection (on its thread), then free its slot.
+
+        Parameters
+        ----------
+        request
+            The connection's socket.
+        client_address
+            The client's (host, port).
+        """
         try:
             super().process_request_thread(request, client_address)
         finally:
@@ -362,7 +493,16 @@ class ViewerServer(ThreadingHTTPServer):
             self._slots.release()
 
     def handle_error(self, request: Any, client_address: Any) -> None:
-        """A request's error in one line on stderr, none for a client gone or too slow."""
+        """A request's error (the one being handled) in one line on stderr, none for a client
+        gone or too slow.
+
+        Parameters
+        ----------
+        request
+            The connection's socket.
+        client_address
+            The client's (host, port).
+        """
         e = sys.exc_info()[1]
         if not isinstance(e, (ConnectionError, TimeoutError)):
             report(e)
@@ -380,9 +520,26 @@ class ViewerServer(ThreadingHTTPServer):
 
 
 def make_server(viewer: Viewer, port: int = 8765, timeout: float = 10.0, max_clients: int = 16) -> ViewerServer:
-    """The web server of ``viewer`` on 127.0.0.1:``port`` (0: any free port); not yet serving.
-    A connection is dropped after ``timeout`` seconds without progress; beyond ``max_clients``
-    connections at once, one is answered 503."""
+    """The web server of a viewer, on 127.0.0.1; not yet serving. It serves the page (``/``),
+    the MJPEG stream (``/stream``), the next frame (``/frame.jpg``) and keys (``/key?k=NAME``),
+    see the module docstring.
+
+    Parameters
+    ----------
+    viewer
+        The viewer whose frames are served.
+    port
+        The TCP port to listen on (default 8765; 0: any free port, see ``server_address``).
+    timeout
+        Seconds without progress after which a connection is dropped.
+    max_clients
+        The most connections served at once; beyond, one is answered 503.
+
+    Returns
+    -------
+    ViewerServer
+        The server, bound and listening; call ``serve_forever`` to serve.
+    """
     if isinstance(port, bool) or not isinstance(port, int) or not 0 <= port <= 65535:
         raise InvalidInputError(f"port must be a whole number from 0 to 65535 (0: any free port), got {port!r}")
     keys = json.dumps(sorted(KEYS) + ["r", " "])
@@ -404,7 +561,14 @@ def make_server(viewer: Viewer, port: int = 8765, timeout: float = 10.0, max_cli
                 self.send_error(HTTPStatus.REQUEST_HEADER_FIELDS_TOO_LARGE, f"over {MAX_HEAD} bytes")
 
         def parse_request(self) -> bool:
-            """Refuse requests not addressed to this machine by name (403) and requests with a body (413)."""
+            """Parse the request line and headers; refuse requests not addressed to this machine
+            by name (403) and requests with a body (413).
+
+            Returns
+            -------
+            bool
+                Whether the request is to be answered (False: the error is sent already).
+            """
             if not super().parse_request():
                 return False
             hosts, origins = self.headers.get_all("Host", []), self.headers.get_all("Origin", [])

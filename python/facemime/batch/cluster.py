@@ -26,15 +26,34 @@ class ClusterError(FacemimeError, ConnectionError):
 
 
 def check_address(address: str) -> None:
-    """Refuse a scheduler address that is not ``PROTOCOL://HOST:PORT`` (tcp, tls, ucx, ws, wss)."""
+    """Refuse a scheduler address that is not ``PROTOCOL://HOST:PORT`` (tcp, tls, ucx, ws, wss):
+    raise :class:`~facemime.errors.InvalidInputError`.
+
+    Parameters
+    ----------
+    address
+        The scheduler's address, e.g. ``tcp://10.0.0.5:8786``; the port must be 1-65535 and an
+        IPv6 host be written in brackets.
+    """
     m = _ADDRESS.match(address)
     if m is None or not 0 < int(m.group(3)) < 65536:
         raise InvalidInputError(f"the scheduler address must look like tcp://HOST:PORT, got {address!r}")
 
 
 def local_cluster(jobs: int) -> LocalCluster:
-    """A new ``distributed.LocalCluster`` of ``jobs`` worker processes, one thread each, their
-    BLAS/OpenMP pools set to one thread, logs below errors silenced, the dashboard on a free port."""
+    """A new local Dask cluster.
+
+    Parameters
+    ----------
+    jobs
+        How many worker processes it has.
+
+    Returns
+    -------
+    distributed.LocalCluster
+        ``jobs`` worker processes, one thread each, their BLAS/OpenMP pools set to one thread, logs
+        below errors silenced, the dashboard on a free port.
+    """
     from distributed import LocalCluster
 
     return LocalCluster(
@@ -49,11 +68,28 @@ def local_cluster(jobs: int) -> LocalCluster:
 
 @contextmanager
 def open_client(jobs: int, scheduler: str | None = None, retries: int = 2) -> Iterator[object]:
-    """A ``distributed.Client``: on a new local cluster of ``jobs`` worker processes, each with
-    one thread and its BLAS/OpenMP pools set to one thread, that retries a task whose worker died
-    ``retries`` times (the scheduler's ``allowed-failures``); or attached to the running
-    ``scheduler`` (its own setting of retries applies). Logs below errors are silenced; the
-    dashboard is served only when bokeh is installed."""
+    """A Dask client, closed (with the local cluster it started, if any) when the ``with`` block
+    ends. Logs below errors are silenced; the dashboard is served only when bokeh is installed.
+    :class:`ClusterError` when the cluster cannot be started or the scheduler not reached within
+    :data:`CONNECT_SECONDS`.
+
+    Parameters
+    ----------
+    jobs
+        Worker processes of the new local cluster, each with one thread and its BLAS/OpenMP pools
+        set to one thread; unused with ``scheduler``.
+    scheduler
+        The address (``PROTOCOL://HOST:PORT``, see :func:`check_address`) of a running Dask
+        scheduler to attach to instead; None starts a local cluster.
+    retries
+        How many times the local cluster retries a task whose worker died (the scheduler's
+        ``allowed-failures``); a running ``scheduler``'s own setting applies instead.
+
+    Yields
+    ------
+    distributed.Client
+        The client, on the local cluster or attached to ``scheduler``.
+    """
     import dask
     from distributed import Client
 
@@ -80,7 +116,19 @@ def open_client(jobs: int, scheduler: str | None = None, retries: int = 2) -> It
 
 
 def dashboard_link(client: object) -> str | None:
-    """The address of the cluster's dashboard, None when it serves none (bokeh missing)."""
+    """The address of the cluster's dashboard.
+
+    Parameters
+    ----------
+    client
+        A ``distributed.Client``, as :func:`open_client` yields.
+
+    Returns
+    -------
+    str or None
+        The dashboard's URL; None when the scheduler serves none (bokeh missing) or the client
+        cannot tell.
+    """
     if find_spec("bokeh") is None:  # the scheduler serves no dashboard without it
         return None
     try:

@@ -25,11 +25,25 @@ class Item:
 
 
 def list_videos(source: str | Path) -> list[Item]:
-    """The videos of ``source``: a folder (video files found in it and below, by their ending,
-    sorted) or a text file with one video path a line (relative to the file's folder; blank
-    lines and lines starting with ``#`` skipped; listed files need not exist: a missing one
-    fails alone). One-line errors for a missing or unreadable source and for one with no
-    videos."""
+    """The videos of a batch. One-line errors (:class:`~facemime.errors.InputFileError`,
+    :class:`~facemime.errors.InvalidInputError`) for a missing or unreadable source and for one
+    with no videos.
+
+    Parameters
+    ----------
+    source
+        A folder (the video files found in it and below, by their ending, see
+        :data:`VIDEO_SUFFIXES`; names starting with ``.`` skipped) or a text file with one video
+        path a line (relative to the file's folder; blank lines and lines starting with ``#``
+        skipped; listed files need not exist: a missing one fails alone).
+
+    Returns
+    -------
+    list of Item
+        For a folder, sorted by path and named by the path relative to ``source`` without its
+        suffix; for a list, in its order (repeats dropped) and named by the file's stem (with 8 hex
+        digits of a hash of its absolute path where several files share a stem).
+    """
     source = Path(source)
     if not source.exists():
         raise InputFileError(f"input {source} does not exist")

@@ -27,12 +27,41 @@ RESULTS = {"track": (".json",), "run": (".json", ".run.mp4"), "encode": (".fmstr
 
 
 def result_paths(out_dir: Path, name: str, what: str) -> list[Path]:
-    """The result files of video ``name`` for ``what`` (track JSON first, where there is one)."""
+    """The result files of one video.
+
+    Parameters
+    ----------
+    out_dir
+        The batch's output folder.
+    name
+        The video's name (:attr:`facemime.batch.inputs.Item.name`: may contain ``/``).
+    what
+        What the batch makes: ``track``, ``run`` or ``encode`` (a key of :data:`RESULTS`).
+
+    Returns
+    -------
+    list of Path
+        ``out_dir/NAME`` with each suffix of ``RESULTS[what]``: the track JSON first, where there
+        is one (``NAME.json``, then ``NAME.run.mp4`` for run; ``NAME.fmstream`` for encode).
+    """
     return [out_dir / f"{name}{suffix}" for suffix in RESULTS[what]]
 
 
 def source_stamp(path: Path) -> dict[str, int] | None:
-    """The video file's size (bytes) and modification time (ns): a changed video is redone."""
+    """The video file's size and modification time, recorded as ``source``: a changed video is
+    redone.
+
+    Parameters
+    ----------
+    path
+        The video file.
+
+    Returns
+    -------
+    dict or None
+        ``{"bytes": size in bytes, "mtime_ns": modification time, ns since the epoch}``; None
+        when the file cannot be read.
+    """
     try:
         st = path.stat()
     except OSError:
@@ -41,8 +70,19 @@ def source_stamp(path: Path) -> dict[str, int] | None:
 
 
 def result_sizes(paths: list[Path]) -> dict[str, int] | None:
-    """Bytes of each result file by name (None when one is missing): a result cut short or
-    replaced after its batch is redone."""
+    """Bytes of each result file, recorded as ``results``: a result cut short or replaced after
+    its batch is redone.
+
+    Parameters
+    ----------
+    paths
+        The video's result files (:func:`result_paths`).
+
+    Returns
+    -------
+    dict or None
+        File name (without the folder) to size in bytes; None when one is missing or unreadable.
+    """
     try:
         return {p.name: p.stat().st_size for p in paths}
     except OSError:
@@ -50,10 +90,25 @@ def result_sizes(paths: list[Path]) -> dict[str, int] | None:
 
 
 def summarise(paths: list[Path], what: str) -> dict[str, Any]:
-    """Parse and check the results of one video; returns ``frames``, ``mean_confidence`` and
-    ``lost_frames``. Raises :class:`FacemimeError` when a result is missing, unreadable or
-    incomplete: a track file whose frames do not run, one by one, to the video's last frame, a
-    side-by-side video without that many frames, a stream that does not decode to its end."""
+    """Parse and check the results of one video. Raises :class:`FacemimeError` when a result is
+    missing, unreadable or incomplete: a track file whose frames do not run, one by one, to the
+    video's last frame, a side-by-side video without that many frames, a stream that does not
+    decode to its end.
+
+    Parameters
+    ----------
+    paths
+        The video's result files, in the order of :func:`result_paths`.
+    what
+        ``track``, ``run`` or ``encode``: what made them.
+
+    Returns
+    -------
+    dict
+        The manifest fields ``frames`` (int: frames tracked or decoded), ``mean_confidence``
+        (float 0-1 over the frames and features, 4 decimals; None for encode or without
+        confidences) and ``lost_frames`` (int: frames with a lost feature).
+    """
     if what == "encode":
         return _summarise_stream(paths[0])
     from facemime.io.contours_json import load_document
@@ -107,13 +162,28 @@ def _summarise_stream(path: Path) -> dict[str, Any]:
 class Manifest:
     """The manifest file of an output folder: :meth:`read` the last line of each video,
     :meth:`append` a line (flushed to disk at once: a batch killed at any moment loses at most the
-    line being written, which a later read skips)."""
+    line being written, which a later read skips).
+
+    Parameters
+    ----------
+    out_dir
+        The batch's output folder; the manifest is ``out_dir/manifest.jsonl`` (:data:`MANIFEST`),
+        its :attr:`path`.
+    """
 
     def __init__(self, out_dir: Path):
         self.path = Path(out_dir) / MANIFEST
 
     def read(self) -> dict[str, dict[str, Any]]:
-        """The last line of each video (by name); unparsable lines are skipped."""
+        """The last line of each video; unparsable lines are skipped. Raises
+        :class:`~facemime.io.outputs.OutputFileError` when the file exists but cannot be read.
+
+        Returns
+        -------
+        dict of str to dict
+            Each video's name to its last manifest line (a JSON object); empty when there is no
+            manifest yet.
+        """
         last: dict[str, dict[str, Any]] = {}
         try:
             with open(self.path, encoding="utf-8") as f:
@@ -131,7 +201,15 @@ class Manifest:
         return last
 
     def append(self, record: dict[str, Any]) -> None:
-        """Append one line (``finished`` is set to now)."""
+        """Append one line, creating the folder and file as needed; raises
+        :class:`~facemime.io.outputs.OutputFileError` when it cannot be written.
+
+        Parameters
+        ----------
+        record
+            The video's manifest line (see the module); written with ``finished`` set to now (UTC,
+            ISO 8601, seconds), ``record`` itself unchanged.
+        """
         record = {**record, "finished": datetime.now(UTC).isoformat(timespec="seconds")}
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
@@ -144,9 +222,26 @@ class Manifest:
 
 
 def is_complete(record: dict[str, Any] | None, path: Path, paths: list[Path], what: str) -> bool:
-    """Whether a video needs no new run: its last manifest line says done, for the same ``what``
-    and the same video file (size, modification time), and its results parse and check with as
-    many frames as that line records."""
+    """Whether a video needs no new run.
+
+    Parameters
+    ----------
+    record
+        The video's last manifest line (:meth:`Manifest.read`); None when it has none.
+    path
+        The video file.
+    paths
+        Its result files (:func:`result_paths`).
+    what
+        ``track``, ``run`` or ``encode``: what the batch makes now.
+
+    Returns
+    -------
+    bool
+        True when ``record`` says done, for the same ``what`` and the same video file (size,
+        modification time), the result files have the sizes it records, and they parse and check
+        (:func:`summarise`) with as many frames as it records.
+    """
     if not record or record.get("status") != "done" or record.get("what") != what:
         return False
     if record.get("source") != source_stamp(path) or record.get("results") != result_sizes(paths):

@@ -63,7 +63,19 @@ def pin_threads() -> None:
 
 
 def declared_frames(video: Path) -> int:
-    """The frames the video's container declares (or its duration × rate; 0 when unreadable)."""
+    """The frames a video's container declares, for its time limit.
+
+    Parameters
+    ----------
+    video
+        The video file.
+
+    Returns
+    -------
+    int
+        The frame count of its first video stream, or its duration × average frame rate where the
+        container has no count; 0 when unreadable or neither is known.
+    """
     import av
 
     try:
@@ -94,11 +106,42 @@ def process(
     previous: dict[str, Any] | None = None,
     start_seconds: float = START_SECONDS,
 ) -> dict[str, Any]:
-    """The manifest line (see :mod:`facemime.batch.manifest`) of one video: ``previous``, its
-    earlier line, marked ``skipped`` when the results it describes are complete and valid;
-    otherwise that of a new run of ``task`` (the command's work,
-    :func:`facemime.app.batch.default_task`) on ``video`` within ``start_seconds`` +
-    ``timeout_per_frame`` s × its declared frames (None: no limit), its results checked."""
+    """The manifest line (see :mod:`facemime.batch.manifest`) of one video: its earlier line when
+    the results it describes are complete and valid; otherwise that of a new run of ``task``, its
+    results checked. Run on a worker; pins the process to one thread (:func:`pin_threads`) and
+    first removes temporary files an earlier, killed run left beside the results.
+
+    Parameters
+    ----------
+    name
+        The video's name (:attr:`facemime.batch.inputs.Item.name`), its line's ``video``.
+    video
+        Path of the video file.
+    results
+        Paths of its result files (:func:`facemime.batch.manifest.result_paths`).
+    what
+        ``track``, ``run`` or ``encode``.
+    timeout_per_frame
+        Seconds allowed per frame the container declares (:func:`declared_frames`), beyond
+        ``start_seconds``; None: no time limit.
+    task
+        The work (the command's, :func:`facemime.app.batch.default_task`), called as
+        ``task(Path(video), results as Paths, what)``.
+    previous
+        The video's last manifest line from an earlier batch; None when it has none.
+    start_seconds
+        Seconds allowed beyond the per-frame allowance (start-up: loading models, fitting the face).
+
+    Returns
+    -------
+    dict
+        ``previous`` with ``skipped`` set to True, when complete; otherwise a new line with
+        ``video``, ``path``, ``what``, ``source``, ``status`` (``done``, ``failed`` or ``timed
+        out``), ``error`` (one line; None when done), ``frames`` (None unless done), ``seconds``
+        (wall time of this call, s) and, when done, ``mean_confidence``, ``lost_frames``,
+        ``results`` and ``warnings`` (only when there were any); ``finished`` is left to
+        :meth:`facemime.batch.manifest.Manifest.append`.
+    """
     path, paths = Path(video), [Path(p) for p in results]
     if previous is not None and is_complete(previous, path, paths, what):
         return {**previous, "skipped": True}
@@ -140,7 +183,15 @@ class _Watchdog:
     """Raises :class:`TimedOut` in the calling thread once ``limit`` seconds pass, unless
     :meth:`finish` was called; if the thread is still busy ``GRACE_SECONDS`` later (stuck in
     native code, which a Python exception cannot interrupt), records a worker event and ends the
-    worker process (the batch then records the task as timed out)."""
+    worker process (the batch then records the task as timed out).
+
+    Parameters
+    ----------
+    limit
+        Seconds from now (wall clock) until :class:`TimedOut` is raised.
+    name
+        The video's name, for the watchdog thread's name and the worker event.
+    """
 
     def __init__(self, limit: float, name: str):
         self._target = threading.get_ident()

@@ -21,7 +21,7 @@ from typing import Protocol
 import numpy as np
 
 from facemime import _core
-from facemime.animate.analysis import FrameMotion, start_analysis
+from facemime.animate.analysis import FrameMotion, analysed
 from facemime.codec.clip import Clip, encode_clip
 from facemime.codec.params import Basis, pose_vector
 from facemime.codec.stream import DEFAULT_QUALITY, LADDER, MotionEncoder, Settings
@@ -49,21 +49,55 @@ CAMERA_FPS = 30.0
 
 
 class Sink(Protocol):
-    """Where the sender's stream goes (the server's :class:`~facemime.call.server.Hub`)."""
+    """Where the sender's stream goes (:class:`~facemime.app.call.Call`: the recording, and the
+    server's :class:`~facemime.call.server.Hub`)."""
 
     def start_stream(self, header: bytes, actor: bytes) -> None:
-        """A stream starts: its header chunk and actor chunk."""
+        """A stream starts.
+
+        Parameters
+        ----------
+        header
+            The header chunk.
+        actor
+            The actor chunk.
+        """
 
     def packet(self, first: int, arrived: list[float], data: bytes) -> None:
-        """A packet chunk ``data`` holding frames ``first`` ... (their arrival, ms since the epoch)."""
+        """A packet is made.
+
+        Parameters
+        ----------
+        first
+            The index of the packet's first frame from the stream's start.
+        arrived
+            Each of its frames' arrival at the sender, ms since the epoch.
+        data
+            The packet chunk.
+        """
 
     def end(self, error: str | None) -> None:
-        """The source has ended (``error``: why, when it failed)."""
+        """The source has ended.
+
+        Parameters
+        ----------
+        error
+            Why, when it failed; None when it ended normally.
+        """
 
 
 class FileSource:
-    """A video file played at its own frame rate: frame i is due ``i / fps`` seconds after the
-    first was analysed; ``loop`` plays it again and again (the indices keep counting)."""
+    """A video file played at its own frame rate: the first frame at once; the pace starts when
+    the next is asked for (the first, the actor's fit, done), frame i ≥ 1 being due
+    ``(i - 1) / fps`` seconds after that.
+
+    Parameters
+    ----------
+    path
+        Path of the video file.
+    loop
+        Play it again and again (the indices keep counting).
+    """
 
     def __init__(self, path: str | Path, loop: bool = False):
         self.path, self.loop = Path(path), loop
@@ -72,9 +106,21 @@ class FileSource:
         self.size = (self._reader.width, self._reader.height)
 
     def frames(self, stop: threading.Event) -> Iterator[tuple[np.ndarray, float]]:
-        """(RGB frame, arrival) for each frame when due, until ``stop`` is set. The arrival is
-        when the frame was due, ms since the epoch (a frame read late, the reader being behind,
-        arrived when due, as from a camera)."""
+        """Each frame when due, until ``stop`` is set.
+
+        Parameters
+        ----------
+        stop
+            Set to end the frames (a wait for a frame's time ends at once).
+
+        Yields
+        ------
+        frame : (H, W, 3) uint8 array
+            RGB.
+        arrival : float
+            When the frame was due, ms since the epoch (a frame read late, the reader being
+            behind, arrived when due, as from a camera).
+        """
         reader, i, base = self._reader, 0, None
         while True:
             with reader:
@@ -103,7 +149,14 @@ class FileSource:
 
 
 class CameraSource:
-    """A camera (OpenCV's device ``index``), its frames as they come."""
+    """A camera, its frames as they come. Its first frame is read here (a camera that gives none
+    fails here).
+
+    Parameters
+    ----------
+    index
+        OpenCV's device index of the camera.
+    """
 
     def __init__(self, index: int):
         import cv2
@@ -126,7 +179,20 @@ class CameraSource:
         self.size = (frame.shape[1], frame.shape[0])
 
     def frames(self, stop: threading.Event) -> Iterator[tuple[np.ndarray, float]]:
-        """(RGB frame, arrival: when it was read, ms since the epoch) until ``stop`` is set."""
+        """The camera's frames as they come, until ``stop`` is set.
+
+        Parameters
+        ----------
+        stop
+            Set to end the frames (checked between frames).
+
+        Yields
+        ------
+        frame : (H, W, 3) uint8 array
+            RGB.
+        arrival : float
+            When it was read, ms since the epoch.
+        """
         frame, arrived = self._first, self._arrived
         while frame is not None and not stop.is_set():
             yield self._cv2.cvtColor(frame, self._cv2.COLOR_BGR2RGB), arrived
@@ -140,7 +206,20 @@ class CameraSource:
 
 
 def open_source(source: str, loop: bool = False) -> FileSource | CameraSource:
-    """A video file, or a camera where ``source`` is a whole number naming no file."""
+    """A video file, or a camera.
+
+    Parameters
+    ----------
+    source
+        Path of a video file, or a camera's index: a whole number naming no file.
+    loop
+        Play a file again and again.
+
+    Returns
+    -------
+    FileSource or CameraSource
+        The source, open.
+    """
     if source.isdigit() and not Path(source).exists():
         return CameraSource(int(source))
     return FileSource(source, loop)
@@ -163,15 +242,50 @@ class SenderStats:
     delays: list[tuple[float, float]] = field(default_factory=list)
 
     def motion_kbit_s(self, fps: float) -> float:
-        """The packets' rate over the streamed frames, kbit/s."""
+        """The packets' rate over the streamed frames.
+
+        Parameters
+        ----------
+        fps
+            The source's frame rate, frames/s.
+
+        Returns
+        -------
+        float
+            kbit/s; 0 before any frame was streamed.
+        """
         return self.packet_bytes * 8 / 1000 / (self.frames / fps) if self.frames else 0.0
 
 
 class Sender(threading.Thread):
-    """Reads, analyses and codes a source's frames into ``sink`` until the source ends or
-    :meth:`stop` is called. The first frame is read and the actor fitted (or ``actor`` placed) in
-    the constructor, so that a source without a face fails there, in one line; :attr:`error` is
-    what stopped the thread otherwise (None: the source ended, or it was stopped)."""
+    """Reads, analyses and codes a source's frames into a sink until the source ends or
+    :meth:`stop` is called.
+
+    The first frame is read and the actor fitted (or the given one placed) in the constructor, so
+    that a source without a face fails there, in one line; :attr:`error` is what stopped the
+    thread otherwise (None: the source ended, or it was stopped).
+
+    Parameters
+    ----------
+    source
+        Where the frames come from.
+    sink
+        Where the stream goes.
+    actor
+        The actor to place on the face; None: one is fitted on the first frame.
+    quality
+        The stream's quality, 0-10 (:data:`~facemime.codec.stream.LADDER`); None: the finest
+        whose warm-up frames fit ``rate``.
+    packet_frames
+        Frames per packet, 1-32.
+    keyframe
+        Seconds between scheduled intra packets (less than a packet's is taken as a packet's).
+    warmup
+        Seconds of analysed frames (one at least) the basis is learned from before the stream
+        starts; they are not streamed.
+    rate
+        The motion's rate aimed at without a ``quality``, kbit/s (> 0).
+    """
 
     def __init__(
         self,
@@ -205,15 +319,17 @@ class Sender(threading.Thread):
         self._forced = False  # an intra packet was asked for and is not made yet
         self._packets_made = 0
         self._frames = source.frames(self._stopping)
-        first, arrived = next(self._frames, (None, 0.0))
-        if first is None:
+        self._arrived = 0.0  # when the frame being analysed arrived (wall clock, ms)
+        self._analysed = analysed(self._pictures(), source.name, actor=actor, fps=source.fps)
+        started = next(self._analysed, None)
+        if started is None:
             raise InputFileError(f"{source.name} has no frames")
-        self.analysis = start_analysis(first, source.name, actor=actor, fps=source.fps)
+        _, self.analysis, motion = started
         self.actor = actor or self.analysis.actor
         # made now, not when the stream starts: encoding the texture and scene takes ~0.3 s, which
         # delayed the first packets that much
         self._actor_data = actor_bytes(self.actor, "webp", self.settings.texture)
-        self._warm: list[tuple[FrameMotion, float]] = [(self.analysis.last, arrived)]
+        self._warm: list[tuple[FrameMotion, float]] = [(motion, self._arrived)]
         self.encoder: MotionEncoder | None = None
 
     def stop(self) -> None:
@@ -222,7 +338,14 @@ class Sender(threading.Thread):
 
     def request_intra(self) -> bool:
         """A receiver asks for an intra packet: the next packet is made one, unless it is one
-        already. Returns whether the request changed anything (it is honoured)."""
+        already.
+
+        Returns
+        -------
+        bool
+            Whether the request changed anything (it is honoured): False also before the stream
+            starts.
+        """
         with self._lock:
             self.stats.intra_asked += 1
             if self.encoder is None or self._forced or self._packets_made % self.keyframe_packets == 0:
@@ -238,6 +361,7 @@ class Sender(threading.Thread):
         except Exception as e:  # noqa: BLE001 (told by the caller, in one line)
             self.error, error = e, e
         finally:
+            self._analysed.close()
             self._frames.close()
             self.source.close()
             try:
@@ -246,15 +370,20 @@ class Sender(threading.Thread):
             finally:
                 self.finished.set()
 
-    def _run(self) -> None:
+    def _pictures(self) -> Iterator[np.ndarray]:
+        """The source's frames, noting each one's arrival for the latency figures."""
         for frame, arrived in self._frames:
-            motion = self.analysis.update(frame)
+            self._arrived = arrived
+            yield frame
+
+    def _run(self) -> None:
+        for _, _, motion in self._analysed:
             if self.encoder is None:
-                self._warm.append((motion, arrived))
+                self._warm.append((motion, self._arrived))
                 if len(self._warm) >= self.warmup_frames:
                     self._start()
             else:
-                self._push(motion, arrived)
+                self._push(motion, self._arrived)
         if self._stopping.is_set():
             return
         if self.encoder is None:  # the source ended within the warm-up: nothing to stream

@@ -73,13 +73,25 @@ _LOGGER.propagate = False
 
 
 def web_folder() -> Traversable:
-    """The receiver's page and script, in the package's ``web`` folder."""
+    """The package's ``web`` folder.
+
+    Returns
+    -------
+    Traversable
+        The folder of the receiver's page and script.
+    """
     return resources.files("facemime") / "web"
 
 
 class Client:
     """One stream connection's queue of messages (text or binary), filled by the sender's thread
-    without waiting, emptied by the connection's own thread (:meth:`take`)."""
+    without waiting, emptied by the connection's own thread (:meth:`take`).
+
+    Parameters
+    ----------
+    connection
+        The client's WebSocket connection.
+    """
 
     def __init__(self, connection: ServerConnection):
         self.connection = connection
@@ -90,8 +102,14 @@ class Client:
         self._gone = False
 
     def put(self, *messages: str | bytes) -> None:
-        """Queue ``messages``; a client whose oldest message waits over :data:`MAX_BEHIND` s is
-        closed instead (1008)."""
+        """Queue messages; a client whose oldest message waits over :data:`MAX_BEHIND` s is
+        closed instead (1008).
+
+        Parameters
+        ----------
+        *messages
+            The messages, in order: str for a text message, bytes for a binary one.
+        """
         now = time.monotonic()
         with self._changed:
             if self.closing is not None or self._gone:
@@ -110,7 +128,17 @@ class Client:
             timer.start()
 
     def close(self, code: int, reason: str, drain: bool = False) -> None:
-        """Close with ``code`` (once): at once, or with ``drain`` after the messages queued."""
+        """Close the connection (the first call only counts).
+
+        Parameters
+        ----------
+        code
+            The WebSocket close code.
+        reason
+            The close reason, text.
+        drain
+            Send the messages queued first; False: drop them and close at once.
+        """
         with self._changed:
             if self.closing is None:
                 self.closing, self._drain = (code, reason), drain
@@ -125,8 +153,14 @@ class Client:
             self._changed.notify_all()
 
     def take(self) -> str | bytes | None:
-        """The next message to send, waiting for one; None when the connection is to close
-        (:attr:`closing` says how, None: it has closed)."""
+        """The next message to send, waiting for one.
+
+        Returns
+        -------
+        str, bytes or None
+            The message (str: text, bytes: binary); None when the connection is to close
+            (:attr:`closing` says how; None there: it has closed).
+        """
         with self._changed:
             self._changed.wait_for(lambda: self._items or self.closing is not None or self._gone)
             if self._items and not self._gone and (self.closing is None or self._drain):
@@ -140,8 +174,16 @@ class Client:
 
 class Hub:
     """The stream's clients: the sender hands each chunk over once (:meth:`start`,
-    :meth:`packet`, :meth:`end`), every client gets it in its own queue. ``hello`` is the first
-    message of every client; ``on_intra`` is called on a client's request for an intra packet."""
+    :meth:`packet`, :meth:`end`), every client gets it in its own queue.
+
+    Parameters
+    ----------
+    hello
+        The fields of the first message of every client besides its type: ``source``, ``fps``
+        (frames/s), ``width``, ``height`` (pixels).
+    on_intra
+        Called (no arguments; its result ignored) on a client's request for an intra packet.
+    """
 
     def __init__(self, hello: dict, on_intra: Callable[[], object]):
         self._hello = json.dumps({"type": "hello", **hello})
@@ -162,7 +204,14 @@ class Hub:
             return len(self._clients)
 
     def join(self, client: Client) -> None:
-        """A client connects: it gets the hello, and the stream's start if it has started."""
+        """A client connects: it gets the hello, the stream's start if it has started, and the
+        end (then it is closed) if the source has ended.
+
+        Parameters
+        ----------
+        client
+            The new client's queue.
+        """
         with self._lock:
             self.served += 1
             self._clients.add(client)
@@ -174,26 +223,58 @@ class Hub:
                 client.close(NORMAL, "the source has ended", drain=True)
 
     def leave(self, client: Client) -> None:
+        """A client has gone.
+
+        Parameters
+        ----------
+        client
+            Its queue.
+        """
         with self._lock:
             self._clients.discard(client)
             self._lock.notify_all()
 
     def start(self, header: bytes, actor: bytes) -> None:
-        """The stream starts: its header and actor chunks, to every client now and later."""
+        """The stream starts: its header and actor chunks, to every client now and later.
+
+        Parameters
+        ----------
+        header
+            The header chunk.
+        actor
+            The actor chunk; b"": none (the stream does not carry the actor).
+        """
         with self._lock:
             self._start = (header, actor) if actor else (header,)
             for c in self._clients:
                 c.put(*self._start)
 
     def packet(self, first: int, arrived: list[float], data: bytes) -> None:
-        """A packet chunk holding frames ``first`` ..., arrived at ``arrived`` (ms since the epoch)."""
+        """A packet chunk, to every client after its ``frames`` message.
+
+        Parameters
+        ----------
+        first
+            The index of the packet's first frame from the stream's start.
+        arrived
+            Each of its frames' arrival at the sender, ms since the epoch.
+        data
+            The packet chunk.
+        """
         text = json.dumps({"type": "frames", "first": first, "arrived": [round(t, 3) for t in arrived]})
         with self._lock:
             for c in self._clients:
                 c.put(text, data)
 
     def end(self, error: str | None = None) -> None:
-        """The source has ended: every client gets the end message and is closed (1000)."""
+        """The source has ended: every client gets the end message and is closed (1000).
+
+        Parameters
+        ----------
+        error
+            Why the source failed (its whitespace collapsed into single spaces in the message);
+            None: it ended normally.
+        """
         with self._lock:
             self._end = json.dumps({"type": "end"} | ({"error": " ".join(error.split())} if error else {}))
             for c in self._clients:
@@ -201,13 +282,32 @@ class Hub:
                 c.close(NORMAL, "the source has ended", drain=True)
 
     def close_all(self, code: int = GOING_AWAY, reason: str = "the call is over") -> None:
-        """Close every client now."""
+        """Close every client now, dropping its queued messages.
+
+        Parameters
+        ----------
+        code
+            The WebSocket close code.
+        reason
+            The close reason, text.
+        """
         with self._lock:
             for c in self._clients:
                 c.close(code, reason)
 
     def wait_empty(self, timeout: float) -> bool:
-        """Wait up to ``timeout`` s for every client to have left; whether they have."""
+        """Wait for every client to have left.
+
+        Parameters
+        ----------
+        timeout
+            The longest wait, seconds.
+
+        Returns
+        -------
+        bool
+            Whether they have.
+        """
         with self._lock:
             return self._lock.wait_for(lambda: not self._clients, timeout)
 
@@ -265,8 +365,22 @@ def _response(status: int, phrase: str, body: bytes, kind: str) -> Response:
 
 
 def make_server(hub: Hub, port: int = PORT, web: Path | Traversable | None = None) -> Server:
-    """The call's server on 127.0.0.1:``port`` (0: any free port), not yet serving; ``web``: the
-    folder of the page and script (default :func:`web_folder`)."""
+    """The call's server on 127.0.0.1, not yet serving.
+
+    Parameters
+    ----------
+    hub
+        The stream's clients.
+    port
+        The TCP port, 0-65535; 0: any free port.
+    web
+        The folder of the page and script; None: :func:`web_folder`.
+
+    Returns
+    -------
+    Server
+        The server, listening (its socket bound); ``serve_forever`` serves.
+    """
     if isinstance(port, bool) or not isinstance(port, int) or not 0 <= port <= 65535:
         raise InvalidInputError(f"port must be a whole number from 0 to 65535 (0: any free port), got {port!r}")
     folder = web_folder() if web is None else web

@@ -66,7 +66,18 @@ class Update:
     image: np.ndarray
 
     def payload(self, quality: int = QUALITY) -> bytes:
-        """The chunk's payload (the image as lossy WebP at ``quality``)."""
+        """The appearance chunk's payload (``docs/bitstream.md``, "Appearance (version 2)").
+
+        Parameters
+        ----------
+        quality
+            WebP quality of the image, 1-100 (lossy).
+
+        Returns
+        -------
+        bytes
+            ``u32`` F, ``u16`` X, ``u16`` Y, then the image as WebP.
+        """
         ok, data = cv2.imencode(
             ".webp", cv2.cvtColor(self.image, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_WEBP_QUALITY, quality]
         )
@@ -76,7 +87,20 @@ class Update:
 
 
 def parse(payload: bytes) -> Update | None:
-    """The update in an appearance chunk's ``payload``; None when its image does not decode."""
+    """The update in an appearance chunk's payload (``docs/bitstream.md``, "Appearance (version
+    2)").
+
+    Parameters
+    ----------
+    payload
+        The chunk's payload: ``u32`` F, ``u16`` X, ``u16`` Y, a WebP image.
+
+    Returns
+    -------
+    Update or None
+        The update, its image RGB; None when the payload has no image (8 bytes or fewer) or its
+        image does not decode.
+    """
     if len(payload) <= HEAD.size:
         return None
     frame, x, y = HEAD.unpack_from(payload)
@@ -87,11 +111,25 @@ def parse(payload: bytes) -> Update | None:
 
 
 def paste(texture: np.ndarray, update: Update) -> bool:
-    """Paste ``update`` into ``texture`` ((H, W, 3) uint8, in place), its edges blended as the
-    spec says: a texel at distance d (texels) from the nearest edge of the update that is not on
-    or beyond the texture's border weighs k / 8, k = min(8, d + 1), and becomes
-    ``(k * u + (8 - k) * t + 4) // 8``. Returns False (texture untouched) when the update lies
-    wholly outside the texture."""
+    """Paste an update into a texture, its edges blended as the spec says (``docs/bitstream.md``,
+    "Appearance (version 2)").
+
+    A texel at distance d (texels) from the nearest edge of the update that is not on or beyond
+    the texture's border weighs k / 8, k = min(8, d + 1), and becomes
+    ``(k * u + (8 - k) * t + 4) // 8``; the update's texels beyond the texture are ignored.
+
+    Parameters
+    ----------
+    texture
+        (H, W, 3) uint8 RGB texture, changed in place.
+    update
+        The update: its image goes at texel (``x``, ``y``), x right, y down.
+
+    Returns
+    -------
+    bool
+        False (texture untouched) when the update lies wholly outside the texture, else True.
+    """
     h, w = texture.shape[:2]
     uh, uw = update.image.shape[:2]
     x1, y1 = min(update.x + uw, w), min(update.y + uh, h)
@@ -118,9 +156,33 @@ def lay_back(
     facing: np.ndarray,
     size: tuple[int, int],
 ) -> tuple[np.ndarray, np.ndarray]:
-    """``frame`` (H, W, 3) laid onto a texture of ``size`` (width, height) through the triangles
-    ``facing`` (indices into ``triangles``) whose vertices are seen at ``points`` (N, 2) px and
-    sit at ``model_uv`` (N, 2) in the texture: (texture, coverage 0..255)."""
+    """A frame laid back onto the texture through a mesh: each triangle drawn from the frame into
+    texture space.
+
+    Parameters
+    ----------
+    frame
+        (H, W, 3) uint8 RGB image.
+    model_uv
+        (N, 2) float array: each vertex's texture coordinates (u, v) in [0, 1] from the texture's
+        top-left corner (v down).
+    triangles
+        (F, 3) int array of vertex indices.
+    points
+        (N, 2) float array: each vertex's place in ``frame``, (x, y) pixels, y down, origin at
+        the centre of the top-left pixel.
+    facing
+        (F,) bool mask (or indices) of the triangles to lay back.
+    size
+        (width, height) of the texture, texels.
+
+    Returns
+    -------
+    texture : (height, width, 3) uint8 array
+        RGB: the frame's pixels where the triangles cover the texture, 0 elsewhere.
+    coverage : (height, width) uint8 array
+        255 where a triangle covers the texel, 0 elsewhere.
+    """
     w, h = size
     out = np.zeros((h, w, 3), np.uint8)
     cover = np.zeros((h, w), np.uint8)
@@ -134,9 +196,22 @@ def lay_back(
 
 
 class AppearanceSender:
-    """Chooses appearance updates for one actor's texture (``texture``: the receiver's copy,
-    kept up to date here) at ``budget`` kbit/s for a video at ``fps`` frames/s. ``model`` is the
-    actor's head model (its ``uv`` address the texture)."""
+    """Chooses appearance updates for one actor's texture under a bit budget.
+
+    :attr:`texture` is the receiver's copy of the texture, kept up to date here; :attr:`updates`
+    counts the updates sent.
+
+    Parameters
+    ----------
+    model
+        The actor's head model (its ``uv`` address the texture).
+    texture
+        (H, W, 3) uint8 RGB: the actor's texture as the receiver holds it (copied).
+    budget
+        The updates' rate, at most, kbit/s (chunk framing included).
+    fps
+        The video's frame rate, frames/s.
+    """
 
     def __init__(self, model: HeadModel, texture: np.ndarray, budget: float, fps: float):
         self.model, self.texture = model, texture.copy()
@@ -163,8 +238,27 @@ class AppearanceSender:
         self.updates = 0
 
     def update(self, index: int, frame: np.ndarray, vertices: np.ndarray, pose: Pose) -> bytes | None:
-        """Look at frame ``index`` (RGB (H, W, 3) uint8), drawn by the receiver with ``vertices``
-        (N, 3) in ``pose``; returns an appearance payload to send before it, or None."""
+        """Take a frame's share of the budget and, on every :data:`CHECK`-th frame, look at it for
+        an update.
+
+        Parameters
+        ----------
+        index
+            The frame's index from the stream's start (the update's F).
+        frame
+            (H, W, 3) uint8 RGB: the real frame.
+        vertices
+            (N, 3) float array: the model's vertices as the receiver draws this frame, model units
+            (x to the subject's left, y up, z towards the camera).
+        pose
+            The pose the receiver draws them in.
+
+        Returns
+        -------
+        bytes or None
+            An appearance chunk's payload to send before the frame's packet (already applied to
+            :attr:`texture`), or None.
+        """
         self._bits = min(self._cap, self._bits + self._per_frame)
         if index % CHECK:
             return None
@@ -212,10 +306,24 @@ class AppearanceSender:
 
 
 class Appearance:
-    """The receiver's side: the actor's ``texture`` as the stream's appearance updates change it,
-    frame by frame. ``payloads``: the appearance chunks' payloads in stream order; ``after``: for
-    each, how many frames the decoder had output before it (an update applies from its frame F,
-    or from the first frame output after it when it comes late)."""
+    """The receiver's side: the actor's texture as the stream's appearance updates change it,
+    frame by frame.
+
+    An update applies from its frame F, or from the first frame output after it when it comes
+    late. :attr:`texture` is the texture now; :attr:`applied` and :attr:`refused` count the
+    updates pasted and those whose image did not decode or that lay outside the texture.
+
+    Parameters
+    ----------
+    texture
+        (H, W, 3) uint8 RGB: the actor's texture (copied).
+    payloads
+        The appearance chunks' payloads, in stream order
+        (:attr:`~facemime.codec.stream.MotionDecoder.appearance`).
+    after
+        For each payload, how many frames the decoder had output before it
+        (:attr:`~facemime.codec.stream.MotionDecoder.appearance_after`).
+    """
 
     def __init__(self, texture: np.ndarray, payloads: list[bytes], after: list[int]):
         self.texture = texture.copy()
@@ -225,8 +333,19 @@ class Appearance:
         self.applied = 0
 
     def due(self, frame: int) -> bool:
-        """Apply, in stream order, the updates that apply from ``frame`` or before; returns
-        whether :attr:`texture` changed."""
+        """Apply, in stream order, the updates due by a frame.
+
+        Parameters
+        ----------
+        frame
+            The frame's index from the stream's start: the updates that apply from it or before
+            are pasted.
+
+        Returns
+        -------
+        bool
+            Whether :attr:`texture` changed.
+        """
         changed = False
         while self._pending and self._pending[0][0] <= frame:
             if paste(self.texture, self._pending.pop(0)[1]):

@@ -49,7 +49,8 @@ MAX_COEFFICIENTS = max(m for _, m in LADDER)
 
 @dataclass
 class Clip:
-    """A video's analysis: its actor, frame rate, size (width, height) and per-frame motion."""
+    """A video's analysis: its actor, frame rate (frames/s), size (width, height, pixels),
+    per-frame motion, warnings, and the seconds the analysis took."""
 
     actor: Actor
     fps: float
@@ -60,7 +61,20 @@ class Clip:
 
 
 def analyse(video: str | Path, actor: Actor | None = None) -> Clip:
-    """Fit (or place ``actor``), track and measure every frame of ``video``."""
+    """Fit (or place an actor), track and measure every frame of a video.
+
+    Parameters
+    ----------
+    video
+        Path of the video file (any FFmpeg-readable one).
+    actor
+        The actor to place on the face; None: one is fitted on the video.
+
+    Returns
+    -------
+    Clip
+        The video's analysis, with the time it took (seconds).
+    """
     t0 = time.perf_counter()
     with VideoReader(video) as reader:
         analysis, motion = None, []
@@ -81,9 +95,21 @@ def analyse(video: str | Path, actor: Actor | None = None) -> Clip:
 
 
 def track_clip(track: str | Path, actor: Actor | None = None) -> Clip:
-    """The motion of the ``facemime.track/1`` file ``track`` as a clip, on ``actor`` (default:
-    the generic painted head) as ``view`` plays it (:mod:`facemime.animate.replay`): the track's
-    size and frame rate, its motion measured on the actor itself."""
+    """The motion of a track file as a clip, on an actor as ``view`` plays it
+    (:mod:`facemime.animate.replay`).
+
+    Parameters
+    ----------
+    track
+        Path of the ``facemime.track/1`` file (``.json``).
+    actor
+        The actor the motion is played on; None: the generic painted head.
+
+    Returns
+    -------
+    Clip
+        The track's size and frame rate, its motion measured on the actor itself, no warnings.
+    """
     from facemime.animate.replay import load_replay
 
     t0 = time.perf_counter()
@@ -101,10 +127,32 @@ def _look(frame: FrameMotion) -> Look:
 def encode_clip(
     clip: Clip, settings: Settings, carry_actor: bool, basis: Basis | None = None
 ) -> tuple[bytes, bytes, list[bytes]]:
-    """The stream of an analysed clip: (header, actor chunk or b"", packets). ``basis``: the
-    clip's (default: learned from it, at the settings' size). The stream carries the frames'
-    looks (format version 2) when a frame with a face has a look that is not neutral; otherwise
-    it is a version-1 stream."""
+    """The stream of an analysed clip.
+
+    The stream carries the frames' looks (format version 2) when a frame with a face has a look
+    that is not neutral; otherwise it is a version-1 stream.
+
+    Parameters
+    ----------
+    clip
+        The analysed clip.
+    settings
+        How the stream is coded.
+    carry_actor
+        Whether the actor follows the header in the stream.
+    basis
+        The clip's basis, cut to the settings' :attr:`~facemime.codec.stream.Settings.basis_size`
+        vectors; None: learned from the clip's frames with a face.
+
+    Returns
+    -------
+    header : bytes
+        The header chunk.
+    actor : bytes
+        The actor chunk, or b"" when the actor is not carried.
+    packets : list of bytes
+        The packet chunks, in order.
+    """
     faces = [m for m in clip.motion if m.face]
     m = settings.basis_size
     if basis is None:
@@ -137,10 +185,37 @@ def with_appearance(
     settings: Settings,
     budget: float,
 ) -> tuple[list[bytes], AppearanceSender]:
-    """``packets`` with appearance updates (:mod:`facemime.codec.appearance`) of at most
-    ``budget`` kbit/s put before the packet holding each update's first frame: ``video`` is read
-    again, each frame laid onto the texture through what the receiver draws (the stream decoded
-    here). Returns the chunks and the sender (its texture is the receiver's at the end)."""
+    """A stream's packets with appearance updates (:mod:`facemime.codec.appearance`), each put
+    before the packet holding its first frame.
+
+    The video is read again, each frame laid onto the texture through what the receiver draws
+    (the stream decoded here).
+
+    Parameters
+    ----------
+    video
+        Path of the video the clip was analysed from.
+    clip
+        Its analysis.
+    header
+        The stream's header chunk.
+    actor_chunk
+        The stream's actor chunk; b"": the stream does not carry the actor (``clip.actor`` is
+        the receiver's).
+    packets
+        The stream's packet chunks, in order (:func:`encode_clip`).
+    settings
+        The settings the stream was coded with.
+    budget
+        The updates' rate, at most, kbit/s.
+
+    Returns
+    -------
+    chunks : list of bytes
+        The packets with the appearance chunks among them.
+    sender : AppearanceSender
+        The sender: its texture is the receiver's at the end.
+    """
     decoder = MotionDecoder(None if actor_chunk else clip.actor)
     decoded = decoder.push(header + actor_chunk + b"".join(packets)) + decoder.finish()
     held = decoder.actor  # the actor as the receiver holds it: its texture as the stream carries it
@@ -158,8 +233,19 @@ def with_appearance(
 
 
 def scene_bytes(actor_chunk: bytes) -> int:
-    """Bytes of the scene image inside a stream's actor chunk (``docs/bitstream.md``: tag, seq,
-    LEB128 length, payload = the actor file, CRC-32); 0 without a chunk or a scene."""
+    """Bytes of the scene image inside a stream's actor chunk.
+
+    Parameters
+    ----------
+    actor_chunk
+        The whole chunk (``docs/bitstream.md``, "Chunks" and "Actor": tag, seq, LEB128 length,
+        payload = the actor file, CRC-32), or b"".
+
+    Returns
+    -------
+    int
+        The scene's compressed bytes in the actor file; 0 without a chunk or a scene.
+    """
     if not actor_chunk:
         return 0
     at = 3
@@ -170,7 +256,18 @@ def scene_bytes(actor_chunk: bytes) -> int:
 
 
 def read_stream(path: str | Path) -> bytes:
-    """The bytes of a stream file (one-line errors for a missing, unreadable or huge file)."""
+    """The bytes of a stream file (one-line errors for a missing, unreadable or huge file).
+
+    Parameters
+    ----------
+    path
+        Path of the ``.fmstream`` file; at most :data:`MAX_STREAM_BYTES` bytes.
+
+    Returns
+    -------
+    bytes
+        The file's contents.
+    """
     path = Path(path)
     if not path.is_file():
         raise InputFileError(f"stream {path} does not exist" if not path.exists() else f"stream {path} is not a file")

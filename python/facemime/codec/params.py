@@ -32,20 +32,58 @@ LOOK_KINDS = tuple(range(1, len(LOOK_NAMES) + 1))
 
 
 def pose_vector(pose: Pose) -> np.ndarray:
-    """(6,) yaw, pitch, roll, ln scale, tx, ty."""
+    """The first six parameters of a frame (``docs/bitstream.md``, "Parameters"): the pose's.
+
+    Parameters
+    ----------
+    pose
+        The head pose.
+
+    Returns
+    -------
+    (6,) float64 array
+        yaw, pitch, roll (degrees), ln of the scale (scale in pixels per model unit), tx, ty
+        (pixels).
+    """
     return np.array([pose.yaw, pose.pitch, pose.roll, np.log(pose.scale), pose.tx, pose.ty])
 
 
 def pose_from_vector(v: np.ndarray) -> Pose:
-    """The pose of a (6,) :func:`pose_vector`."""
+    """The pose of a :func:`pose_vector`.
+
+    Parameters
+    ----------
+    v
+        (6,) float array (only its first six entries are read): yaw, pitch, roll (degrees), ln of
+        the scale (pixels per model unit), tx, ty (pixels).
+
+    Returns
+    -------
+    Pose
+        The head pose, its scale ``exp(v[3])``.
+    """
     return Pose(
         yaw=float(v[0]), pitch=float(v[1]), roll=float(v[2]), scale=float(np.exp(v[3])), tx=float(v[4]), ty=float(v[5])
     )
 
 
 def look_from_extras(kinds: tuple[int, ...], values: np.ndarray) -> Look:
-    """The look of a stream's extras: ``values`` (X,) of the parameters of ``kinds`` (X,). A kind
-    that is not a look value (:data:`LOOK_KINDS`) is ignored; a look value without its kind is 0.
+    """The look of a stream's extra parameters (``docs/bitstream.md``, "Look (version 2)").
+
+    A kind that is not a look value (:data:`LOOK_KINDS`) is ignored; a look value without its kind
+    is 0.
+
+    Parameters
+    ----------
+    kinds
+        (X,) the extra parameters' kinds, in the header's order.
+    values
+        (X,) float array: the extra parameters' values, in the order of ``kinds``.
+
+    Returns
+    -------
+    Look
+        The look: eye closures (shares of the key frame's opening), iris shifts (eye widths).
 
     Examples
     --------
@@ -61,20 +99,41 @@ def look_from_extras(kinds: tuple[int, ...], values: np.ndarray) -> Look:
 
 @dataclass(frozen=True, eq=False)
 class Basis:
-    """M orthonormal directions of knot motion: ``raw`` (M, 2K) int16 as sent, ``vectors`` the
-    same as float64."""
+    """M orthonormal directions of knot motion: ``raw`` (M, 2K) int16 as sent (entries ×32767),
+    ``vectors`` the same as float64."""
 
     raw: np.ndarray
 
     @cached_property
     def vectors(self) -> np.ndarray:
+        """The directions as numbers.
+
+        Returns
+        -------
+        (M, 2K) float64 array
+            :attr:`raw` / 32767: each row a unit direction over x0, y0, x1, y1, ...
+        """
         return self.raw.astype(np.float64) / BASIS_ONE
 
     @classmethod
     def learn(cls, offsets: np.ndarray, m: int) -> Basis:
-        """The ``m`` principal directions (uncentred: the rest shape is offset zero) of
-        ``offsets`` (T, K, 2) model units, from a singular value decomposition. Fewer frames
-        than ``m`` give the remaining directions of the knots' own coordinates."""
+        """The principal directions (uncentred: the rest shape is offset zero) of knot offsets,
+        from a singular value decomposition, quantised as sent.
+
+        Parameters
+        ----------
+        offsets
+            (T, K, 2) float array: each frame's knot offsets (x to the subject's left, y up),
+            model units.
+        m
+            Directions wanted; at most 2K are given.
+
+        Returns
+        -------
+        Basis
+            min(``m``, 2K) directions, the most significant first. With fewer frames than ``m``,
+            the directions after the T-th complete an orthonormal basis (as the SVD gives them).
+        """
         x = np.asarray(offsets, np.float64).reshape(len(offsets), -1)
         rows = x.shape[1]
         m = int(min(m, rows))
@@ -82,17 +141,51 @@ class Basis:
         return cls(np.round(vt[:m] * BASIS_ONE).astype(np.int16))
 
     def coefficients(self, offsets: np.ndarray) -> np.ndarray:
-        """(M,) coefficients of (K, 2) offsets."""
+        """The coefficients of knot offsets on this basis (their projection).
+
+        Parameters
+        ----------
+        offsets
+            (K, 2) float array: the knots' offsets (x to the subject's left, y up), model units.
+
+        Returns
+        -------
+        (M,) float64 array
+            The coefficients, model units.
+        """
         return self.vectors @ np.asarray(offsets, np.float64).ravel()
 
     def offsets(self, coefficients: np.ndarray) -> np.ndarray:
-        """(K, 2) offsets of (M,) coefficients."""
+        """The knot offsets of coefficients on this basis.
+
+        Parameters
+        ----------
+        coefficients
+            (M,) float array, model units.
+
+        Returns
+        -------
+        (K, 2) float64 array
+            The knots' offsets (x to the subject's left, y up), model units.
+        """
         return (self.vectors.T @ np.asarray(coefficients, np.float64)).reshape(-1, 2)
 
 
 def topology_id(model: HeadModel) -> bytes:
-    """Eight bytes naming the model's topology: its vertex count, triangles and knot vertices
-    (the first 8 bytes of the SHA-256 of their compact JSON, ``docs/bitstream.md``)."""
+    """The topology of a head model, as the stream's header names it (``docs/bitstream.md``,
+    "Actor").
+
+    Parameters
+    ----------
+    model
+        The head model.
+
+    Returns
+    -------
+    bytes
+        Eight bytes: the first 8 of the SHA-256 of the compact JSON of the model's vertex count,
+        triangles and knot vertices.
+    """
     doc = {
         "vertices": len(model.vertices),
         "triangles": np.asarray(model.triangles).tolist(),

@@ -101,13 +101,40 @@ class Settings:
         return LADDER[self.quality][1] if self.coefficients is None else self.coefficients
 
     def steps(self, coefficients: int, look: bool = False) -> list[float]:
-        """Quantiser step per parameter (pose, then ``coefficients`` coefficients, then with
-        ``look`` the look's six values)."""
+        """Quantiser step per parameter (``docs/bitstream.md``, "Parameters").
+
+        Parameters
+        ----------
+        coefficients
+            Basis coefficients per frame.
+        look
+            Whether the look's six values follow the coefficients.
+
+        Returns
+        -------
+        list of float
+            6 + ``coefficients`` (+ 6 with ``look``) steps: yaw, pitch, roll (degrees), ln scale,
+            tx, ty (pixels), the coefficients (model units), the look's closures (shares of the
+            key frame's opening) and iris shifts (eye widths).
+        """
         scale = LADDER[self.quality][0]
         return [s * scale for s in POSE_STEPS + (COEFFICIENT_STEP,) * coefficients + (LOOK_STEPS if look else ())]
 
     def framing(self, fps: float) -> tuple[int, int]:
-        """(frames per packet, packets per intra packet) at ``fps``."""
+        """The stream's packets at a frame rate.
+
+        Parameters
+        ----------
+        fps
+            The video's frame rate, frames/s.
+
+        Returns
+        -------
+        frames : int
+            Frames per packet (P), 1-32.
+        keyframe : int
+            Packets from one intra packet to the next (K), 1-65535.
+        """
         frames = int(min(32, max(1, round(self.packet * fps))))
         return frames, int(min(65535, max(1, round(self.keyframe * fps / frames))))
 
@@ -138,17 +165,33 @@ class EncodedFrame:
 class MotionEncoder:
     """Encodes one face's motion, frame by frame.
 
-    ``actor``: the actor the motion is measured on (its model's topology and content hash go in
-    the header; with ``carry_actor`` the actor itself follows the header, texture as WebP);
-    ``fps``, ``size`` (width, height px): the video's; ``basis``: the coefficients' basis
-    (learned from the clip, :meth:`Basis.learn`); ``classes``: per parameter, the spread class
-    of its starting table (``facemime._core.choose_classes``; default: a middle class);
-    ``reference``: the pose intra frames are coded from (default: the actor's); ``look``: the
-    stream carries each frame's :class:`~facemime.types.look.Look` (format version 2; without
-    it the stream is version 1 and the receiver decodes a neutral look); ``actor_data``: the
-    carried actor's file bytes when already made (:func:`~facemime.io.actor_file.actor_bytes`
-    with a WebP texture: a live sender makes them before its stream starts, as they take a few
-    hundred milliseconds).
+    Parameters
+    ----------
+    actor
+        The actor the motion is measured on: its model's topology and content hash go in the
+        header.
+    fps
+        The video's frame rate, frames/s (within (0, 1000]).
+    size
+        (width, height) of the video, pixels.
+    basis
+        The coefficients' basis (learned from the clip, :meth:`Basis.learn`).
+    settings
+        How the stream is coded.
+    carry_actor
+        Whether the actor itself follows the header, its texture as WebP.
+    classes
+        Per parameter, the spread class (0-15) of its starting table
+        (``facemime._core.choose_classes``); None: a middle class (6) for all.
+    reference
+        The pose intra frames are coded from; None: the actor's.
+    look
+        Whether the stream carries each frame's :class:`~facemime.types.look.Look` (format
+        version 2); without it the stream is version 1 and the receiver decodes a neutral look.
+    actor_data
+        The carried actor's file bytes when already made
+        (:func:`~facemime.io.actor_file.actor_bytes` with a WebP texture: a live sender makes
+        them before its stream starts, as they take a few hundred milliseconds); None: made here.
     """
 
     def __init__(
@@ -195,7 +238,13 @@ class MotionEncoder:
         self.actor_data = actor_data
 
     def start(self) -> bytes:
-        """The stream's first bytes: the header, and the actor when carried."""
+        """The stream's first bytes.
+
+        Returns
+        -------
+        bytes
+            The header chunk, followed by the actor chunk when the actor is carried.
+        """
         return self.header + (_core.actor_chunk(self.actor_data) if self.actor_data else b"")
 
     @property
@@ -206,9 +255,28 @@ class MotionEncoder:
     def push(
         self, face: bool, lost: Sequence[str], pose: Pose, offsets: np.ndarray, look: Look | None = None
     ) -> EncodedFrame:
-        """Adds a frame: ``face`` (False: the pose, offsets and look are not sent), the features
-        ``lost``, the ``pose``, (K, 2) ``offsets`` (model units) and the ``look`` (None:
-        neutral; only an encoder made with ``look=True`` sends one)."""
+        """Adds a frame.
+
+        Parameters
+        ----------
+        face
+            Whether the frame shows a face; False: the pose, offsets and look are not sent.
+        lost
+            The features the tracker lost, names of :data:`facemime.types.contours.FEATURES`
+            (``mouth_outer``, ``mouth_inner``, ``brow_left``, ``brow_right``).
+        pose
+            The head pose.
+        offsets
+            (K, 2) float array: the knots' offsets (x to the subject's left, y up), model units.
+        look
+            The frame's look; None: neutral. Only an encoder made with ``look=True`` sends one
+            that is not neutral.
+
+        Returns
+        -------
+        EncodedFrame
+            What the receiver will decode for the frame, and the packet it completed, if any.
+        """
         look_values = (Look() if look is None else look).vector()
         if not np.all(np.isfinite(look_values)):
             raise InvalidInputError(f"the look's values must be finite, got {look_values.tolist()}")
@@ -233,16 +301,22 @@ class MotionEncoder:
         self._core.request_intra()
 
     def finish(self) -> bytes:
-        """The last packet's bytes (empty when none is pending)."""
+        """Ends the stream.
+
+        Returns
+        -------
+        bytes
+            The last packet chunk; b"" when no frame is pending.
+        """
         return self._core.finish() or b""
 
 
 @dataclass
 class DecodedFrame:
     """One frame out of the decoder: its ``index`` from the stream's start, ``face`` (False: show
-    the last face, dimmed), the features ``lost``, ``pose``, (K, 2) ``offsets``, ``concealed``:
-    it was lost or damaged and repeats the last good frame, and its ``look`` (neutral for a
-    version-1 stream, which carries none, and before the first decoded frame)."""
+    the last face, dimmed), the features ``lost``, ``pose``, (K, 2) ``offsets`` (model units),
+    ``concealed``: it was lost or damaged and repeats the last good frame, and its ``look``
+    (neutral for a version-1 stream, which carries none, and before the first decoded frame)."""
 
     index: int
     face: bool
@@ -255,10 +329,11 @@ class DecodedFrame:
 
 @dataclass
 class StreamInfo:
-    """The header's facts: ``fps``, ``size`` (width, height px), frames per packet, packets per
-    intra packet, the basis, whether the actor is in the stream, its content hash, and
-    ``extras``: the kinds of the extra parameters (``docs/bitstream.md``, "Look"; kinds 1-6 are
-    the look's values, :data:`~facemime.codec.params.LOOK_KINDS`; empty for version 1)."""
+    """The header's facts: ``fps`` (frames/s), ``size`` (width, height px), frames per packet,
+    packets per intra packet, the basis, whether the actor is in the stream, its content hash, the
+    model's topology, and ``extras``: the kinds of the extra parameters (``docs/bitstream.md``,
+    "Look (version 2)"; kinds 1-6 are the look's values, :data:`~facemime.codec.params.LOOK_KINDS`;
+    empty for version 1)."""
 
     fps: float
     size: tuple[int, int]
@@ -277,17 +352,27 @@ class StreamInfo:
 
 
 class MotionDecoder:
-    """Decodes a stream fed in pieces. ``actor``: the receiver's own copy of the stream's actor
-    (needed when the stream does not carry it; refused if it is another actor). ``from_start``:
-    the bytes start at the stream's start (a file); False for a receiver joining a live stream.
-    ``max_concealed``: for a file, refuse a stream that conceals more than this many frames per
-    frame decoded, and a minute besides (a stream whose sequence numbers jump far ahead).
+    """Decodes a stream fed in pieces.
 
     ``appearance`` collects the payloads of the stream's appearance chunks (updates of the
     actor's texture, ``docs/bitstream.md``, "Appearance"), unparsed, in stream order as they are
     read; ``appearance_after[k]`` is the number of frames the decoder had output (decoded and
     concealed, over all calls of :meth:`push` and :meth:`finish`) before ``appearance[k]`` was
     read, so it falls between those frames and the next.
+
+    Parameters
+    ----------
+    actor
+        The receiver's own copy of the stream's actor: needed when the stream does not carry
+        it; refused if it is another actor. None: the stream's.
+    from_start
+        Whether the bytes start at the stream's start (a file); False for a receiver joining a
+        live stream.
+    name
+        What the stream is called in error messages.
+    max_concealed
+        For a file: refuse a stream that conceals more than this many frames per frame decoded,
+        and a minute besides (a stream whose sequence numbers jump far ahead); None: no limit.
     """
 
     def __init__(
@@ -416,8 +501,13 @@ class MotionDecoder:
         return frames
 
     def reference(self) -> Pose:
-        """The pose the stream's motion starts from (its header's reference, quantised): the
-        source face's pose on its key frame."""
+        """The pose the stream's motion starts from.
+
+        Returns
+        -------
+        Pose
+            The header's reference pose (quantised): the source face's pose on its key frame.
+        """
         h = self._core.header()
         if h is None:
             raise StreamError(f"{self.name} has no header")
@@ -446,12 +536,29 @@ class MotionDecoder:
             decoded = again()
 
     def push(self, data: bytes) -> list[DecodedFrame]:
-        """Reads ``data``; returns the frames it completed, in order (concealed ones included)."""
+        """Reads more of the stream.
+
+        Parameters
+        ----------
+        data
+            The stream's next bytes, a piece of any size.
+
+        Returns
+        -------
+        list of DecodedFrame
+            The frames it completed, in order (concealed ones included).
+        """
         self._magic_seen = self._magic_seen or b"FMST" in data
         return self._segments(self._core.push(bytes(data)), lambda: self._core.push(b""))
 
     def finish(self) -> list[DecodedFrame]:
-        """Reads the end of the stream; raises :class:`StreamError` when nothing was decodable."""
+        """Reads the end of the stream; raises :class:`StreamError` when nothing was decodable.
+
+        Returns
+        -------
+        list of DecodedFrame
+            The frames still pending, in order (concealed ones included).
+        """
         frames = self._segments(self._core.finish(), self._core.finish)
         if self.info is None:
             reason = self._core.header_error()

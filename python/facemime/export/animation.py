@@ -41,10 +41,26 @@ def _multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def quaternions(yaw: np.ndarray, pitch: np.ndarray, roll: np.ndarray) -> np.ndarray:
-    """(T, 4) unit quaternions (x, y, z, w) of ``Rz(roll) Rx(pitch) Ry(yaw)`` (degrees, see
-    :func:`facemime.types.pose.rotation_matrix`), each on the side of the one before
-    (``q`` and ``-q`` are one rotation; glTF interpolates between neighbours as given).
+    """Unit quaternions of the rotations ``Rz(roll) Rx(pitch) Ry(yaw)`` (see
+    :func:`facemime.types.pose.rotation_matrix`), each on the side of the one before.
 
+    Parameters
+    ----------
+    yaw
+        (T,) float array: each frame's yaw, degrees.
+    pitch
+        (T,) float array: each frame's pitch, degrees.
+    roll
+        (T,) float array: each frame's roll, degrees.
+
+    Returns
+    -------
+    (T, 4) float64 array
+        (x, y, z, w) unit quaternions, each on the side of the one before (``q`` and ``-q`` are
+        one rotation; glTF interpolates between neighbours as given).
+
+    Examples
+    --------
     >>> np.round(quaternions(np.array([90.0]), np.zeros(1), np.zeros(1)), 4).tolist()
     [[0.0, 0.7071, 0.0, 0.7071]]
     """
@@ -63,10 +79,27 @@ def quaternions(yaw: np.ndarray, pitch: np.ndarray, roll: np.ndarray) -> np.ndar
 
 
 def node_keys(poses: np.ndarray, metres_per_unit: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(translation (T, 3) metres, rotation (T, 4) quaternions, scale (T, 3)) of the head's node
-    for ``poses`` ((T, 6) in the order of :data:`POSE_KEYS`: degrees, pixels per model unit,
-    pixels), as the module docstring maps them; ``metres_per_unit``: of the model (0.001 for mm).
+    """The keys of the head's node for a track's poses, as the module docstring maps them.
 
+    Parameters
+    ----------
+    poses
+        (T, 6) float array, each row in the order of :data:`POSE_KEYS`: yaw, pitch, roll degrees,
+        scale pixels per model unit, tx, ty pixels.
+    metres_per_unit
+        Metres per model unit of the head (0.001 for millimetres).
+
+    Returns
+    -------
+    translation : (T, 3) float64 array
+        Metres, the first frame at the origin; y up (the image's y reversed), z 0.
+    rotation : (T, 4) float64 array
+        (x, y, z, w) unit quaternions (:func:`quaternions`).
+    scale : (T, 3) float64 array
+        Uniform scale relative to the first frame, the same in all three columns.
+
+    Examples
+    --------
     >>> t, r, s = node_keys(np.array([[0, 0, 0, 2.0, 100, 50], [0, 0, 0, 4.0, 110, 40]]), 0.001)
     >>> (t[1] * 1000).tolist(), s[1].tolist()
     ([5.0, 5.0, 0.0], [2.0, 2.0, 2.0])
@@ -82,11 +115,27 @@ def node_keys(poses: np.ndarray, metres_per_unit: float) -> tuple[np.ndarray, np
 
 
 def camera_box(first: np.ndarray, size: tuple[int, int], metres_per_unit: float) -> tuple[float, float, float, float]:
-    """(left, right, top, bottom), metres, of the orthographic camera (looking down -z, y up)
-    that shows an image of ``size`` = (width, height) pixels as facemime projects the frames
-    whose first pose is ``first`` ((6,), :data:`POSE_KEYS`) under :func:`node_keys`: pixel
-    centres at integers, the image's edges half a pixel beyond the outer ones.
+    """The view box of the orthographic camera (looking down -z, y up) that shows the frames
+    keyed by :func:`node_keys` as facemime projects them: pixel centres at integers, the image's
+    edges half a pixel beyond the outer ones.
 
+    Parameters
+    ----------
+    first
+        (6,) float array: the first frame's pose in the order of :data:`POSE_KEYS` (degrees,
+        pixels per model unit, pixels).
+    size
+        (width, height) of the image, pixels.
+    metres_per_unit
+        Metres per model unit of the head (0.001 for millimetres).
+
+    Returns
+    -------
+    tuple of 4 float
+        (left, right, top, bottom) of the camera's view, metres in the world (y up).
+
+    Examples
+    --------
     >>> camera_box(np.array([0, 0, 0, 1.0, 1.5, 1.5]), (4, 4), 1.0)
     (-2.0, 2.0, 2.0, -2.0)
     """

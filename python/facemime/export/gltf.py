@@ -35,6 +35,13 @@ TYPES = {1: "SCALAR", 2: "VEC2", 3: "VEC3", 4: "VEC4"}
 class Glb:
     """A glTF document being built, with its binary buffer.
 
+    Parameters
+    ----------
+    generator
+        The tool named in the document's ``asset.generator``.
+
+    Examples
+    --------
     >>> g = Glb()
     >>> g.accessor(np.zeros((3, 2), np.float32))
     0
@@ -49,13 +56,41 @@ class Glb:
         self._length = 0
 
     def add(self, kind: str, entry: dict[str, Any]) -> int:
-        """Append ``entry`` to the document's list ``kind`` (``nodes``, ``meshes``, ...); its index."""
+        """Append an entry to one of the document's top-level lists.
+
+        Parameters
+        ----------
+        kind
+            The list's glTF name (``nodes``, ``meshes``, ...); created when missing.
+        entry
+            The glTF object appended, as JSON-ready values.
+
+        Returns
+        -------
+        int
+            The entry's index in that list, as other glTF objects refer to it.
+        """
         items = self.doc.setdefault(kind, [])
         items.append(entry)
         return len(items) - 1
 
     def view(self, data: bytes, target: int | None = None) -> int:
-        """Store ``data`` as a buffer view (4-byte aligned, as glTF needs for floats); its index."""
+        """Store bytes as a buffer view (4-byte aligned, as glTF needs for floats).
+
+        Parameters
+        ----------
+        data
+            The view's bytes.
+        target
+            The view's glTF ``target`` (:data:`ARRAY_BUFFER` for vertex attributes,
+            :data:`ELEMENT_ARRAY_BUFFER` for indices); None: no target written (images,
+            animation data).
+
+        Returns
+        -------
+        int
+            The buffer view's index.
+        """
         pad = -self._length % 4
         if pad:
             self._pieces.append(b"\0" * pad)
@@ -68,9 +103,25 @@ class Glb:
         return self.add("bufferViews", entry)
 
     def accessor(self, array: np.ndarray, target: int | None = None, bounds: bool = False) -> int:
-        """Store ``array`` ((count,) or (count, 1-4) of float32, uint32, uint16 or uint8) and
-        describe it; ``bounds``: write its per-component ``min`` and ``max`` (glTF needs them on
-        positions and animation times). Its accessor index."""
+        """Store an array in its own buffer view and describe it by an accessor.
+
+        Parameters
+        ----------
+        array
+            (count,) or (count, 1-4) array of float32, uint32, uint16 or uint8, in the units the
+            glTF property takes (metres for positions, seconds for animation times); written
+            little-endian.
+        target
+            The buffer view's glTF ``target`` (see :meth:`view`); None: none.
+        bounds
+            Whether to write the per-component ``min`` and ``max`` (glTF needs them on positions
+            and animation times).
+
+        Returns
+        -------
+        int
+            The accessor's index.
+        """
         a = np.ascontiguousarray(array, dtype=array.dtype.newbyteorder("<"))
         width = 1 if a.ndim == 1 else a.shape[1]
         entry: dict[str, Any] = {
@@ -87,7 +138,14 @@ class Glb:
         return self.add("accessors", entry)
 
     def bytes(self) -> bytes:
-        """The ``.glb`` file: header, JSON chunk (padded with spaces), binary chunk (with zeros)."""
+        """The ``.glb`` file of the document built so far.
+
+        Returns
+        -------
+        bytes
+            The 12-byte header, the JSON chunk (padded with spaces) and, when anything was
+            stored, the binary chunk (padded with zeros).
+        """
         if self._length:
             self.doc["buffers"] = [{"byteLength": self._length + (-self._length % 4)}]
         text = json.dumps(self.doc, separators=(",", ":")).encode()
@@ -101,9 +159,23 @@ class Glb:
 
 
 def read_glb(data: bytes) -> tuple[dict[str, Any], bytes]:
-    """The JSON document and binary chunk of a ``.glb`` file's bytes (for checks; no validation
+    """Split a ``.glb`` file into its JSON document and binary chunk (for checks; no validation
     beyond the header and chunk types).
 
+    Parameters
+    ----------
+    data
+        The whole ``.glb`` file.
+
+    Returns
+    -------
+    doc : dict
+        The parsed JSON document.
+    blob : bytes
+        The binary chunk; empty when the file has none.
+
+    Examples
+    --------
     >>> doc, blob = read_glb(Glb("x").bytes())
     >>> doc["asset"], blob
     ({'version': '2.0', 'generator': 'x'}, b'')
@@ -124,7 +196,23 @@ def read_glb(data: bytes) -> tuple[dict[str, Any], bytes]:
 
 
 def accessor_array(doc: dict[str, Any], blob: bytes, index: int) -> np.ndarray:
-    """The array of accessor ``index`` (tightly packed views only, as :class:`Glb` writes them)."""
+    """The array an accessor describes (tightly packed views only, as :class:`Glb` writes them).
+
+    Parameters
+    ----------
+    doc
+        The glTF JSON document (:func:`read_glb`).
+    blob
+        The binary chunk the document's buffer views address.
+    index
+        The accessor's index in ``doc["accessors"]``.
+
+    Returns
+    -------
+    (count,) or (count, width) array
+        Read-only view of ``blob`` in the accessor's dtype (float32, uint32, uint16 or uint8);
+        (count,) for ``SCALAR`` accessors, else ``width`` = 2-4 components per row.
+    """
     acc = doc["accessors"][index]
     view = doc["bufferViews"][acc["bufferView"]]
     dtype = next(d for d, c in COMPONENTS.items() if c == acc["componentType"])

@@ -78,6 +78,13 @@ class Performance:
 
     @property
     def metres_per_unit(self) -> float:
+        """Metres per model unit of the actor's model (its ``unit`` looked up in :data:`METRES`).
+
+        Returns
+        -------
+        float
+            0.001 for a model in millimetres, 0.01 in centimetres, 1 in metres.
+        """
         unit = self.actor.model.unit
         if unit not in METRES:
             raise InvalidInputError(f"the actor's model is in {unit!r}; export needs one in {', '.join(METRES)}")
@@ -85,7 +92,19 @@ class Performance:
 
 
 def glb_bytes(perf: Performance) -> bytes:
-    """The ``.glb`` file of ``perf`` (see the module docstring)."""
+    """The ``.glb`` file of a performance (see the module docstring).
+
+    Parameters
+    ----------
+    perf
+        The performance: the actor's mesh, texture and morph targets, and one animation key per
+        frame.
+
+    Returns
+    -------
+    bytes
+        The binary glTF 2.0 file; positions and morph targets in metres, key times in seconds.
+    """
     m = perf.metres_per_unit
     model = perf.actor.model
     g = Glb(f"facemime {__version__}")
@@ -175,9 +194,26 @@ def _file_weights(path: Path, names: tuple[str, ...]) -> np.ndarray | None:
 
 
 def load_performance(track: str | Path, actor: Actor | None = None) -> Performance:
-    """The performance of a ``facemime.track/1`` file written by ``facemime run`` on ``actor``
-    (default: the generic painted head, as ``facemime view`` plays a track file): the frames'
-    ``weights`` when every frame has them, else solved from their knot offsets and eye closure."""
+    """The performance of a ``facemime.track/1`` file written by ``facemime run``, played by an
+    actor.
+
+    Parameters
+    ----------
+    track
+        Path of the track file.
+    actor
+        The head that plays the track; None: the generic painted head framed in the track's video
+        size, as ``facemime view`` plays a track file. Its model must have the generic head's
+        expression controls and knots.
+
+    Returns
+    -------
+    Performance
+        The frames' ``weights`` when every frame has them, else solved from their knot offsets
+        and eye closure; key times ``index / fps`` seconds; each pose's scale multiplied by the
+        track's outer eye corner distance over the actor model's (both model units), the size the
+        head is shown at alone.
+    """
     from facemime.animate.expressions import Expressions
 
     track = Path(track)

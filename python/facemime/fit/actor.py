@@ -33,8 +33,31 @@ SCENE_MAX_SIDE = 2048
 
 
 def smear_texture(model: HeadModel, photo: np.ndarray, fit: Fit, points: ReferencePoints, source: dict) -> Actor:
-    """Build the actor: ``model`` with ``fit``'s vertices, textured by ``photo`` ((H, W, 3) uint8
-    RGB) — each vertex's texture coordinate is where it projects in the photo (docs/method.md §2.4)."""
+    """Build the actor: the model with the fit's vertices, textured by the photo — each vertex's
+    texture coordinate is where it projects in the photo (docs/method.md §2.4).
+
+    Parameters
+    ----------
+    model
+        The head fitted; its triangles, groups and units are kept, its vertices and ``uv``
+        replaced.
+    photo
+        (H, W, 3) uint8 RGB: the photo the model was fitted on.
+    fit
+        The fit of ``model`` to ``photo``: adjusted vertices (model units) and frontal pose.
+    points
+        The reference points fitted to, name -> (K, 2) (x, y) pixels of ``photo``.
+    source
+        Where the photo came from: ``file`` (name only), ``frame``, ``width``, ``height``
+        (pixels); copied into the actor.
+
+    Returns
+    -------
+    Actor
+        Its texture the photo cropped around the projected face (margin :data:`TEXTURE_MARGIN`
+        of the face's size) and shrunk to at most :data:`TEXTURE_MAX_SIDE` pixels a side, its
+        scene the whole photo shrunk to at most :data:`SCENE_MAX_SIDE` pixels a side.
+    """
     h, w = photo.shape[:2]
     px = project(fit.vertices, fit.pose)[0]
     lo, hi = px.min(axis=0), px.max(axis=0)
@@ -68,16 +91,41 @@ def _shrunk(image: np.ndarray, side: int) -> np.ndarray:
 
 
 def generic_actor(size: tuple[int, int] = (512, 512)) -> Actor:
-    """The generic head with its painted texture, as an actor framed in a view of ``size`` =
-    (width, height) pixels."""
+    """The generic head with its painted texture, as an actor framed in a view.
+
+    Parameters
+    ----------
+    size
+        (width, height) of the view, pixels.
+
+    Returns
+    -------
+    Actor
+        The generic head (millimetres) with a 512 x 512 painted texture, frontal, centred and
+        filling 0.8 of the view's tighter side; no source, points or scene.
+    """
     head = generic_head()
     return Actor(head, painted_texture(head, 512), Pose.framing(head.vertices, size, 0.8))
 
 
 def find_points(photo: np.ndarray, name: str) -> tuple[AutoPoints, list[str]]:
-    """The reference points of the largest face of ``photo`` ((H, W, 3) uint8 RGB) and warnings
-    (several faces); ``name`` names the photo in them and in the
-    :class:`~facemime.errors.NoFaceError` raised where there is no face."""
+    """The reference points of the largest face of a photo, and warnings (several faces).
+
+    Parameters
+    ----------
+    photo
+        (H, W, 3) uint8 RGB.
+    name
+        Names the photo in the warnings and in the :class:`~facemime.errors.NoFaceError`
+        raised where there is no face.
+
+    Returns
+    -------
+    found : AutoPoints
+        The points, (x, y) pixels of ``photo``, and the face they were found on.
+    warnings : list of str
+        One line when there are several faces; else empty.
+    """
     try:
         found = auto_points(photo)
     except NoFaceError:
@@ -89,10 +137,32 @@ def find_points(photo: np.ndarray, name: str) -> tuple[AutoPoints, list[str]]:
 def fit_actor(
     photo: np.ndarray, name: str, points: dict | None = None, frame: int = 0, model: HeadModel | None = None
 ) -> tuple[Actor, list[str], float]:
-    """Fit ``model`` (default: the generic head) to ``photo`` ((H, W, 3) uint8 RGB) on the given
-    validated reference ``points`` or, without them, on points found automatically. ``name`` is
-    the photo's file name, for messages and the actor's metadata. Returns the actor, warnings
-    (several faces) and the final contour residual (pixels)."""
+    """Fit a head model to a photo on given reference points or, without them, on points found
+    automatically.
+
+    Parameters
+    ----------
+    photo
+        (H, W, 3) uint8 RGB.
+    name
+        The photo's file name, for messages and the actor's metadata (its last path component).
+    points
+        Validated reference points (:func:`facemime.types.points.check_points`), name -> (K, 2)
+        (x, y) pixels of ``photo``; None: found automatically on the largest face.
+    frame
+        The photo's frame index in its video (0 for a still image), for the actor's metadata.
+    model
+        The head fitted; None: the generic head.
+
+    Returns
+    -------
+    actor : Actor
+        The fitted, textured head (:func:`smear_texture`).
+    warnings : list of str
+        For the user (several faces found); empty with given ``points``.
+    residual : float
+        Mean contour disagreement after the elastic adjustment, pixels.
+    """
     model = model or generic_head()
     warnings: list[str] = []
     if points is None:
@@ -104,7 +174,19 @@ def fit_actor(
 
 
 def init_contours(actor: Actor) -> dict[str, np.ndarray]:
-    """The eight tracker contours of ``actor``: its mouth and brow vertices projected onto its
-    source photo, name -> (K, 2) float64 pixels."""
+    """The eight tracker contours of an actor: its mouth and brow vertices projected onto its
+    source photo.
+
+    Parameters
+    ----------
+    actor
+        A fitted actor; its pose maps its model onto its source photo.
+
+    Returns
+    -------
+    dict of str -> (K, 2) float64 array
+        Contour name (:data:`~facemime.types.contours.CONTOUR_NAMES`) -> (x, y) pixels of the
+        source photo, ordered image-left to image-right.
+    """
     points = project(actor.model.vertices, actor.pose)[0]
     return {n: points[actor.model.groups[n]] for n in CONTOUR_NAMES}

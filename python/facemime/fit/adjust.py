@@ -27,9 +27,23 @@ TOLERANCE = 0.004
 
 
 def frontal_pose(model_points: np.ndarray, image_points: np.ndarray) -> Pose:
-    """The frontal pose (roll, scale, translation) that best maps (K, 3) model points onto
-    (K, 2) image points, least squares; K >= 2.
+    """The frontal pose (roll, scale, translation) that best maps model points onto image
+    points, least squares.
 
+    Parameters
+    ----------
+    model_points
+        (K, 3) float array, K >= 2: model coordinates, model units; z is ignored (frontal view).
+    image_points
+        (K, 2) float array: the matching (x, y) pixels, y down.
+
+    Returns
+    -------
+    Pose
+        Yaw and pitch 0; roll degrees, scale pixels per model unit, tx, ty pixels.
+
+    Examples
+    --------
     >>> frontal_pose(np.array([[-45.0, 0, 0], [45, 0, 0]]), np.array([[100.0, 50], [190, 50]]))
     Pose(yaw=0.0, pitch=0.0, roll=-0.0, scale=1.0, tx=145.0, ty=50.0)
     """
@@ -61,14 +75,28 @@ class Fit:
 
 
 def fit_model(model: HeadModel, points: ReferencePoints) -> Fit:
-    """Scale and place ``model`` on validated reference ``points`` (see
-    :func:`facemime.types.points.check_points`), then adjust it elastically until its contours
-    lie on theirs.
+    """Scale and place a head model on reference points, then adjust it elastically until its
+    contours lie on theirs.
 
     The placement is the least-squares similarity of the single points (but the lids) and the
     curve ends; the adjusted image positions are taken back into model space through it, so
     proportions that differ from the generic head (a longer face, a wider mouth) stay in the
     vertices.
+
+    Parameters
+    ----------
+    model
+        The head to fit; its groups hold the vertices each point marks
+        (:func:`~facemime.types.points.model_chain`).
+    points
+        Validated reference points (:func:`facemime.types.points.check_points`), name -> (K, 2)
+        (x, y) pixels of the photo.
+
+    Returns
+    -------
+    Fit
+        The adjusted vertices (model units; x and y adjusted, z the model's own), the placing
+        pose and the residual of each iteration, pixels.
     """
     anchors_m, anchors_i = [], []
     for name, pts in points.items():

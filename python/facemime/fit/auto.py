@@ -31,10 +31,20 @@ class AutoPoints:
 
 
 def auto_points(rgb: np.ndarray) -> AutoPoints:
-    """Reference points of the largest human face in an (H, W, 3) uint8 RGB photo, clipped to
-    the photo.
+    """Reference points of the largest human face in a photo, clipped to the photo.
 
     Raises :class:`facemime.errors.NoFaceError` when no face is found.
+
+    Parameters
+    ----------
+    rgb
+        (H, W, 3) uint8 RGB photo.
+
+    Returns
+    -------
+    AutoPoints
+        The points, name -> (K, 2) float64 (x, y) pixels within the photo (-0.5 to W - 0.5,
+        -0.5 to H - 0.5), and the face they were found on.
     """
     face = find_face(rgb)
     h, w = rgb.shape[:2]

@@ -14,7 +14,23 @@ YAWS = (-30.0, 0.0, 30.0)
 
 
 def preview_sheet(actor: Actor, photo: np.ndarray, cell: int = 360) -> np.ndarray:
-    """The preview of ``actor`` fitted on ``photo``; each panel ``cell`` pixels square."""
+    """The preview of an actor fitted on a photo.
+
+    Parameters
+    ----------
+    actor
+        The fitted actor; its pose maps its model onto ``photo``.
+    photo
+        (H, W, 3) uint8 RGB: the photo the actor was fitted on.
+    cell
+        Side of each square panel, pixels.
+
+    Returns
+    -------
+    (cell, 4 * cell, 3) uint8 array
+        RGB, four panels left to right: the photo around the face with the adjusted wireframe,
+        then the textured actor at yaw -30, 0 and +30 degrees (:data:`YAWS`).
+    """
     m = actor.model
     points = project(m.vertices, actor.pose)[0]
     lo, hi = points.min(axis=0), points.max(axis=0)

@@ -11,6 +11,14 @@ from facemime.types.head import HeadModel
 
 
 def generic_head() -> HeadModel:
-    """The generic head shipped with facemime (about 120 vertices, millimetres)."""
+    """The generic head shipped with facemime (about 120 vertices, millimetres).
+
+    Returns
+    -------
+    HeadModel
+        Read afresh from ``data/generic_head.json``: model units millimetres, origin between the
+        outer eye corners (90 mm apart), with texture coordinates, vertex groups and deformation
+        units.
+    """
     text = resources.files("facemime.head").joinpath("data/generic_head.json").read_text(encoding="utf-8")
     return parse_head(text, "generic_head.json")

@@ -20,8 +20,25 @@ LASHES = (40, 28, 26)
 
 
 def painted_texture(model: HeadModel, size: int = 512) -> np.ndarray:
-    """A (size, size, 3) uint8 RGB texture painted at ``model.uv`` from its vertex groups.
+    """A texture painted at the model's texture coordinates from its vertex groups: skin, brows,
+    eyes, lips and nostrils.
 
+    Parameters
+    ----------
+    model
+        The head; it needs ``uv`` and a facemime head's brow, eye, mouth and nose groups
+        (:data:`facemime.types.head.REQUIRED_GROUPS`); the nostrils are painted where the nose
+        has a facemime head's layout (at least ten vertices, the ninth and tenth the alae).
+    size
+        Side of the square texture, pixels, 16 to 4096.
+
+    Returns
+    -------
+    (size, size, 3) uint8 array
+        RGB, addressed by ``model.uv`` from its top-left corner.
+
+    Examples
+    --------
     >>> from facemime.head import generic_head
     >>> painted_texture(generic_head(), 64).shape
     (64, 64, 3)
@@ -64,7 +81,8 @@ def painted_texture(model: HeadModel, size: int = 512) -> np.ndarray:
     cv2.fillPoly(img, [poly("mouth_outer_upper", "mouth_outer_lower")], LIP, **draw)
     cv2.polylines(img, [poly("mouth_inner_upper")], False, MOUTH_LINE, max(1, round(3 * scale)), **draw)
     nose = px[model.groups["nose"]]
-    for k in (8, 9):  # the two alae: nostrils just inside them, towards the nose tip
+    alae = (8, 9) if len(nose) >= 10 else ()  # a shorter nose (a head of its own) has no nostrils painted
+    for k in alae:  # the two alae: nostrils just inside them, towards the nose tip
         c = 0.6 * nose[k] + 0.4 * nose[7]
         cv2.ellipse(
             img,

@@ -56,8 +56,22 @@ SCENES = ("scene.png", "scene.webp")
 
 
 def actor_json(actor: Actor) -> bytes:
-    """The ``actor.json`` member of ``actor``'s file (deterministic: its SHA-256 names the actor
-    in a stream, see ``docs/bitstream.md``)."""
+    """The ``actor.json`` member of ``actor``'s file.
+
+    The bytes are deterministic: their SHA-256 names the actor in a stream (see
+    ``docs/bitstream.md``, and :func:`actor_id`).
+
+    Parameters
+    ----------
+    actor
+        The actor to describe.
+
+    Returns
+    -------
+    bytes
+        The ``facemime.actor/1`` JSON document (model, pose, source, reference points, texture and
+        scene sizes), UTF-8.
+    """
     doc = {
         "format": ACTOR_FORMAT,
         "model": head_document(actor.model),
@@ -72,8 +86,23 @@ def actor_json(actor: Actor) -> bytes:
 
 
 def actor_bytes(actor: Actor, texture: str = "png", quality: int = 90) -> bytes:
-    """``actor`` as the bytes of an actor file, its texture and scene as PNG or WebP (``quality``
-    1-100)."""
+    """``actor`` as the bytes of an actor file (a ZIP archive, see the module docstring).
+
+    Parameters
+    ----------
+    actor
+        The actor to store.
+    texture
+        How the texture and the scene are encoded: ``"png"`` (what a file on disk holds) or
+        ``"webp"`` (the smaller form a stream carries).
+    quality
+        WebP quality, 1-100; PNG is lossless and ignores it.
+
+    Returns
+    -------
+    bytes
+        The ``.actor`` file's content; the same actor gives the same bytes.
+    """
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
         # ZipInfo entries are dated 1980-01-01: the same actor gives the same bytes, whenever written
@@ -98,7 +127,23 @@ def _encoded(image: np.ndarray, what: str, kind: str, quality: int) -> bytes:
 
 
 def save_actor(path: str | Path, actor: Actor, force: bool = False) -> Path:
-    """Write ``actor`` to ``path`` atomically (PNG texture); refuses to overwrite unless ``force``."""
+    """Write ``actor`` to an ``.actor`` file atomically, its texture and scene as PNG.
+
+    Parameters
+    ----------
+    path
+        The file to write; its folder is created if missing.
+    actor
+        The actor to store.
+    force
+        Overwrite an existing file; without it one is refused with
+        :class:`facemime.io.outputs.OutputExistsError`.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
     path = Path(path)
     check_outputs([path], force)
     return write_bytes(path, actor_bytes(actor))
@@ -122,7 +167,19 @@ def _member(z: zipfile.ZipFile, name: str, limit: int, where: str) -> bytes:
 
 
 def load_actor(path: str | Path) -> Actor:
-    """Read and validate an ``.actor`` file."""
+    """Read and validate an ``.actor`` file.
+
+    Parameters
+    ----------
+    path
+        The ``.actor`` file. One that is missing or not a file raises :class:`InputFileError`; a
+        corrupt, foreign or hostile one :class:`ActorFileError`.
+
+    Returns
+    -------
+    Actor
+        The actor the file holds.
+    """
     path = Path(path)
     if not path.is_file():
         raise InputFileError(
@@ -132,13 +189,37 @@ def load_actor(path: str | Path) -> Actor:
 
 
 def actor_id(actor: Actor) -> bytes:
-    """The SHA-256 of the actor's ``actor.json`` member: what a stream names it by."""
+    """The SHA-256 of the actor's ``actor.json`` member: what a stream names it by.
+
+    Parameters
+    ----------
+    actor
+        The actor to name.
+
+    Returns
+    -------
+    bytes
+        The 32-byte SHA-256 digest of :func:`actor_json`.
+    """
     return hashlib.sha256(actor_json(actor)).digest()
 
 
 def actor_from_bytes(source: str | Path | bytes, where: str) -> Actor:
-    """Read and validate an actor file's content: ``source`` is its path or its bytes; ``where``
-    names it in messages."""
+    """Read and validate an actor file's content.
+
+    Parameters
+    ----------
+    source
+        The ``.actor`` file's path, or its bytes (as a stream carries them).
+    where
+        What names the file in error messages.
+
+    Returns
+    -------
+    Actor
+        The actor; a file that is not a valid actor raises :class:`ActorFileError`, one that cannot
+        be read :class:`InputFileError`.
+    """
     try:
         with zipfile.ZipFile(io.BytesIO(source) if isinstance(source, bytes) else source) as z:
             text = _member(z, "actor.json", MAX_JSON_BYTES, where)

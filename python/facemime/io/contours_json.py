@@ -63,8 +63,20 @@ class ContourFileError(FacemimeError, ValueError):
 
 
 def load_json(path: str | Path, what: str) -> Any:
-    """The JSON document of the ``what`` file at ``path`` (within the input policy's size, see
-    :mod:`facemime.limits`)."""
+    """The JSON document in a file, read within the input policy's size (:mod:`facemime.limits`).
+
+    Parameters
+    ----------
+    path
+        The JSON file.
+    what
+        The kind of file (``"init"``, ``"track"``, ``"points"``), named in error messages.
+
+    Returns
+    -------
+    Any
+        The parsed document; a file that is not UTF-8 JSON raises :class:`ContourFileError`.
+    """
     p = Path(path)
     data = read_json_text(p, what)
     try:
@@ -78,7 +90,22 @@ def load_json(path: str | Path, what: str) -> Any:
 
 
 def load_document(path: str | Path, what: str, fmt: str) -> dict[str, Any]:
-    """Read the JSON ``what`` file at ``path`` and check that it is a ``fmt`` document."""
+    """Read a JSON file and check that it is a document of the expected format.
+
+    Parameters
+    ----------
+    path
+        The JSON file.
+    what
+        The kind of file (``"init"``, ``"track"``, ``"points"``), named in error messages.
+    fmt
+        The format name its ``"format"`` must hold, e.g. ``"facemime.init/1"``.
+
+    Returns
+    -------
+    dict
+        The document; another format raises :class:`ContourFileError`.
+    """
     doc = load_json(path, what)
     if not isinstance(doc, dict) or doc.get("format") != fmt:
         found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
@@ -114,8 +141,23 @@ def _contours(doc: Mapping[str, Any], where: str, size: tuple[int, int] | None, 
 
 
 def read_init(path: str | Path, size: tuple[int, int] | None = None) -> tuple[int, Contours]:
-    """Read a ``facemime.init/1`` file; returns (frame index, contours). With ``size``
-    (width, height) every point must lie inside the image."""
+    """Read a ``facemime.init/1`` file.
+
+    Parameters
+    ----------
+    path
+        The init file.
+    size
+        (width, height) of the video, pixels: every point must then lie inside the image (within
+        half a pixel of the outer pixels' centres). None checks no bounds.
+
+    Returns
+    -------
+    frame : int
+        The 0-based index of the frame the contours are on (0 when the file has no ``frame``).
+    contours : dict of str -> (N, 2) float64 array
+        The eight contours by name, (x, y) pixels.
+    """
     doc = load_document(path, "init", INIT_FORMAT)
     where = str(path)
     frame = doc.get("frame", 0)
@@ -125,7 +167,21 @@ def read_init(path: str | Path, size: tuple[int, int] | None = None) -> tuple[in
 
 
 def init_document(frame: int, contours: Mapping[str, np.ndarray]) -> dict[str, Any]:
-    """A ``facemime.init/1`` document."""
+    """A ``facemime.init/1`` document.
+
+    Parameters
+    ----------
+    frame
+        0-based index of the frame the contours are on.
+    contours
+        The eight contours by name (:data:`facemime.types.contours.CONTOUR_NAMES`, all required),
+        each (N, 2) (x, y) pixels; other names are left out.
+
+    Returns
+    -------
+    dict
+        The JSON-ready document, coordinates rounded to 0.001 pixel.
+    """
     return {
         "format": INIT_FORMAT,
         "frame": int(frame),
@@ -139,11 +195,31 @@ def track_document(
     timing: Mapping[str, float] | None = None,
     model: Mapping[str, Any] | None = None,
 ) -> dict[str, Any]:
-    """A ``facemime.track/1`` document. ``frames``: dicts with ``index``, ``contours`` (name ->
-    (N, 2) array) and optionally ``confidence`` (feature -> float), ``lost`` (list of
-    features), ``redetected`` (bool: the face landmark model put the contours right on this
-    frame), ``face`` (bool), ``pose`` (mapping) and ``offsets`` ((K, 2) array); ``model``
-    describes the knots the offsets belong to (see the module docstring)."""
+    """A ``facemime.track/1`` document.
+
+    Parameters
+    ----------
+    video
+        The video's ``width``, ``height`` (pixels), ``fps`` (frames/s) and ``frames`` (count);
+        other keys are left out.
+    frames
+        One mapping per frame, as :func:`track_entry` takes: ``index``, ``contours`` (name -> (N, 2)
+        (x, y) pixels) and optionally ``confidence`` (feature -> 0..1), ``lost`` (list of
+        features), ``redetected`` (bool: the face landmark model put the contours right on this
+        frame), ``face`` (bool), ``pose`` (key -> value, degrees and pixels), ``offsets`` ((K, 2)
+        model units), ``look``, ``weights`` and ``scene_departure`` with ``scene_departs``.
+    timing
+        The top-level ``timing`` entry (``processing_seconds``, ``frames_processed``); None leaves
+        it out.
+    model
+        The top-level ``model`` entry: ``unit``, ``knots``, ``feature_sizes``, ``iod``, what the
+        offsets belong to (see the module docstring); None leaves it out.
+
+    Returns
+    -------
+    dict
+        The JSON-ready document.
+    """
     doc: dict[str, Any] = {"format": TRACK_FORMAT, "frames": [track_entry(f) for f in frames]}
     return {**doc, **_closing(video, timing, model)}
 
@@ -164,8 +240,20 @@ def _closing(
 
 
 def track_entry(f: Mapping[str, Any]) -> dict[str, Any]:
-    """One frame's entry of a track document (see :func:`track_document`), rounded to what the
-    format keeps."""
+    """One frame's entry of a track document, rounded to what the format keeps.
+
+    Parameters
+    ----------
+    f
+        The frame: ``index``, ``contours`` and the optional keys that :func:`track_document`
+        lists; other keys are left out.
+
+    Returns
+    -------
+    dict
+        The JSON-ready entry: coordinates and offsets to 0.001, confidences, pose values, look,
+        weights and scene departure to 4 decimals.
+    """
     entry: dict[str, Any] = {
         "index": int(f["index"]),
         "contours": {n: np.round(np.asarray(c, float), 3).tolist() for n, c in f["contours"].items()},
@@ -196,7 +284,13 @@ class TrackWriter:
     """Writes a ``facemime.track/1`` document frame by frame to ``path`` (a file that the caller
     puts in place when complete, :class:`facemime.io.outputs.Outputs`), so that a long video's
     track is not held in memory: :meth:`append` each frame (as for :func:`track_document`), then
-    :meth:`close` with what comes after the frames."""
+    :meth:`close` with what comes after the frames.
+
+    Parameters
+    ----------
+    path
+        The file to write, opened (and truncated) at once.
+    """
 
     def __init__(self, path: Path):
         self._path = path
@@ -214,6 +308,13 @@ class TrackWriter:
         self._io(lambda: self._file.write(text))
 
     def append(self, frame: Mapping[str, Any]) -> None:
+        """Write one frame's entry.
+
+        Parameters
+        ----------
+        frame
+            The frame, as :func:`track_document` takes it (see :func:`track_entry`).
+        """
         self._write(("," if self.frames else "") + "\n" + json.dumps(track_entry(frame)))
         self.frames += 1
 
@@ -224,6 +325,19 @@ class TrackWriter:
         model: Mapping[str, Any] | None = None,
         extra: Mapping[str, Any] | None = None,
     ) -> None:
+        """Write the entries after the frames and close the file.
+
+        Parameters
+        ----------
+        video
+            The video's ``width``, ``height`` (pixels), ``fps`` (frames/s) and ``frames`` (count).
+        timing
+            The top-level ``timing`` entry; None leaves it out.
+        model
+            The top-level ``model`` entry (see :func:`track_document`); None leaves it out.
+        extra
+            More top-level entries (``scene_departs``); None for none.
+        """
         self._write("\n], " + json.dumps(_closing(video, timing, model, extra))[1:])
         self._io(self._file.close)
 
@@ -239,12 +353,39 @@ class TrackWriter:
 
 
 def write_json(path: str | Path, doc: Mapping[str, Any]) -> Path:
-    """Write a JSON document atomically (compact, one frame per line for track files)."""
+    """Write a JSON document atomically, compact, on one line.
+
+    Parameters
+    ----------
+    path
+        The file to write (an init or track file); its folder is created if missing.
+    doc
+        The document, as :func:`init_document` or :func:`track_document` make it.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
     return write_text(path, json.dumps(doc, separators=(",", ":")) + "\n")
 
 
 def read_track(path: str | Path) -> tuple[dict[str, Any], dict[int, Contours]]:
-    """Read a ``facemime.track/1`` file; returns (video info, frame index -> contours)."""
+    """Read a ``facemime.track/1`` file's contours.
+
+    Parameters
+    ----------
+    path
+        The track file.
+
+    Returns
+    -------
+    video : dict
+        The file's ``video`` entry (``width``, ``height``, ``fps``, ``frames``), ``{}`` when it
+        has none.
+    contours : dict of int -> dict of str -> (N, 2) float64 array
+        Frame index -> the contours of that frame by name, (x, y) pixels.
+    """
     doc = load_document(path, "track", TRACK_FORMAT)
     where = str(path)
     frames = doc.get("frames")

@@ -35,9 +35,21 @@ _COUNT_LIMITS = {
 
 
 def check_model_count(where: str, what: str, count: int) -> None:
-    """Refuse a model of more ``what`` (a key of ``_COUNT_LIMITS``) than the input policy allows
-    (:mod:`facemime.limits`) with a :class:`ModelFormatError` naming ``where``, the limit and
-    how to raise it."""
+    """Refuse a model of more vertices, triangles or unit values than the input policy allows.
+
+    The refusal (:mod:`facemime.limits`) is a :class:`ModelFormatError` naming ``where``, the limit
+    and how to raise it.
+
+    Parameters
+    ----------
+    where
+        What names the model (its file, section, line) in the message.
+    what
+        What is counted, a key of ``_COUNT_LIMITS``: ``"vertices"``, ``"triangles"`` or
+        ``"deformation unit values (units x vertices)"``.
+    count
+        How many the model has.
+    """
     variable = _COUNT_LIMITS[what]
     most = limit(variable)
     if count > most:
@@ -47,9 +59,20 @@ def check_model_count(where: str, what: str, count: int) -> None:
 
 
 def read_model_file(path: Path) -> bytes:
-    """The bytes of a model file. A file over the byte limit is refused with
-    :class:`ModelFormatError` before it is read (or, when its size is unknown, after one byte
-    more than the limit); a missing or unreadable one with :class:`InputFileError`."""
+    """The bytes of a model file, within the input policy's size.
+
+    Parameters
+    ----------
+    path
+        The model file (``facemime.head/1`` JSON or CANDIDE ``.wfm``).
+
+    Returns
+    -------
+    bytes
+        The whole file. A file over the byte limit (``FACEMIME_MAX_MODEL_BYTES``) is refused with
+        :class:`ModelFormatError` before it is read (or, when its size is unknown, after one byte
+        more than the limit); a missing or unreadable one with :class:`InputFileError`.
+    """
     most = limit("FACEMIME_MAX_MODEL_BYTES")
     too_big = f"more than the limit of {most} bytes; set FACEMIME_MAX_MODEL_BYTES to allow more"
     try:
@@ -74,6 +97,16 @@ def load_head(path: str | Path) -> HeadModel:
 
     Raises :class:`InputFileError` if it cannot be read and :class:`ModelFormatError`, naming the
     file and the problem, if it is not a valid model or is over a limit (see the module docstring).
+
+    Parameters
+    ----------
+    path
+        The model file.
+
+    Returns
+    -------
+    HeadModel
+        The model, in the file's ``unit`` (model space, see the module docstring).
     """
     path = Path(path)
     try:
@@ -84,6 +117,21 @@ def load_head(path: str | Path) -> HeadModel:
 
 
 def parse_head(text: str, where: str) -> HeadModel:
+    """Parse and validate the text of a ``facemime.head/1`` JSON model.
+
+    Parameters
+    ----------
+    text
+        The JSON text.
+    where
+        What names the model (its file) in error messages.
+
+    Returns
+    -------
+    HeadModel
+        The model; text that is not valid JSON or not a valid model raises
+        :class:`ModelFormatError`.
+    """
     try:
         doc = parse_json(text, where)
     except json.JSONDecodeError as e:
@@ -94,7 +142,19 @@ def parse_head(text: str, where: str) -> HeadModel:
 
 
 def head_document(model: HeadModel) -> dict[str, Any]:
-    """``model`` as a ``facemime.head/1`` document (JSON-ready; floats kept exactly)."""
+    """``model`` as a ``facemime.head/1`` document.
+
+    Parameters
+    ----------
+    model
+        The model to store; its shape units are not stored.
+
+    Returns
+    -------
+    dict
+        The JSON-ready document, floats kept exactly; each deformation unit lists only the
+        vertices it moves.
+    """
     units = {
         name: {
             "description": model.descriptions.get(name, ""),
@@ -115,9 +175,22 @@ def head_document(model: HeadModel) -> dict[str, Any]:
 
 
 def head_from_document(doc: object, where: str) -> HeadModel:
-    """Validate a parsed ``facemime.head/1`` document and build the model; a
-    :class:`ModelFormatError` naming ``where`` and the problem otherwise (also for a model over
-    the vertex or triangle limit, checked on the lists' lengths before any array is built)."""
+    """Validate a parsed ``facemime.head/1`` document and build the model.
+
+    Parameters
+    ----------
+    doc
+        The parsed JSON document (anything: it is checked).
+    where
+        What names the document (its file, or the actor file holding it) in error messages.
+
+    Returns
+    -------
+    HeadModel
+        The model; an invalid document raises a :class:`ModelFormatError` naming ``where`` and
+        the problem (also for a model over the vertex, triangle or deformation-unit-value limit,
+        checked on the lists' lengths before any array is built).
+    """
     if not isinstance(doc, dict) or doc.get("format") != HEAD_FORMAT:
         found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
         raise ModelFormatError(f"{where}: expected format {HEAD_FORMAT!r}, got {found!r}")

@@ -29,7 +29,14 @@ IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp")
 
 
 def check_image_suffix(path: str | Path) -> None:
-    """Refuse an image file name whose type :func:`write_image` cannot write."""
+    """Refuse an image file name whose type :func:`write_image` cannot write.
+
+    Parameters
+    ----------
+    path
+        The image file name; its suffix (any case) must be one of :data:`IMAGE_SUFFIXES`, else
+        :class:`InvalidInputError`.
+    """
     if Path(path).suffix.lower() not in IMAGE_SUFFIXES:
         raise InvalidInputError(f"cannot write image {path}: its name must end in one of {', '.join(IMAGE_SUFFIXES)}")
 
@@ -46,9 +53,21 @@ def _same(a: Path, b: Path) -> bool:
 
 
 def check_outputs(paths: Iterable[str | Path], force: bool, inputs: Iterable[str | Path | None] = ()) -> None:
-    """Refuse (with one message naming them) an output that is one of the command's ``inputs``
-    or another of its outputs, whatever ``force`` says; existing files unless ``force``; and
-    outputs whose folder cannot be created."""
+    """Refuse, with one message naming them, outputs that cannot or may not be written.
+
+    Refused are an output that is one of the command's inputs or another of its outputs (also
+    through a link), whatever ``force`` says; existing files unless ``force``; a folder; and
+    outputs whose folder cannot be created or written.
+
+    Parameters
+    ----------
+    paths
+        The command's output files.
+    force
+        Allow existing files to be overwritten (:class:`OutputExistsError` otherwise).
+    inputs
+        The command's input files; None entries (an option not given) are skipped.
+    """
     files = [Path(p) for p in paths]
     for i, p in enumerate(files):
         for q in (Path(q) for q in inputs if q is not None):
@@ -73,8 +92,20 @@ def check_outputs(paths: Iterable[str | Path], force: bool, inputs: Iterable[str
 
 
 def temporary_sibling(path: Path) -> Path:
-    """A new, unique file name next to ``path`` with the same suffix (same filesystem, so the
-    final rename is atomic)."""
+    """A new, unique file next to ``path`` with the same suffix (same filesystem, so the final
+    rename is atomic).
+
+    Parameters
+    ----------
+    path
+        The file to be written; its folder is created if missing.
+
+    Returns
+    -------
+    Path
+        The temporary file, ``.<stem>.<random>.part<suffix>`` in ``path``'s folder, created empty
+        with the usual mode (0666 less the umask).
+    """
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".part{path.suffix}", dir=path.parent)
@@ -92,6 +123,17 @@ class Outputs:
     (:meth:`stage`), and they are put in place together when the block ends without an error;
     otherwise (an error, Ctrl-C, SIGTERM) none is, and the temporary files are removed.
 
+    Parameters
+    ----------
+    paths
+        The command's output files: checked at once by :func:`check_outputs`.
+    force
+        Allow existing files to be overwritten.
+    inputs
+        The command's input files, which no output may replace; None entries are skipped.
+
+    Examples
+    --------
     >>> import tempfile, pathlib
     >>> folder = pathlib.Path(tempfile.mkdtemp())
     >>> with Outputs([folder / "a.txt", folder / "b.txt"], force=False) as out:
@@ -110,7 +152,19 @@ class Outputs:
         return self
 
     def stage(self, path: str | Path) -> Path:
-        """The temporary file to write ``path`` (one of the outputs) to."""
+        """The temporary file to write an output to.
+
+        Parameters
+        ----------
+        path
+            One of the outputs (a ``ValueError`` otherwise).
+
+        Returns
+        -------
+        Path
+            Its temporary file beside it (the same one on each call), put in place when the block
+            ends without an error.
+        """
         path = Path(path)
         if path not in self.paths:
             raise ValueError(f"{path} is not one of the outputs")
@@ -141,8 +195,21 @@ class Outputs:
 
 @contextmanager
 def atomic_file(path: Path) -> Iterator[Path]:
-    """Yield a temporary file next to ``path`` to write; when the block ends without an error it
-    replaces ``path`` in one step, otherwise it is removed. OS errors become one line."""
+    """Write a file atomically through a temporary file next to it.
+
+    When the block ends without an error the temporary file replaces ``path`` in one step,
+    otherwise it is removed. OS errors become one line (:class:`OutputFileError`).
+
+    Parameters
+    ----------
+    path
+        The file to write; its folder is created if missing.
+
+    Yields
+    ------
+    Path
+        The temporary file to write (from :func:`temporary_sibling`).
+    """
     tmp = temporary_sibling(path)
     try:
         yield tmp
@@ -154,7 +221,20 @@ def atomic_file(path: Path) -> Iterator[Path]:
 
 
 def write_text(path: str | Path, text: str) -> Path:
-    """Write a UTF-8 text file atomically."""
+    """Write a UTF-8 text file atomically.
+
+    Parameters
+    ----------
+    path
+        The file to write; its folder is created if missing.
+    text
+        The file's content.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
     path = Path(path)
     with atomic_file(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
@@ -162,7 +242,20 @@ def write_text(path: str | Path, text: str) -> Path:
 
 
 def write_bytes(path: str | Path, data: bytes) -> Path:
-    """Write a binary file atomically."""
+    """Write a binary file atomically.
+
+    Parameters
+    ----------
+    path
+        The file to write; its folder is created if missing.
+    data
+        The file's content.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
     path = Path(path)
     with atomic_file(path) as tmp:
         tmp.write_bytes(data)
@@ -170,7 +263,20 @@ def write_bytes(path: str | Path, data: bytes) -> Path:
 
 
 def write_image(path: str | Path, image: np.ndarray) -> Path:
-    """Write an RGB or gray uint8 image (PNG, JPEG, ... by suffix) atomically."""
+    """Write an image file atomically, its type (PNG, JPEG, ...) by the name's suffix.
+
+    Parameters
+    ----------
+    path
+        The file to write; its suffix must be one of :data:`IMAGE_SUFFIXES`.
+    image
+        (H, W, 3) uint8 RGB or (H, W) uint8 gray image.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
     path = Path(path)
     check_image_suffix(path)
     with atomic_file(path) as tmp:

@@ -18,8 +18,20 @@ MIN_SIDE = 64
 
 
 def read_photo(path: str | Path, frame: int = 0) -> np.ndarray:
-    """The (H, W, 3) uint8 RGB image in ``path``: an image file, or frame ``frame`` (0-based)
-    of a video."""
+    """The photo in an image file, or in a frame of a video.
+
+    Parameters
+    ----------
+    path
+        An image file (a suffix of :data:`IMAGE_TYPES`) or any video FFmpeg reads.
+    frame
+        0-based index of the video frame to take; must be 0 for a still image.
+
+    Returns
+    -------
+    (H, W, 3) uint8 array
+        RGB, a video frame turned upright; each side at least :data:`MIN_SIDE` pixels.
+    """
     path = Path(path)
     if not path.exists():
         raise InputFileError(f"{path} does not exist")

@@ -17,7 +17,21 @@ POINTS_FORMAT = "facemime.points/1"
 
 
 def read_points(path: str | Path, size: tuple[int, int]) -> ReferencePoints:
-    """Read and validate a points file for an image of ``size`` = (width, height)."""
+    """Read and validate a ``facemime.points/1`` file.
+
+    Parameters
+    ----------
+    path
+        The points file.
+    size
+        (width, height) of the image the points are on, pixels: every point must lie inside it.
+
+    Returns
+    -------
+    ReferencePoints
+        Name -> (K, 2) float64 array of (x, y) pixels (K = 1 for a single point); an invalid file
+        raises :class:`ContourFileError`.
+    """
     doc = load_document(path, "points", POINTS_FORMAT)
     try:
         return check_points(doc.get("points"), *size, where=str(path))

@@ -43,12 +43,21 @@ class VideoWriter:
     writer closes without an error (a failed run leaves nothing behind).
 
     Frame sizes must be even (4:2:0); odd sizes are padded by one pixel of the edge colour.
-    ``fps`` is any positive, finite frame rate (frames per second). Frames are encoded on a thread
-    of the writer's own, beside the caller's work: :meth:`write` converts a frame to the
-    encoder's 4:2:0 layout (so the caller may reuse its buffer at once) and waits only while
-    :data:`QUEUED` frames, or as many as fit in :data:`QUEUED_BYTES`, are still to be encoded.
-    An encoding error is raised by the next :meth:`write` or on closing.
+    Frames are encoded on a thread of the writer's own, beside the caller's work: :meth:`write`
+    converts a frame to the encoder's 4:2:0 layout (so the caller may reuse its buffer at once)
+    and waits only while :data:`QUEUED` frames, or as many as fit in :data:`QUEUED_BYTES`, are
+    still to be encoded. An encoding error is raised by the next :meth:`write` or on closing.
 
+    Parameters
+    ----------
+    path
+        The video file to write: ``.mp4`` (H.264) or ``.webm`` (VP9).
+    fps
+        Frame rate, frames/s: any positive, finite number (kept as a fraction of denominator at
+        most 1001).
+
+    Examples
+    --------
     >>> import tempfile, pathlib
     >>> out = pathlib.Path(tempfile.mkdtemp()) / "clip.mp4"
     >>> with VideoWriter(out, fps=25) as w:
@@ -84,7 +93,13 @@ class VideoWriter:
         return self
 
     def write(self, frame: np.ndarray) -> None:
-        """Append one (H, W, 3) uint8 RGB frame; every frame must have the first one's size."""
+        """Append one frame.
+
+        Parameters
+        ----------
+        frame
+            (H, W, 3) uint8 RGB image; every frame must have the first one's size.
+        """
         if not (isinstance(frame, np.ndarray) and frame.dtype == np.uint8 and frame.ndim == 3 and frame.shape[2] == 3):
             raise InvalidInputError(f"video frames must be (H, W, 3) uint8 RGB, got {getattr(frame, 'shape', frame)}")
         self._raise_error()
@@ -194,6 +209,11 @@ class VideoReader:
     decoding. ``decoded`` counts the frames given; ``warnings`` lists, one line each, what was
     wrong with the file once an iteration has reached its end: fewer frames than the container
     declares (a truncated file), damaged packets skipped.
+
+    Parameters
+    ----------
+    path
+        The video file: any FFmpeg-readable one.
     """
 
     #: Frames decoded and waiting for the caller at most (2, 4 and 8 gave the same speed to
@@ -342,6 +362,7 @@ class VideoReader:
         self._decoding = None
 
     def close(self) -> None:
+        """Stop the decoding and close the file."""
         self._stop_decoding()
         self._container.close()
 

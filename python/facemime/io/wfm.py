@@ -45,22 +45,66 @@ _COUNTED = {"VERTEX LIST": "vertices", "FACE LIST": "triangles"}  # sections who
 
 
 class _Lines:
-    """Numbered, non-empty lines of a section, consumed in order, with error context."""
+    """Numbered, non-empty lines of a section, consumed in order, with error context.
+
+    Parameters
+    ----------
+    where
+        What names the file in error messages.
+    section
+        The section's title, e.g. ``"VERTEX LIST"``.
+    lines
+        The section's (1-based line number in the file, stripped text) pairs.
+    """
 
     def __init__(self, where: str, section: str, lines: list[tuple[int, str]]):
         self.where, self.section, self.lines, self.pos = where, section, lines, 0
 
     def fail(self, what: str) -> ModelFormatError:
+        """The error to raise for a problem at the current line.
+
+        Parameters
+        ----------
+        what
+            The problem.
+
+        Returns
+        -------
+        ModelFormatError
+            Naming the file, section, line number and ``what``.
+        """
         line = self.lines[min(self.pos, len(self.lines) - 1)][0] if self.lines else "?"
         return ModelFormatError(f"{self.where}: {self.section}, line {line}: {what}")
 
     def next(self) -> str:
+        """Take the next line; a section that has none left is an error.
+
+        Returns
+        -------
+        str
+            The line's text.
+        """
         if self.pos >= len(self.lines):
             raise self.fail("section ends early")
         self.pos += 1
         return self.lines[self.pos - 1][1]
 
     def numbers(self, count: int, kind: type) -> list[Any]:
+        """Take the next line as ``count`` numbers; another count, or a value that is not a
+        ``kind`` (or, for ``int``, beyond int64), is an error naming that line.
+
+        Parameters
+        ----------
+        count
+            How many numbers the line must hold.
+        kind
+            ``int`` or ``float``.
+
+        Returns
+        -------
+        list
+            The ``count`` values, of type ``kind``.
+        """
         parts = self.next().split()
         try:
             if len(parts) != count:
@@ -76,8 +120,23 @@ class _Lines:
             ) from None
 
     def table(self, rows: int, columns: int, kind: type) -> np.ndarray:
-        """The next ``rows`` lines as a (rows, columns) float64 or int64 array (``kind`` float or
-        int): numpy's parser first, then line by line, naming the first bad line, if that fails."""
+        """Take the next ``rows`` lines as a table: numpy's parser first, then line by line,
+        naming the first bad line, if that fails.
+
+        Parameters
+        ----------
+        rows
+            How many lines to take.
+        columns
+            How many numbers each line must hold.
+        kind
+            ``float`` or ``int``.
+
+        Returns
+        -------
+        (rows, columns) float64 or int64 array
+            float64 for ``kind`` float, int64 for int.
+        """
         dtype = np.int64 if kind is int else np.float64
         chunk = [line for _, line in self.lines[self.pos : self.pos + rows]]
         if rows and len(chunk) == rows:
@@ -95,6 +154,13 @@ class _Lines:
         return np.array([self.numbers(columns, kind) for _ in range(rows)], dtype=dtype).reshape(-1, columns)
 
     def count(self) -> int:
+        """Take the next line as a count; a negative one is an error.
+
+        Returns
+        -------
+        int
+            The count, 0 or more.
+        """
         n = int(self.numbers(1, int)[0])
         if n < 0:
             raise self.fail(f"negative count {n}")
@@ -104,10 +170,21 @@ class _Lines:
 def load_wfm(path: str | Path) -> HeadModel:
     """Load a CANDIDE ``.wfm`` file as a :class:`HeadModel` in facemime's axes.
 
-    Animation units become ``units``, shape units ``shape_units`` (each named as in the file);
-    the file's texture coordinates become ``uv``. The model has no named vertex groups.
     Raises :class:`InputFileError` or :class:`ModelFormatError` naming the file, section and line;
     a model over an input limit (see the module docstring) is a :class:`ModelFormatError` too.
+
+    Parameters
+    ----------
+    path
+        The ``.wfm`` file.
+
+    Returns
+    -------
+    HeadModel
+        The model, x mirrored into facemime's axes, in CANDIDE's units (``unit`` "CANDIDE units")
+        and named after the file's stem. Animation units become ``units``, shape units
+        ``shape_units`` (each named as in the file); the file's texture coordinates become ``uv``.
+        The model has no named vertex groups.
     """
     path = Path(path)
     data = read_model_file(path)

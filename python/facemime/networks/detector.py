@@ -61,8 +61,14 @@ class Detection:
 
 @cache
 def anchors() -> np.ndarray:
-    """The 896 anchor centres, (896, 2) float64, as fractions of the input side, in the
-    network's output order (row by row, cell by cell, the anchors of a cell together)."""
+    """The 896 anchor centres, in the network's output order (row by row, cell by cell, the
+    anchors of a cell together).
+
+    Returns
+    -------
+    (896, 2) float64 array
+        (x, y) of each anchor's centre, as fractions of the input side (0..1, y down).
+    """
     out = []
     for stride, per_cell in zip(STRIDES, ANCHORS_PER_CELL):
         cells = INPUT // stride
@@ -77,17 +83,20 @@ def decode(scores: np.ndarray, regressors: np.ndarray, min_score: float = MIN_SC
 
     Parameters
     ----------
-    scores : (896,) float array
-        Raw (pre-sigmoid) anchor scores.
-    regressors : (896, 16) float array
-        Per anchor: box centre offset (x, y), box width and height, then six keypoint offsets
-        (x, y), all in input pixels relative to the anchor's centre.
-    min_score : float
-        Lowest sigmoid score kept.
+    scores
+        (896,) float array: raw (pre-sigmoid) anchor scores.
+    regressors
+        (896, 16) float array: per anchor, the box centre's offset (x, y) from the anchor's
+        centre, the box width and height, then six keypoint offsets (x, y) from the anchor's
+        centre, all in input pixels.
+    min_score
+        Lowest sigmoid score kept, 0..1.
 
     Returns
     -------
-    Detections with ``box`` and ``keypoints`` as fractions of the input side, unsuppressed.
+    list of Detection
+        The anchors scoring ``min_score`` or more, in anchor order, unsuppressed: ``box`` and
+        ``keypoints`` as fractions of the input side, ``score`` after the sigmoid.
 
     Examples
     --------
@@ -108,9 +117,22 @@ def decode(scores: np.ndarray, regressors: np.ndarray, min_score: float = MIN_SC
 
 
 def overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Intersection over union of box ``a`` (4,) with each of boxes ``b`` (N, 4); boxes are
-    (x0, y0, x1, y1).
+    """Intersection over union of one box with each of several.
 
+    Parameters
+    ----------
+    a
+        (4,) float array: the box (x0, y0, x1, y1).
+    b
+        (N, 4) float array: the boxes (x0, y0, x1, y1), in ``a``'s units.
+
+    Returns
+    -------
+    (N,) float64 array
+        The overlap of ``a`` with each of ``b``, 0..1.
+
+    Examples
+    --------
     >>> overlap(np.array([0, 0, 2, 2.0]), np.array([[1, 0, 3, 2.0], [5, 5, 6, 6]]))
     array([0.33333333, 0.        ])
     """
@@ -124,8 +146,22 @@ def overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def suppress(detections: list[Detection], min_overlap: float = MIN_OVERLAP) -> list[Detection]:
     """Weighted non-maximum suppression: the strongest detection left takes every detection
     overlapping it by more than ``min_overlap`` (itself included), and becomes their
-    score-weighted mean box and keypoints, with its own score. Strongest first.
+    score-weighted mean box and keypoints, with its own score.
 
+    Parameters
+    ----------
+    detections
+        The detections to merge, in any order.
+    min_overlap
+        Intersection over union (0..1) above which a detection joins the strongest one's group.
+
+    Returns
+    -------
+    list of Detection
+        The merged detections, strongest first, in the units of ``detections``.
+
+    Examples
+    --------
     >>> a = Detection(np.array([0, 0, 10, 10.0]), np.zeros((6, 2)), 0.9)
     >>> b = Detection(np.array([2, 0, 12, 10.0]), np.ones((6, 2)), 0.6)
     >>> c = Detection(np.array([50, 50, 60, 60.0]), np.zeros((6, 2)), 0.7)
@@ -185,6 +221,21 @@ def windows(width: int, height: int) -> list[tuple[int, int, int]]:
     frame), squares of the shorter side along the longer one and squares of half the shorter
     side, each overlapping its neighbours by half.
 
+    Parameters
+    ----------
+    width
+        The image's width, pixels.
+    height
+        The image's height, pixels.
+
+    Returns
+    -------
+    list of (x, y, side)
+        Each window as int pixels: (x, y) of its top-left pixel (negative where the letterboxed
+        whole image reaches beyond the image) and its side.
+
+    Examples
+    --------
     >>> windows(400, 200)
     [(0, -100, 400), (0, 0, 200), (100, 0, 200), (200, 0, 200)]
     """
@@ -221,8 +272,8 @@ def _search(rgb: np.ndarray, back: np.ndarray) -> list[Detection]:
 
 
 def detect_faces(rgb: np.ndarray, min_score: float = MIN_SCORE) -> list[Detection]:
-    """Faces scoring ``min_score`` or more in an (H, W, 3) uint8 RGB image, strongest first, in
-    image pixels (detections from :data:`MIN_SCORE` up are merged by the suppression).
+    """Faces scoring ``min_score`` or more in an image (detections from :data:`MIN_SCORE` up are
+    merged by the suppression).
 
     The whole image is searched first; only where that detects nothing at all are the smaller
     windows of :func:`windows` searched (a face small in a large frame: a closer look also
@@ -230,6 +281,18 @@ def detect_faces(rgb: np.ndarray, min_score: float = MIN_SCORE) -> list[Detectio
     face of ``min_score``, the whole image turned by a quarter, a half and three quarters of a
     turn is searched (a phone video stored on its side, a photo upside down; the shared animal
     photos, turned, score 0.73 at most).
+
+    Parameters
+    ----------
+    rgb
+        (H, W, 3) uint8 RGB image.
+    min_score
+        Lowest detection score kept, 0..1.
+
+    Returns
+    -------
+    list of Detection
+        The faces, strongest first, boxes and keypoints in pixels of ``rgb``; empty when none.
     """
     h, w = rgb.shape[:2]
     whole, *parts = windows(w, h)

@@ -57,9 +57,25 @@ class Face:
 
 
 def find_face(rgb: np.ndarray, min_score: float = FACE_SCORE) -> Face:
-    """The largest human face of an (H, W, 3) uint8 RGB image and its landmarks.
+    """The largest human face of an image and its landmarks.
 
-    Raises :class:`facemime.errors.NoFaceError` when no face scores ``min_score`` or more.
+    The detections are tried largest first; the first whose crop the landmark model scores as a
+    face is taken. Raises :class:`facemime.errors.NoFaceError` when no face scores ``min_score``
+    or more.
+
+    Parameters
+    ----------
+    rgb
+        (H, W, 3) uint8 RGB image.
+    min_score
+        Lowest detection score of a face, 0..1.
+
+    Returns
+    -------
+    Face
+        The face: its (468, 3) landmarks in pixels of ``rgb`` (the mean of the two passes, or
+        the first alone where the second finds no face), its detection and how many faces were
+        detected (at least :data:`MIN_OTHER_FACE` of its size).
     """
     detections = detect_faces(rgb, min_score)
     for detection in sorted(detections, key=lambda d: -d.size):
@@ -74,8 +90,21 @@ def find_face(rgb: np.ndarray, min_score: float = FACE_SCORE) -> Face:
 
 
 def follow_face(rgb: np.ndarray, previous: np.ndarray) -> np.ndarray | None:
-    """The landmarks of the face that had landmarks ``previous`` ((468, 2+) pixels) in an
-    earlier frame, measured on the crop those frame in ``rgb`` (one landmark pass, no
-    detection); None when the crop holds no face."""
+    """The landmarks of a face found in an earlier frame, measured on the crop its landmarks
+    frame in this one (one landmark pass, no detection).
+
+    Parameters
+    ----------
+    rgb
+        (H, W, 3) uint8 RGB image: the frame.
+    previous
+        (468, 2+) float array: the face's landmarks in an earlier frame, (x, y) pixels first.
+
+    Returns
+    -------
+    (468, 3) float64 array or None
+        The landmarks, (x, y) pixels of ``rgb`` and relative depth in the same scale; None when
+        the crop holds no face.
+    """
     points, score = landmark_pass(rgb, crop_from_landmarks(previous))
     return points if score >= MIN_FACE_SCORE else None

@@ -54,9 +54,20 @@ class Crop:
     angle: float
 
     def affine(self, size: int = INPUT) -> np.ndarray:
-        """The (2, 3) affine map from pixel (u, v) of the crop sampled at ``size`` x ``size``
-        to image pixels.
+        """The affine map from the pixels of the crop, sampled square, to image pixels.
 
+        Parameters
+        ----------
+        size
+            Side of the sampled crop, pixels.
+
+        Returns
+        -------
+        (2, 3) float64 array
+            Maps pixel (u, v, 1) of the ``size`` x ``size`` crop to (x, y) image pixels.
+
+        Examples
+        --------
         >>> Crop(np.array([10.0, 20.0]), 4.0, 0.0).affine(4).round(6) + 0.0
         array([[ 1. ,  0. ,  8.5],
                [ 0. ,  1. , 18.5]])
@@ -67,8 +78,20 @@ class Crop:
         return np.column_stack([axes, origin])
 
     def sample(self, rgb: np.ndarray, size: int = INPUT) -> np.ndarray:
-        """The crop of ``rgb`` (H, W, 3 uint8) as a ``size`` x ``size`` image (edges
-        replicated beyond the image)."""
+        """The crop of an image as a square image, bilinear, edges replicated beyond the image.
+
+        Parameters
+        ----------
+        rgb
+            (H, W, 3) uint8 RGB image.
+        size
+            Side of the result, pixels.
+
+        Returns
+        -------
+        (size, size, 3) uint8 array
+            The crop, RGB, turned so that its x axis lies along ``angle``.
+        """
         return cv2.warpAffine(
             rgb,
             self.affine(size),
@@ -80,17 +103,40 @@ class Crop:
 
 def crop_from_detection(detection: Detection) -> Crop:
     """The landmark model's crop around a detected face: the box's centre, its larger side
-    grown :data:`GROW` times, turned by the eye keypoints."""
+    grown :data:`GROW` times, turned by the eye keypoints.
+
+    Parameters
+    ----------
+    detection
+        The face, in image pixels.
+
+    Returns
+    -------
+    Crop
+        The crop, in image pixels.
+    """
     eyes = detection.keypoints[1] - detection.keypoints[0]
     centre = (detection.box[:2] + detection.box[2:]) / 2
     return Crop(centre, GROW * detection.size, float(np.arctan2(eyes[1], eyes[0])))
 
 
 def crop_from_landmarks(points: np.ndarray) -> Crop:
-    """The crop that frames landmarks ``points`` ((468, 2+) pixels): turned by the outer eye
-    corners, centred on the points' extent along and across that line, its side the larger
-    extent grown :data:`GROW` times.
+    """The crop that frames a face's landmarks: turned by the outer eye corners, centred on the
+    points' extent along and across that line, its side the larger extent grown :data:`GROW`
+    times.
 
+    Parameters
+    ----------
+    points
+        (468, 2+) float array: Face Mesh landmarks, (x, y) pixels first.
+
+    Returns
+    -------
+    Crop
+        The crop, in image pixels.
+
+    Examples
+    --------
     >>> p = np.zeros((468, 2)); p[EYE_AXIS[1]] = [40.0, 0.0]; p[0] = [0, 60]
     >>> crop = crop_from_landmarks(p)
     >>> crop.centre.tolist(), crop.side, crop.angle
@@ -107,10 +153,21 @@ def crop_from_landmarks(points: np.ndarray) -> Crop:
 
 
 def landmark_pass(rgb: np.ndarray, crop: Crop) -> tuple[np.ndarray, float]:
-    """One pass of the landmark model on ``crop`` of ``rgb`` ((H, W, 3) uint8 RGB).
+    """One pass of the landmark model on a crop of an image.
 
-    Returns the (468, 3) float64 landmarks in image pixels and the face score (0..1; below
-    :data:`MIN_FACE_SCORE` the crop holds no face).
+    Parameters
+    ----------
+    rgb
+        (H, W, 3) uint8 RGB image.
+    crop
+        The region of ``rgb`` the model sees.
+
+    Returns
+    -------
+    landmarks : (468, 3) float64 array
+        (x, y) image pixels and the relative depth in the same scale (smaller is nearer).
+    score : float
+        The face score, 0..1; below :data:`MIN_FACE_SCORE` the crop holds no face.
     """
     net = load_network("face_landmark.tflite")
     net.setInput(cv2.dnn.blobFromImage(crop.sample(rgb), 1.0 / 255.0))  # the model takes [0, 1]

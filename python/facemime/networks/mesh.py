@@ -69,8 +69,21 @@ FACE_OVAL = (
 
 def reference_points(landmarks: np.ndarray) -> dict[str, np.ndarray]:
     """facemime's reference points (:mod:`facemime.types.points`) from one face's Face Mesh
-    landmarks, a (468 or 478, 2+) array in pixels: name -> (K, 2) float64 pixels.
+    landmarks.
 
+    Parameters
+    ----------
+    landmarks
+        (468 or 478, 2+) float array: the landmarks, (x, y) pixels first.
+
+    Returns
+    -------
+    dict of str -> (K, 2) float64 array
+        Name -> (x, y) pixels: the single points of :data:`POINT_INDICES` (K = 1), the eight
+        contours and ``face_outline``.
+
+    Examples
+    --------
     >>> points = reference_points(np.arange(478 * 2, dtype=float).reshape(478, 2))
     >>> points["nose_tip"].tolist(), len(points["face_outline"]), len(points)
     ([[8.0, 9.0]], 36, 19)

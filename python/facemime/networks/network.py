@@ -19,8 +19,20 @@ _loaded = threading.local()
 
 
 def load_network(name: str) -> cv2.dnn.Net:
-    """The shipped TFLite model ``name`` (one of :data:`MODELS`) as an OpenCV network of this
-    thread's own (loaded on the thread's first call)."""
+    """A shipped TFLite model as an OpenCV network of this thread's own (loaded on the
+    thread's first call).
+
+    Parameters
+    ----------
+    name
+        The model file, one of :data:`MODELS`; another, or one that cannot be loaded, raises
+        :class:`FacemimeError`.
+
+    Returns
+    -------
+    cv2.dnn.Net
+        The network, the same one on each call from this thread.
+    """
     nets: dict[str, cv2.dnn.Net] = _loaded.__dict__.setdefault("nets", {})
     if name not in nets:
         nets[name] = _read(name)

@@ -22,12 +22,29 @@ SCALE = 1024
 
 
 def sample_affine(image: np.ndarray, m: np.ndarray, size: tuple[int, int]) -> np.ndarray:
-    """``image`` (H, W, C) uint8 sampled at ``m @ (col, row, 1)`` for each pixel (col, row) of
-    an output of ``size`` (cols, rows): bilinear, the position in 1/32 px (each coordinate
-    ``rint(m · (col, row, 1) · 1024) + 16`` shifted down 5 bits, the row and column parts
-    rounded apart), integer weights that sum to 1024, the sum rounded; the border replicated.
-    Returns (rows, cols, C) uint8.
+    """Sample ``image`` bilinearly at ``m @ (col, row, 1)`` for each output pixel (col, row).
 
+    The position is taken in 1/32 px (each coordinate ``rint(m · (col, row, 1) · 1024) + 16``
+    shifted down 5 bits, the row and column parts rounded apart), the integer weights sum to 1024,
+    the sum is rounded; outside the picture its border is replicated.
+
+    Parameters
+    ----------
+    image
+        (H, W, C) uint8 array, the picture sampled; a channel axis is required.
+    m
+        (2, 3) float affine map from an output pixel (col, row, 1) to the (x, y) position in
+        ``image`` it samples, pixels.
+    size
+        (cols, rows) = (width, height) of the output, pixels.
+
+    Returns
+    -------
+    (rows, cols, C) uint8 array
+        The sampled picture.
+
+    Examples
+    --------
     >>> img = np.arange(12, dtype=np.uint8).reshape(2, 2, 3) * 20
     >>> sample_affine(img, np.array([[1.0, 0, 0.5], [0, 1, 0]]), (1, 1))[0, 0].tolist()
     [30, 50, 70]
@@ -55,10 +72,23 @@ def sample_affine(image: np.ndarray, m: np.ndarray, size: tuple[int, int]) -> np
 
 
 def shift_offset(d: np.ndarray) -> tuple[int, int]:
-    """The sampling offset, 1/32 px, that moves a picture by ``d`` (dx, dy) px: each pixel then
-    samples the picture at (x + ox / 32, y + oy / 32). ``d`` is taken to float32 first, as the
-    receiver sends it.
+    """The sampling offset that moves a picture by ``d``, for :func:`shifted`.
 
+    Each pixel then samples the picture at (x + ox / 32, y + oy / 32).
+
+    Parameters
+    ----------
+    d
+        (2,) float array: the move (dx, dy), pixels, y down. Taken to float32 first, as the
+        receiver sends it.
+
+    Returns
+    -------
+    tuple of (ox, oy)
+        The sampling offset, int, 1/32 px: minus ``d``, rounded.
+
+    Examples
+    --------
     >>> shift_offset(np.array([1.0, -0.5]))
     (-32, 16)
     """
@@ -68,10 +98,25 @@ def shift_offset(d: np.ndarray) -> tuple[int, int]:
 
 
 def shifted(image: np.ndarray, offset: tuple[int, int], replicate: bool) -> np.ndarray:
-    """``image`` (H, W) or (H, W, C) float sampled at (x + ox / 32, y + oy / 32): bilinear, the
-    weights float32, the sum in float64, in the order top-left, top-right, bottom-left,
-    bottom-right; outside the picture its border replicated (``replicate``) or 0. Returns float64
-    of ``image``'s shape."""
+    """Sample ``image`` bilinearly at (x + ox / 32, y + oy / 32) for each pixel (x, y).
+
+    The weights are float32, the sum is taken in float64, in the order top-left, top-right,
+    bottom-left, bottom-right.
+
+    Parameters
+    ----------
+    image
+        (H, W) or (H, W, C) float array, the picture sampled.
+    offset
+        (ox, oy) sampling offset, 1/32 px, as from :func:`shift_offset`.
+    replicate
+        Outside the picture, take its border pixels (True) or 0 (False).
+
+    Returns
+    -------
+    float64 array
+        The sampled picture, of ``image``'s shape.
+    """
     ox, oy = offset
     sx, sy = ox >> 5, oy >> 5
     fx, fy = (ox & 31) / SUB, (oy & 31) / SUB

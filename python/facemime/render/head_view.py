@@ -28,8 +28,34 @@ def render_head(
     filter: str = "bilinear",
     depth_test: str = "painter",
 ) -> np.ndarray:
-    """The textured model (or ``vertices``, a deformed copy of its vertices) seen in ``pose``,
-    drawn into a new (H, W, 3) image of ``size`` = (width, height)."""
+    """The textured model seen in ``pose``, drawn into a new image by the Rust rasteriser.
+
+    Parameters
+    ----------
+    model
+        The head; its triangles and texture coordinates (``uv``, required) are used.
+    texture
+        (Ht, Wt, 3) uint8 RGB array (or (Ht, Wt) gray) that ``model.uv`` maps onto the mesh.
+    pose
+        The head pose that places the model in the image.
+    size
+        (width, height) of the new image, pixels.
+    vertices
+        (N, 3) float array: a deformed copy of ``model.vertices`` to draw instead, model units;
+        None draws the rest shape.
+    background
+        An image of ``size``, a 0-255 colour (one value per channel, or one for all), or None for
+        black; see :func:`~facemime.render.raster.render_mesh`.
+    filter
+        Texture lookup, 'nearest' or 'bilinear'.
+    depth_test
+        'painter' (whole triangles far to near) or 'zbuffer' (per pixel).
+
+    Returns
+    -------
+    (H, W, 3) uint8 array
+        The picture, RGB ((H, W) for a gray texture).
+    """
     points, depth = project(model.vertices if vertices is None else vertices, pose)
     if model.uv is None:
         raise InvalidInputError(f"head model {model.name!r} has no texture coordinates (uv)")
@@ -55,12 +81,33 @@ def render_shaded(
     colour: tuple[int, int, int] = (205, 180, 160),
     background: int = 255,
 ) -> np.ndarray:
-    """Flat Lambert shading of the front faces, far to near: an (H, W, 3) preview image of
-    ``size`` = (width, height) pixels, drawn by the Rust rasteriser.
+    """Flat Lambert shading of the front faces, far to near, drawn by the Rust rasteriser.
 
     Each face gets its own three corners, all on the texel of its colour in a one-row palette
     texture, so the nearest-texel fill paints the face in one flat colour. Edges are not
-    anti-aliased (a wireframe drawn on top covers them).
+    anti-aliased (a wireframe drawn on top covers them). A face's shade is ``colour`` times
+    0.25 + 0.75 max(0, cos) of the angle between its pose-rotated normal and :data:`LIGHT`.
+
+    Parameters
+    ----------
+    model
+        The head; its triangles are used, and its vertices unless ``vertices`` is given.
+    pose
+        The head pose that places the model in the image.
+    size
+        (width, height) of the preview image, pixels.
+    vertices
+        (N, 3) float array: a deformed copy of ``model.vertices`` to draw instead, model units;
+        None draws the rest shape.
+    colour
+        (R, G, B) 0-255 colour of a face lit head-on.
+    background
+        0-255 level of all three channels where no face is drawn.
+
+    Returns
+    -------
+    (H, W, 3) uint8 array
+        The RGB preview image.
     """
     v = model.vertices if vertices is None else vertices
     points, depth = project(v, pose)
@@ -96,8 +143,28 @@ def draw_wireframe(
     colour: tuple[int, int, int] = (40, 220, 90),
     thickness: int = 1,
 ) -> np.ndarray:
-    """Draw every triangle edge of a projected mesh (``points`` (N, 2) pixels) onto ``image``
-    in place and return it."""
+    """Draw every triangle edge of a projected mesh onto ``image`` in place.
+
+    Each shared edge is drawn once, anti-aliased, its ends at 1/16 px precision.
+
+    Parameters
+    ----------
+    image
+        (H, W, 3) uint8 array (or any image ``cv2.polylines`` takes), drawn on in place.
+    points
+        (N, 2) float array: projected vertices, (x, y) pixels, y down.
+    triangles
+        (F, 3) int array of vertex indices.
+    colour
+        Line colour, one 0-255 value per channel of ``image`` (R, G, B for an RGB image).
+    thickness
+        Line width, pixels.
+
+    Returns
+    -------
+    (H, W, 3) uint8 array
+        ``image`` itself.
+    """
     n = len(points)
     t = np.asarray(triangles, np.int64)
     following = np.roll(t, -1, axis=1)  # edges 0-1, 1-2, 2-0 of each triangle
@@ -116,8 +183,31 @@ def views_sheet(
     yaws: tuple[float, ...] = (-60, -30, 0, 30, 60),
     vertices: np.ndarray | None = None,
 ) -> np.ndarray:
-    """One picture of a model seen at several yaw angles (degrees): a row of textured renders
-    (when a texture is given), a row of flat-shaded renders with the wireframe on top."""
+    """One picture of a model seen at several yaw angles.
+
+    One column per yaw: a textured render on top (when a texture is given), below it a
+    flat-shaded render with the wireframe on top. Each view frames the rest shape to 0.88 of the
+    cell (:meth:`~facemime.types.pose.Pose.framing`).
+
+    Parameters
+    ----------
+    model
+        The head drawn.
+    texture
+        (Ht, Wt, 3) uint8 RGB array mapped by ``model.uv``, or None for no textured row.
+    cell
+        Side of each square view, pixels.
+    yaws
+        The yaw of each column, degrees (positive turns the nose to the image's right).
+    vertices
+        (N, 3) float array: a deformed copy of ``model.vertices`` to draw instead, model units;
+        None draws the rest shape.
+
+    Returns
+    -------
+    (rows * cell, len(yaws) * cell, 3) uint8 array
+        The RGB sheet, ``rows`` 2 with a texture and 1 without.
+    """
     v = model.vertices if vertices is None else vertices
     columns = []
     for yaw in yaws:

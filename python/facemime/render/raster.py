@@ -45,29 +45,36 @@ def render_mesh_into(
 
     Parameters
     ----------
-    out : (H, W) or (H, W, C) uint8 array, C-contiguous
-        The image drawn into; same number of channels as ``texture``.
-    texture : (Ht, Wt) or (Ht, Wt, C) uint8 array
-    tex_coords : (N, 2) float array
-        Texture coordinates (u, v) of each vertex in [0, 1] from the texture's top-left corner;
-        values outside clamp to the texture's edge.
-    points : (N, 2) float array
-        Image position of each vertex, (x, y) pixels, y down.
-    depth : (N,) float array
-        Depth of each vertex, larger = nearer the camera.
-    triangles : (F, 3) int array
-        Vertex indices. A triangle faces the camera when its vertices run counter-clockwise as
-        seen on the image (a model's outward winding, counter-clockwise seen from outside).
-    filter : {'nearest', 'bilinear'}
-    depth_test : {'painter', 'zbuffer'}
-        'painter' draws whole triangles far to near by mean depth (the paper); 'zbuffer' tests
-        every pixel.
-    cull : bool
-        Skip back-facing triangles.
+    out
+        (H, W) or (H, W, C) uint8 array, C-contiguous and writeable: the image drawn into, with
+        the same number of channels as ``texture``.
+    texture
+        (Ht, Wt) or (Ht, Wt, C) uint8 array, the picture mapped onto the mesh.
+    tex_coords
+        (N, 2) float array: texture coordinates (u, v) of each vertex, in [0, 1] of the texture's
+        width and height from its top-left corner (not pixel centre); lookups outside clamp to
+        the texture's edge.
+    points
+        (N, 2) float array: image position of each vertex, (x, y) pixels, y down, origin at the
+        centre of the top-left pixel.
+    depth
+        (N,) float array: depth of each vertex, any unit, larger = nearer the camera.
+    triangles
+        (F, 3) int array of vertex indices. A triangle faces the camera when its vertices run
+        counter-clockwise as seen on the image (a model's outward winding, counter-clockwise seen
+        from outside).
+    filter
+        Texture lookup, 'nearest' or 'bilinear'.
+    depth_test
+        'painter' draws whole triangles far to near by mean vertex depth (the paper); 'zbuffer'
+        tests every pixel.
+    cull
+        Skip back-facing triangles (else both sides are drawn).
 
     Returns
     -------
     RenderStats
+        Triangles drawn, culled and skipped as zero-area, and pixel writes.
 
     Examples
     --------
@@ -115,10 +122,37 @@ def render_mesh(
 ) -> np.ndarray:
     """Draw a textured mesh into a new image of ``size`` = (width, height).
 
-    ``background`` is an image of that size and the texture's channels, a colour (one value per
-    channel, or one for all), or None for black. Other parameters as in :func:`render_mesh_into`.
-    Returns a uint8 image shaped like the texture: (H, W) for gray, (H, W, C) otherwise.
+    Parameters
+    ----------
+    texture
+        (Ht, Wt) or (Ht, Wt, C) uint8 array, as in :func:`render_mesh_into`.
+    tex_coords
+        (N, 2) float array, texture coordinates (u, v) in [0, 1], as in :func:`render_mesh_into`.
+    points
+        (N, 2) float array, image position of each vertex, (x, y) pixels, y down.
+    depth
+        (N,) float array, depth of each vertex, larger = nearer the camera.
+    triangles
+        (F, 3) int array of vertex indices, counter-clockwise on the image facing the camera.
+    size
+        (width, height) of the new image, pixels.
+    background
+        An image of that size and the texture's channels ((H, W) or (H, W, C) uint8, copied), a
+        colour (one 0-255 value per channel, or one for all), or None for black.
+    filter
+        'nearest' or 'bilinear', as in :func:`render_mesh_into`.
+    depth_test
+        'painter' or 'zbuffer', as in :func:`render_mesh_into`.
+    cull
+        Skip back-facing triangles.
 
+    Returns
+    -------
+    uint8 array
+        The image, shaped like the texture: (H, W) for gray, (H, W, C) otherwise.
+
+    Examples
+    --------
     >>> img = render_mesh(np.full((2, 2), 9, np.uint8), [[0, 0], [1, 0], [0, 1]],
     ...                   [[1.0, 1], [5, 1], [1, 5]], np.zeros(3), [[0, 2, 1]], (6, 6), background=3)
     >>> img.shape, int(img[2, 2]), int(img[5, 5])
@@ -144,9 +178,23 @@ def render_mesh(
 
 
 def fill(img: np.ndarray, colour: object) -> np.ndarray:
-    """Fill ``img``, (H, W) or (H, W, C) uint8, with ``colour`` (one value, or one per channel)
-    in place and return it. One row is filled and then copied to the others: numpy's per-pixel
-    broadcast of a C-vector takes about 40 times as long."""
+    """Fill ``img`` with ``colour`` in place.
+
+    One row is filled and then copied to the others: numpy's per-pixel broadcast of a C-vector
+    takes about 40 times as long.
+
+    Parameters
+    ----------
+    img
+        (H, W) or (H, W, C) uint8 array, filled in place.
+    colour
+        One 0-255 value, or one per channel.
+
+    Returns
+    -------
+    (H, W) or (H, W, C) uint8 array
+        ``img`` itself.
+    """
     row = np.empty(img.shape[1:], np.uint8)
     row[...] = colour
     img[...] = row
@@ -154,10 +202,27 @@ def fill(img: np.ndarray, colour: object) -> np.ndarray:
 
 
 def coverage(points: np.ndarray, triangles: np.ndarray, size: tuple[int, int]) -> np.ndarray:
-    """How many triangles cover each pixel, both windings counted: (H, W) uint32.
+    """How many triangles cover each pixel, both windings counted.
 
     0 inside a face marks a hole, more than 1 an overlap (a fold of the mesh).
 
+    Parameters
+    ----------
+    points
+        (N, 2) float array: vertex positions, (x, y) pixels, y down, origin at the centre of the
+        top-left pixel.
+    triangles
+        (F, 3) int array of vertex indices.
+    size
+        (width, height) of the image counted over, pixels.
+
+    Returns
+    -------
+    (H, W) uint32 array
+        The number of triangles covering each pixel.
+
+    Examples
+    --------
     >>> coverage([[0.0, 0], [3, 0], [0, 3]], [[0, 1, 2]], (4, 4)).sum()
     np.uint64(6)
     """

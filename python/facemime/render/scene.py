@@ -35,9 +35,6 @@ from facemime.render.raster import render_mesh_into
 from facemime.shared_constants import BORDER_STEPS, EDGE_MARGIN, RINGS, SLOW
 from facemime.types.similarity import apply, robust_similarity
 
-#: (distance from the face's centre as a multiple of the outline's, share of the head's motion
-#: followed) per ring: the first reaches over the hair and ears and moves with the head; the
-#: second holds the room still, the band between them stretching over what the head uncovers.
 #: Triangles whose vertices all moved less than STILL pixels show the key frame as it is (those
 #: that moved less than :data:`~facemime.shared_constants.SLOW` are sampled nearest).
 STILL = 0.05
@@ -71,8 +68,28 @@ class SceneMesh:
 
     @classmethod
     def build(cls, size: tuple[int, int], anchors: np.ndarray, outline: np.ndarray) -> SceneMesh:
-        """The mesh of a picture of ``size`` = (width, height) whose face outline lies at
-        ``outline`` ((A, 2) pixels, the projections of model vertices ``anchors``)."""
+        """The mesh of a picture whose face outline lies at ``outline``.
+
+        Ring vertices outside the picture or within
+        :data:`~facemime.shared_constants.EDGE_MARGIN` of its shorter side from its edge are left
+        out; :data:`~facemime.shared_constants.BORDER_STEPS` vertices per side make the border.
+
+        Parameters
+        ----------
+        size
+            (width, height) of the picture (the key frame), pixels.
+        anchors
+            (A,) int array: the model vertex indices of the outline (the model's
+            ``face_outline`` group).
+        outline
+            (A, 2) float array: the projections of the ``anchors`` in the key frame, (x, y)
+            pixels; at least three, finite, possibly outside the picture.
+
+        Returns
+        -------
+        SceneMesh
+            The mesh, at rest on the key frame.
+        """
         w, h = size
         outline = np.asarray(outline, np.float64)
         if outline.ndim != 2 or outline.shape[1] != 2 or len(outline) < 3 or not np.isfinite(outline).all():
@@ -95,9 +112,22 @@ class SceneMesh:
         return cls((int(w), int(h)), np.asarray(anchors, np.int64), rest, np.concatenate(follow), _delaunay(rest))
 
     def points(self, outline: np.ndarray) -> np.ndarray:
-        """Every vertex now, (N, 2) pixels, for the face outline now at ``outline`` ((A, 2)
-        pixels): the anchors there, the rings moved by their share of the outline's similarity
-        motion, the border where it was; all kept inside the picture."""
+        """Every vertex now, for the face outline now at ``outline``.
+
+        The anchors are put there, the rings moved by their share of the outline's least-squares
+        similarity motion from the key frame, the border left where it was; all but the anchors
+        are kept inside the picture (clipped to its outer pixel edges).
+
+        Parameters
+        ----------
+        outline
+            (A, 2) float array: the anchors' projections now, (x, y) pixels.
+
+        Returns
+        -------
+        (N, 2) float64 array
+            Every mesh vertex now, (x, y) pixels, in the order of :attr:`rest`.
+        """
         a = len(self.anchors)
         # least squares: with no limit on the residuals no anchor is an outlier
         moved = apply(robust_similarity(self.rest[:a], outline, limit=np.inf)[0], self.rest)
@@ -108,10 +138,23 @@ class SceneMesh:
         return out
 
     def draw(self, out: np.ndarray, key: np.ndarray, outline: np.ndarray) -> None:
-        """Draw the scene into ``out`` ((H, W, 3) uint8 of :attr:`size`) for the face outline now
-        at ``outline``, textured by ``key`` (the key frame at :attr:`size`). Every pixel is
-        written: the key frame is copied and only the triangles that moved are drawn again,
-        those that moved less than :data:`SLOW` pixels sampled nearest, the others bilinear."""
+        """Draw the scene for the face outline now at ``outline``, textured by the key frame.
+
+        Every pixel is written: the key frame is copied and only the triangles that moved (a
+        vertex more than :data:`STILL` px in x or y) are drawn again, those that moved less than
+        :data:`~facemime.shared_constants.SLOW` pixels sampled nearest, the others bilinear, none
+        culled.
+
+        Parameters
+        ----------
+        out
+            (H, W, 3) uint8 RGB array of :attr:`size`, C-contiguous: the picture, written in
+            place.
+        key
+            (H, W, 3) uint8 RGB array: the key frame at :attr:`size`, the same shape as ``out``.
+        outline
+            (A, 2) float array: the anchors' projections now, (x, y) pixels.
+        """
         if key.shape != out.shape:
             raise InvalidInputError(
                 f"the key frame is {key.shape[1]}x{key.shape[0]}, the picture {out.shape[1]}x{out.shape[0]}"

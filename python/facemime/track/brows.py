@@ -24,8 +24,19 @@ MIN_MATCH = 0.5
 
 
 class BrowSearch:
-    """Finds one brow again. ``image``: the first frame, (H, W) grey or (H, W, 3) RGB uint8;
-    ``knots``: that brow's knots on it, (K, 2) px."""
+    """Finds one brow again.
+
+    The template is the first frame's gray box around the brow's knots grown by :data:`MARGIN`
+    of the brow's width; a template under 8 px on a side or with a gray-level spread under 1
+    leaves the search inactive (:meth:`find` then finds nothing).
+
+    Parameters
+    ----------
+    image
+        The first frame, (H, W) gray or (H, W, 3) RGB uint8 array.
+    knots
+        (K, 2) float array: that brow's knots on it, (x, y) pixels.
+    """
 
     def __init__(self, image: np.ndarray, knots: np.ndarray):
         self._knots0 = np.asarray(knots, np.float64)
@@ -36,9 +47,26 @@ class BrowSearch:
         self.active = min(self._template.shape) >= 8 and self._template.std() >= 1.0
 
     def find(self, image: np.ndarray, scale: float, expected: np.ndarray) -> np.ndarray | None:
-        """The brow's knots in ``image`` (grey or RGB; (K, 2) px: the first frame's, scaled by
-        ``scale`` about the match), or None when nothing matched. ``scale``: the head's scale since
-        the first frame; ``expected``: (K, 2) px, where the head motion put the knots."""
+        """The brow's knots in ``image``, or None when nothing matched.
+
+        The template is searched within ± :data:`REACH` of the brow's width (scaled) around where
+        ``expected`` puts it; a correlation below :data:`MIN_MATCH` is no match.
+
+        Parameters
+        ----------
+        image
+            The current frame, (H, W) gray or (H, W, 3) RGB uint8 array.
+        scale
+            The head's scale since the first frame (1 = unchanged); the template is resized by it.
+        expected
+            (K, 2) float array: where the head motion put the knots, (x, y) pixels.
+
+        Returns
+        -------
+        (K, 2) float64 array or None
+            The first frame's knots, (x, y) pixels, scaled by ``scale`` about the template's
+            centre and moved to the match; None when the search is inactive or nothing matched.
+        """
         if not self.active:
             return None
         templ = self._template

@@ -45,7 +45,20 @@ class EyeFrame:
 
     @classmethod
     def of(cls, ring: np.ndarray) -> EyeFrame:
-        """The frame of an eye ring of 8 projected points (corner, 3 upper, corner, 3 lower)."""
+        """The frame of a projected eye ring.
+
+        Parameters
+        ----------
+        ring
+            (8, 2) float array: the ring's projections (corner, 3 upper-lid, corner, 3 lower-lid
+            vertices), (x, y) pixels.
+
+        Returns
+        -------
+        EyeFrame
+            Origin at the middle of the two corners, u from the image-left corner to the
+            image-right one, v that turned 90° (down on the screen for an upright face).
+        """
         a, b = (ring[0], ring[4]) if ring[0, 0] <= ring[4, 0] else (ring[4], ring[0])
         ex = b - a
         return cls((a + b) / 2.0, np.array([ex, [-ex[1], ex[0]]]))
@@ -56,17 +69,52 @@ class EyeFrame:
         return float(np.hypot(*self.axes[0]))
 
     def to_image(self, uv: np.ndarray) -> np.ndarray:
-        """Image (x, y) px of eye coordinates ``uv`` (..., 2)."""
+        """Image positions of eye coordinates.
+
+        Parameters
+        ----------
+        uv
+            (..., 2) float array: (u, v) eye coordinates, eye widths.
+
+        Returns
+        -------
+        (..., 2) float64 array
+            (x, y) pixels.
+        """
         return self.origin + np.asarray(uv) @ self.axes
 
     def to_eye(self, xy: np.ndarray) -> np.ndarray:
-        """Eye coordinates (u, v) of image points ``xy`` (..., 2) px."""
+        """Eye coordinates of image points.
+
+        Parameters
+        ----------
+        xy
+            (..., 2) float array: (x, y) pixels.
+
+        Returns
+        -------
+        (..., 2) float64 array
+            (u, v) eye coordinates, eye widths.
+        """
         return (np.asarray(xy) - self.origin) @ np.linalg.inv(self.axes)
 
     def patch(self, frame: np.ndarray) -> np.ndarray:
-        """The eye's grey patch of ``frame`` (H, W, 3) RGB uint8, sampled every 1 / :data:`DENSITY` eye widths
-        over :data:`SPAN_U` x :data:`SPAN_V` (:func:`~facemime.render.bilinear.sample_affine`, then
-        OpenCV's RGB-to-grey): float32, rows along v."""
+        """The eye's gray patch of ``frame``.
+
+        Sampled every 1 / :data:`DENSITY` eye widths over :data:`SPAN_U` x :data:`SPAN_V`
+        (:func:`~facemime.render.bilinear.sample_affine`, then OpenCV's RGB-to-gray).
+
+        Parameters
+        ----------
+        frame
+            (H, W, 3) uint8 RGB array.
+
+        Returns
+        -------
+        (R, C) float32 array
+            0-255 gray levels; row i at v = SPAN_V[0] + i / DENSITY, column j at
+            u = SPAN_U[0] + j / DENSITY (23 x 29 with the shared constants).
+        """
         rows, cols = _patch_shape()
         step = self.axes / DENSITY
         start = self.to_image(np.array([SPAN_U[0], SPAN_V[0]]))
@@ -118,13 +166,31 @@ def _disc(radius: float) -> np.ndarray:
 
 
 def find_iris(patch: np.ndarray, radius: float = IRIS_RADIUS) -> tuple[np.ndarray, float]:
-    """The iris centre (u, v) in an eye's :meth:`EyeFrame.patch`: where a disc of ``radius`` (eye
-    widths) is darkest against the picture beside it (the mean of a box of the disc's height on
-    either side: taking the brighter box instead pulled the centre towards the side with more
-    sclera, 0.031 against 0.029 IOD on the shared videos). Returns the centre and its contrast
-    (grey levels: how much brighter the sides are than the disc; low when no iris shows). (Taking the disc's
-    darkness inside the eye's opening only, to keep the lashes out, doubled the error on the shared videos: 0.031 to
-    0.050 IOD.)"""
+    """The iris centre in an eye's :meth:`EyeFrame.patch`.
+
+    It is where a disc of ``radius`` is darkest against the picture beside it: the disc's mean
+    less half the mean beside it is least, searched within ± :data:`IRIS_U` along the eye and
+    :data:`IRIS_V` across it, refined between samples by parabolas. Beside it is the mean of two
+    boxes, 0.6 of the radius wide and 1.2 radii tall, just outside the disc on either side
+    (taking the brighter box instead pulled the centre towards the side with more sclera, 0.031
+    against 0.029 IOD on the shared videos). (Taking the disc's darkness inside the eye's opening
+    only, to keep the lashes out, doubled the error on the shared videos: 0.031 to 0.050 IOD.)
+
+    Parameters
+    ----------
+    patch
+        (R, C) float32 array: an eye's gray patch from :meth:`EyeFrame.patch`, 0-255 levels.
+    radius
+        The iris's radius, eye widths.
+
+    Returns
+    -------
+    centre : (2,) float64 array
+        The iris centre (u, v), eye widths.
+    contrast : float
+        How much brighter the sides are than the disc there, gray levels; low when no iris
+        shows.
+    """
     r = radius * DENSITY
     inside = cv2.filter2D(patch, -1, _disc(r), borderType=cv2.BORDER_REPLICATE)
     side = int(round(0.6 * r))
@@ -149,8 +215,18 @@ COLUMN_HALF = 0.05
 
 
 def profiles(patch: np.ndarray) -> np.ndarray:
-    """(C, R) the mean of an eye's :meth:`EyeFrame.patch` over each of :data:`COLUMNS`' bands,
-    per row."""
+    """The mean of an eye's patch over each of :data:`COLUMNS`' bands, per row.
+
+    Parameters
+    ----------
+    patch
+        (R, C) float32 array: an eye's gray patch from :meth:`EyeFrame.patch`, 0-255 levels.
+
+    Returns
+    -------
+    (len(COLUMNS), R) float32 array
+        Per column band (± :data:`COLUMN_HALF` eye widths), the mean gray level of each row.
+    """
     half = max(1, int(round(COLUMN_HALF * DENSITY)))
     return np.array([patch[:, _col(u) - half : _col(u) + half + 1].mean(axis=1) for u in COLUMNS])
 
@@ -180,8 +256,19 @@ class LidModel:
     Each trial moves the key frame's eye by a shift (the head's pose errs by some pixels) and
     closes it: the upper lid comes down to a share of the opening, the skin above sliding with it
     (less and less up to :data:`REACH_UP` above) and the eye between the lids squeezed; the
-    lower lid moves by a shift of its own. This is done on each column's :func:`profiles` (the
-    key frame's, ``key`` (C, R), with its lids at ``upper`` and ``lower`` (C,) v), once."""
+    lower lid moves by a shift of its own. This is done on each column's :func:`profiles` of the
+    key frame, once.
+
+    Parameters
+    ----------
+    key
+        (len(COLUMNS), R) float array: the key frame's eye :func:`profiles`, 0-255 levels.
+    upper
+        (len(COLUMNS),) float array: the key frame's upper lid at each of :data:`COLUMNS`, v in
+        eye widths.
+    lower
+        (len(COLUMNS),) float array: its lower lid there, v in eye widths.
+    """
 
     def __init__(self, key: np.ndarray, upper: np.ndarray, lower: np.ndarray):
         rows = key.shape[1]
@@ -214,9 +301,22 @@ class LidModel:
         self._prior = PRIOR * prior
 
     def share(self, now: np.ndarray) -> float:
-        """The share of the key frame's opening that an eye with :func:`profiles` ``now`` shows:
-        the best trial's (normalised squared difference, summed with the pull :data:`PRIOR`),
-        refined between trials by a parabola."""
+        """The share of the key frame's opening that an eye shows now.
+
+        The best trial's (normalised squared difference, summed with the pull :data:`PRIOR`),
+        refined between trials by a parabola.
+
+        Parameters
+        ----------
+        now
+            (len(COLUMNS), R) float array: the eye's :func:`profiles` now, 0-255 levels.
+
+        Returns
+        -------
+        float
+            The opening as a share of the key frame's, within the range of :data:`OPENINGS`
+            (0 to 1.1).
+        """
         seen = _normalised(now[:, self._rows])
         cost = ((self._trials - seen) ** 2).mean(axis=(-1, -2)) + self._prior
         i, j, k = np.unravel_index(int(np.argmin(cost)), cost.shape)
@@ -237,11 +337,23 @@ class EyeState:
     rest: np.ndarray
 
     def iris_xy(self) -> np.ndarray:
-        """(2, 2) iris centres, image px."""
+        """The iris centres in the image.
+
+        Returns
+        -------
+        (2, 2) float64 array
+            Per eye (the subject's right first), the iris centre (x, y), pixels.
+        """
         return np.array([f.to_image(i) for f, i in zip(self.frames, self.iris)])
 
     def opening_px(self) -> np.ndarray:
-        """(2,) lid opening, px."""
+        """The lid openings in the image.
+
+        Returns
+        -------
+        (2,) float64 array
+            Per eye (the subject's right first), upper to lower lid, pixels.
+        """
         return self.opening * np.array([f.width for f in self.frames])
 
 
@@ -257,9 +369,19 @@ IRIS_HIDDEN = 0.6
 
 
 class EyeTracker:
-    """Measures the eyes of ``model`` (an actor's fitted model, its eye rings on the lids) on
-    frames given with the head's pose, from the ``key`` frame (RGB uint8) in ``key_pose``, the
-    one the actor was fitted on."""
+    """Measures the eyes of an actor's model on frames given with the head's pose.
+
+    ``key`` (attribute) is the :class:`EyeState` measured on the key frame.
+
+    Parameters
+    ----------
+    model
+        The actor's fitted model, its eye rings (:data:`EYES` groups) on the lids.
+    key
+        (H, W, 3) uint8 RGB array: the key frame, the one the actor was fitted on.
+    key_pose
+        The head's pose in ``key``.
+    """
 
     def __init__(self, model: HeadModel, key: np.ndarray, key_pose: Pose):
         self._rings = [model.vertices[model.groups[e]] for e in EYES]
@@ -287,7 +409,20 @@ class EyeTracker:
         return tuple(EyeFrame.of(project(r, pose)[0]) for r in self._rings)  # type: ignore[return-value]
 
     def update(self, frame: np.ndarray, pose: Pose) -> EyeState:
-        """Measure the eyes of ``frame`` (RGB uint8 (H, W, 3)) with the head in ``pose``."""
+        """Measure the eyes of ``frame`` with the head in ``pose``.
+
+        Parameters
+        ----------
+        frame
+            (H, W, 3) uint8 RGB array.
+        pose
+            The head's pose in ``frame``.
+
+        Returns
+        -------
+        EyeState
+            Both eyes' openings, irises and frames on ``frame``.
+        """
         frames = self._frames(pose)
         iris, opening, seen = np.zeros((2, 2)), np.zeros(2), np.zeros(2, bool)
         for k, f in enumerate(frames):
@@ -300,10 +435,26 @@ class EyeTracker:
         return EyeState(opening, iris, frames, seen, rest)
 
     def look(self, state: EyeState) -> tuple[np.ndarray, np.ndarray]:
-        """The closure (2,) and iris shift (2, 2) of :class:`facemime.types.look.Look` for a
-        measured ``state``: relative to the key frame (the iris to where the head's turn carries
-        the key frame's), an iris not seen or hidden by its lids (:data:`IRIS_HIDDEN`) held where
-        it was last seen."""
+        """The closure and iris shift of :class:`facemime.types.look.Look` for a measured state.
+
+        Both are relative to the key frame (the iris to where the head's turn carries the key
+        frame's); every iris shift is shrunk by :data:`IRIS_STILL` towards none, and an iris not
+        seen or hidden by its lids (:data:`IRIS_HIDDEN`) is held where it was last seen (the
+        tracker keeps it from call to call).
+
+        Parameters
+        ----------
+        state
+            The eyes measured on a frame, by :meth:`update`.
+
+        Returns
+        -------
+        closure : (2,) float64 array
+            Per eye (the subject's right first), the share of the key frame's opening closed: 0
+            as on the key frame, 1 shut, negative opened wider.
+        iris : (2, 2) float64 array
+            Per eye, the iris centre's shift (u, v) from its key-frame place, eye widths.
+        """
         closure = 1.0 - state.opening / np.maximum(self.key.opening, 1e-6)
         shift = state.iris - state.rest
         shift = np.sign(shift) * np.maximum(np.abs(shift) - IRIS_STILL, 0.0)  # the measure's noise: still

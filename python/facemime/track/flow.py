@@ -28,14 +28,39 @@ class FrameFlow:
         self._frames = _core.FlowFrames(LEVELS, WINDOW)
 
     def push(self, frame: np.ndarray, crop: tuple[int, int, int, int]) -> None:
-        """The next frame, (H, W) grey or (H, W, 3) RGB uint8 (read as OpenCV's ``RGB2GRAY``
-        grey levels); only ``crop`` = (x0, y0, x1, y1) px, exclusive ends, is used: points
-        outside it are not followed."""
+        """Take the next frame: it becomes the current one, the current one the previous.
+
+        Parameters
+        ----------
+        frame
+            (H, W) gray or (H, W, 3) RGB uint8 array (read as OpenCV's ``RGB2GRAY`` gray levels).
+        crop
+            (x0, y0, x1, y1) pixels of the frame, exclusive ends: the only part used; points
+            outside it are not followed.
+        """
         self._frames.push(
             np.ascontiguousarray(frame, np.uint8), (int(crop[0]), int(crop[1]), int(crop[2]), int(crop[3]))
         )
 
     def track(self, points: np.ndarray, backward: bool = False) -> tuple[np.ndarray, np.ndarray]:
-        """Positions in the current frame of (N, 2) points of the previous one (the reverse
-        with ``backward``): ((N, 2) float64, NaN where lost; (N,) bool, followed)."""
+        """Positions in the current frame of points of the previous one (or the reverse).
+
+        Needs two frames pushed.
+
+        Parameters
+        ----------
+        points
+            (N, 2) float array: (x, y) pixels in the previous frame (in the current one with
+            ``backward``).
+        backward
+            Follow the points from the current frame back into the previous one.
+
+        Returns
+        -------
+        positions : (N, 2) float64 array
+            (x, y) pixels in the current frame (the previous one with ``backward``), NaN where
+            lost.
+        followed : (N,) bool array
+            True where the point was followed.
+        """
         return self._frames.track(as_points(points), backward, ITERATIONS, EPSILON, MIN_EIGEN)

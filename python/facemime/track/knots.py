@@ -35,7 +35,29 @@ class FrameResult:
 
 
 def layout(contours: Mapping[str, np.ndarray], params: TrackerParams) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """Shared knot array and each contour's knot indices; mouth corners are shared."""
+    """Shared knot array and each contour's knot indices; mouth corners are shared.
+
+    Features are laid out in the order of :data:`~facemime.types.contours.FEATURES`, each upper
+    curve then its lower one. A mouth's two corners are single knots, at the mean of its upper
+    and lower curves' ends.
+
+    Parameters
+    ----------
+    contours
+        Contour name -> (N, 2) float array, (x, y) pixels; all eight contours of
+        :data:`~facemime.types.contours.FEATURES`.
+    params
+        The tracker's settings: ``mouth_knots`` and ``brow_knots`` resample each curve to that
+        many knots equally spaced in arc length (None: the contour's own points, or the longer
+        curve's count where a feature's upper and lower curves differ).
+
+    Returns
+    -------
+    knots : (M, 2) float64 array
+        Every knot, (x, y) pixels.
+    index : dict of str -> (n,) int array
+        Contour name -> the indices into ``knots`` of its knots, in the contour's order.
+    """
     knots: list[np.ndarray] = []
     index: dict[str, np.ndarray] = {}
     for feature, (up, low) in FEATURES.items():
@@ -61,6 +83,24 @@ def layout(contours: Mapping[str, np.ndarray], params: TrackerParams) -> tuple[n
 
 
 def check_contours(contours: Mapping[str, object], width: int, height: int) -> dict[str, np.ndarray]:
+    """Check a start frame's contours: all eight present, each of finite points inside the image.
+
+    Parameters
+    ----------
+    contours
+        Contour name -> (N, 2) points, (x, y) pixels; N at least 2, each point within the
+        image's outer pixel edges (-0.5 to ``width`` - 0.5 and ``height`` - 0.5).
+    width
+        Width of the image, pixels.
+    height
+        Height of the image, pixels.
+
+    Returns
+    -------
+    dict of str -> (N, 2) float64 array
+        The eight contours of :data:`~facemime.types.contours.CONTOUR_NAMES`, in that order, as
+        C-contiguous float64 (other entries left out).
+    """
     if not isinstance(contours, Mapping):
         raise InvalidInputError(
             f"contours must be a mapping of contour name to (N, 2) points, got {type(contours).__name__}"
@@ -80,6 +120,20 @@ def check_contours(contours: Mapping[str, object], width: int, height: int) -> d
 
 
 def rgb_frame(name: str, frame: object) -> np.ndarray:
+    """Check that ``frame`` is an RGB image.
+
+    Parameters
+    ----------
+    name
+        What the frame is called in the error raised.
+    frame
+        The image: must be an (H, W, 3) uint8 numpy array.
+
+    Returns
+    -------
+    (H, W, 3) uint8 array
+        ``frame``, C-contiguous (a copy only where it was not).
+    """
     img = validate.image(name, frame)
     if img.ndim != 3 or img.shape[2] != 3:
         raise InvalidInputError(f"{name} must be an (H, W, 3) RGB image, got shape {img.shape}")

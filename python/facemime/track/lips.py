@@ -71,8 +71,22 @@ def _chromaticity(pixels: np.ndarray) -> np.ndarray:
 
 
 def lip_colour(frame: np.ndarray, contours: Mapping[str, np.ndarray]) -> tuple[float, float, float] | None:
-    """The lip score (w_r, w_g, bias) of ``frame`` (H, W, 3) uint8 RGB from its mouth contours,
-    or None when lips and skin cannot be told apart by colour."""
+    """The lip score of ``frame`` from its mouth contours.
+
+    Parameters
+    ----------
+    frame
+        (H, W, 3) uint8 RGB array, the first frame.
+    contours
+        Contour name -> (N, 2) float array, (x, y) pixels; the four mouth contours are read.
+
+    Returns
+    -------
+    tuple of (w_r, w_g, bias) or None
+        The score ``w_r·r + w_g·g − bias`` of a pixel's chromaticities, in skin standard
+        deviations; None when fewer than 10 lip or skin pixels, or the colours closer than
+        :data:`MIN_CHROMA` or separated by less than :data:`MIN_SEPARATION`.
+    """
     shape = frame.shape[:2]
     outer = _polygon_mask(shape, contours["mouth_outer_upper"], contours["mouth_outer_lower"])
     inner = _polygon_mask(shape, contours["mouth_inner_upper"], contours["mouth_inner_lower"])
@@ -100,14 +114,28 @@ def lip_colour(frame: np.ndarray, contours: Mapping[str, np.ndarray]) -> tuple[f
 class LipSearch:
     """Moves mouth knots the flow could not follow, or left inside the lips, onto the lip edges.
 
-    ``frame``, ``contours``: the first frame and its given contours (fit the colour);
-    ``index``: contour name -> its knots' indices in the tracker's knot array; ``edges``: the
-    first frame's knots as settled on the image edges (each knot keeps, in later frames, the
-    offset from its lip edge it had there: the snakes settle on the luma edge, which may lie a
-    little off the colour edge); ``reach``: search range, ± this fraction of the first frame's
-    mouth width; ``min_step``: smallest edge (score units per px). ``active`` is False when
-    the colours did not separate: :meth:`move` then does nothing; ``colour`` is the lip score
-    (w_r, w_g, bias) when it is True.
+    ``active`` is False when the colours did not separate (or the reach is under 1 px):
+    :meth:`move` then does nothing; ``colour`` is the lip score (w_r, w_g, bias) of
+    :func:`lip_colour` when the colours separated, else None.
+
+    Parameters
+    ----------
+    frame
+        (H, W, 3) uint8 RGB array, the first frame (fits the colour with ``contours``).
+    contours
+        Contour name -> (N, 2) float array, (x, y) pixels: the first frame's given contours.
+    index
+        Contour name -> its knots' indices in the tracker's knot array (the four mouth contours
+        are read).
+    edges
+        (K, 2) float array, (x, y) pixels: the first frame's knots as settled on the image edges
+        (each knot keeps, in later frames, the offset from its lip edge it had there: the snakes
+        settle on the luma edge, which may lie a little off the colour edge).
+    reach
+        Search range along a knot's normal: ± this fraction of the first frame's mouth width
+        (between the outer upper lip's corners).
+    min_step
+        Smallest edge the search takes, score units (skin standard deviations) per pixel.
     """
 
     def __init__(
@@ -135,9 +163,23 @@ class LipSearch:
             )
 
     def move(self, frame: np.ndarray, knots: np.ndarray, unfollowed: np.ndarray, scale: float) -> None:
-        """Move the interior mouth knots flagged in ``unfollowed`` (a mask over ``knots``, a
-        C-contiguous (K, 2) float64 array, px), then the outer knots inside their lips (lip
-        colour outside them, then skin), then the inner knots too far inside the mouth, to the
-        lip edges found near them in ``frame``, head scale ``scale`` (in place)."""
+        """Move mouth knots onto the lip edges found near them in ``frame``, in place.
+
+        First the interior (not corner) mouth knots flagged in ``unfollowed``, then the outer
+        knots inside their lips (lip colour outside them, then skin), then the inner knots too
+        far inside the mouth. Does nothing when the search is not ``active``.
+
+        Parameters
+        ----------
+        frame
+            (H, W, 3) uint8 RGB array, the current frame.
+        knots
+            C-contiguous (K, 2) float64 array: the tracker's knots, (x, y) pixels, moved in
+            place.
+        unfollowed
+            (K,) bool array over ``knots``: the knots the optical flow could not follow.
+        scale
+            The head's scale relative to the first frame (positive; 1 = unchanged).
+        """
         if self.active:
             self._placer.place(np.ascontiguousarray(frame), knots, np.ascontiguousarray(unfollowed, bool), float(scale))

@@ -49,7 +49,27 @@ CORNER_BLOCK = 5  # px: side of the square over which the corner measure sums gr
 
 
 def face_frame(contours: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-    """(centre of the brows, u, v, W) of a set of contours; see :data:`ZONES`."""
+    """The face's frame of :data:`ZONES` in a set of contours.
+
+    Parameters
+    ----------
+    contours
+        Name -> (N, 2) float array, (x, y) pixels, each curve image-left to image-right: the
+        four brow curves and the two outer mouth curves at least.
+
+    Returns
+    -------
+    tuple of (c, u, v, W)
+        c : (2,) float64 array
+            Centre of the brows (mean of all their points), pixels.
+        u : (2,) float64 array
+            Unit vector: ``v`` turned to image-right.
+        v : (2,) float64 array
+            From ``c`` to the centre of the outer mouth (mean of its points), pixels.
+        W : float
+            Outer width of the brows (``brow_right_upper``'s first point to
+            ``brow_left_upper``'s last), pixels.
+    """
     brows = np.concatenate([contours[n] for n in contours if n.startswith("brow")])
     mouth = np.concatenate([contours[n] for n in contours if n.startswith("mouth_outer")])
     c = brows.mean(axis=0)
@@ -60,7 +80,18 @@ def face_frame(contours: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarr
 
 
 def zone_polygons(contours: Mapping[str, np.ndarray]) -> list[np.ndarray]:
-    """The rigid zones as (4, 2) pixel polygons."""
+    """The rigid zones of a set of contours as pixel polygons.
+
+    Parameters
+    ----------
+    contours
+        Name -> (N, 2) float array, (x, y) pixels, as :func:`face_frame` takes them.
+
+    Returns
+    -------
+    list of (4, 2) float64 array
+        One quadrilateral per zone of :data:`ZONES`, in that order, (x, y) pixels.
+    """
     c, u, v, width = face_frame(contours)
     polys = []
     for (s0, s1), (t0, t1) in ZONES:
@@ -70,8 +101,24 @@ def zone_polygons(contours: Mapping[str, np.ndarray]) -> list[np.ndarray]:
 
 
 def brow_similarity(src: Mapping[str, np.ndarray], dst: Mapping[str, np.ndarray]) -> np.ndarray:
-    """The 2×3 similarity that best maps the brow contours of ``src`` onto those of ``dst``
-    (robust least squares over their points)."""
+    """The similarity that best maps the brow contours of ``src`` onto those of ``dst`` (robust
+    least squares over their points: :func:`facemime.types.similarity.robust_similarity`, 1 px
+    inlier limit).
+
+    Parameters
+    ----------
+    src
+        Name -> (N, 2) float array, (x, y) pixels: the contours whose brow curves (names starting
+        ``brow``) are mapped.
+    dst
+        Name -> (N, 2) float array, (x, y) pixels: the same brow curves, as many points each,
+        where they are to go.
+
+    Returns
+    -------
+    (2, 3) float64 array
+        The similarity (rotation, uniform scale, translation) of (x, y) pixels.
+    """
     names = [n for n in src if n.startswith("brow")]
     a = np.concatenate([src[n] for n in names])
     b = np.concatenate([dst[n] for n in names])
@@ -94,6 +141,18 @@ class HeadMotion:
     their identities: a point keeps its id for as long as it is followed, new detections get
     new ids (the head-pose estimator keeps each point's 3D position by id). ``followed`` is the
     (points, ids) pair of the points followed from the previous frame, before any re-detection.
+
+    Parameters
+    ----------
+    frame
+        (H, W) grey or (H, W, 3) RGB uint8: the first frame; every later frame has its size.
+    contours
+        Name -> (N, 2) float array, (x, y) pixels: the first frame's contours, the brow and outer
+        mouth curves at least (:func:`face_frame`); its brow curves are the ones
+        :meth:`brow_points` joins from then on.
+    max_points
+        Most rigid points one detection finds (``goodFeaturesToTrack``'s ``maxCorners``), kept
+        at least max(3, W / 30) pixels apart, W the brows' outer width.
     """
 
     def __init__(self, frame: np.ndarray, contours: Mapping[str, np.ndarray], max_points: int = 60):
@@ -139,7 +198,19 @@ class HeadMotion:
         return self._brows
 
     def brow_points(self, contours: Mapping[str, np.ndarray]) -> np.ndarray:
-        """(N, 2) float64 px: the brow contours' points joined, as :meth:`update` takes them."""
+        """The brow contours' points joined, as :meth:`update` takes them.
+
+        Parameters
+        ----------
+        contours
+            Name -> (N, 2) float array, (x, y) pixels, with the brow curves of the first frame's
+            contours (:attr:`brows`), as many points each.
+
+        Returns
+        -------
+        (N, 2) float64 array
+            The points of the curves of :attr:`brows`, in that order, (x, y) pixels.
+        """
         return as_points(np.concatenate([contours[n] for n in self._brows]))
 
     @staticmethod
@@ -195,15 +266,33 @@ class HeadMotion:
     def update(
         self, frame: np.ndarray, brows: np.ndarray, extra: np.ndarray | None = None
     ) -> tuple[np.ndarray, bool, np.ndarray | None]:
-        """Motion from the previous frame to ``frame`` (grey or RGB, as the first).
+        """Motion from the previous frame to ``frame``.
 
-        ``brows``: (N, 2) px, the brow points tracked in the previous frame
-        (:meth:`brow_points` of its contours); the brows, the most reliably tracked feature,
-        place the rigid zones.
-        ``extra``: optional (N, 2) points of the previous frame to follow by the same flow.
-        Returns (step, measured, moved): the 2×3 similarity (identity when too few points agreed
-        and the coarse fallback failed), whether it was measured, and the extra points' new
-        positions (NaN where the flow failed its forward-backward check).
+        Parameters
+        ----------
+        frame
+            (H, W) grey or (H, W, 3) RGB uint8, the first frame's size: the next frame.
+        brows
+            (N, 2) float array, (x, y) pixels: the brow points tracked in the previous frame
+            (:meth:`brow_points` of its contours, as many as the first frame's); the brows, the
+            most reliably tracked feature, place the rigid zones.
+        extra
+            (E, 2) float array, (x, y) pixels of the previous frame: other points to follow by
+            the same flow; None: none.
+
+        Returns
+        -------
+        tuple of (step, measured, moved)
+            step : (2, 3) float64 array
+                The similarity from the previous frame's pixels to this one's: from the rigid
+                points' flow, else a translation from the coarse template search; the identity
+                when both failed.
+            measured : bool
+                Whether ``step`` was measured (False: the identity of a failure).
+            moved : (E, 2) float64 array or None
+                The ``extra`` points' positions in ``frame``, (x, y) pixels, NaN where the flow
+                failed its forward-backward check (all NaN when the head had fewer than
+                :data:`MIN_POINTS` rigid points to follow); None when ``extra`` is None.
         """
         frame = np.ascontiguousarray(frame, np.uint8)
         extra_pts = as_points(np.zeros((0, 2)) if extra is None else extra)

@@ -57,10 +57,31 @@ GAIN = 0.5
 
 
 def mouth_shift(prev_image: np.ndarray, image: np.ndarray, prev: np.ndarray, carried: np.ndarray) -> np.ndarray | None:
-    """How far the mouth moved from ``prev_image`` to ``image`` ((H, W) grey or (H, W, 3) RGB
-    uint8) beyond the head: the (2,) px from ``carried`` ((K, 2) px, the mouth's knots ``prev``
-    of the previous frame moved by the head motion) to where the previous frame's mouth region
-    matched best; None when it matched nowhere."""
+    """How far the mouth moved from ``prev_image`` to ``image`` beyond the head: the previous
+    frame's mouth region (the box of ``prev`` grown by :data:`MARGIN` of the mouth's width) matched
+    in ``image`` within :data:`REACH` of its width of where the head motion put it.
+
+    Parameters
+    ----------
+    prev_image
+        (H, W) grey or (H, W, 3) RGB uint8: the previous frame.
+    image
+        (H, W) grey or (H, W, 3) RGB uint8: this frame.
+    prev
+        (K, 2) float array, (x, y) pixels: the mouth's knots in the previous frame; their x
+        extent is the mouth's width.
+    carried
+        (K, 2) float array, (x, y) pixels: the same knots moved by the head motion into this
+        frame.
+
+    Returns
+    -------
+    (2,) float64 array or None
+        (x, y) pixels from where the head motion put the region (the mean of ``carried`` less
+        that of ``prev``) to where it matched best; None when the region is under 8 px a side
+        or flat (grey standard deviation under 1 level), or matched nowhere above
+        :data:`MIN_MATCH`.
+    """
     height, width = image.shape[:2]
     size = float(np.ptp(prev[:, 0]))
     lo, hi = crop_box(prev, MARGIN * size, width, height)
@@ -75,12 +96,34 @@ def mouth_shift(prev_image: np.ndarray, image: np.ndarray, prev: np.ndarray, car
 def relocate(
     frame: np.ndarray, colour: tuple[float, float, float], expected: np.ndarray, current: np.ndarray, down: np.ndarray
 ) -> Placement | None:
-    """Where the lips of ``frame`` ((H, W, 3) uint8 RGB; lip score ``colour`` = (w_r, w_g,
-    bias), :func:`facemime.track.lips.lip_colour`) are, as the placement of the outer mouth
-    polygon ``expected`` ((N, 2) px, where the mouth is expected) that fits them best, searched
-    :data:`RELOCATE_REACH` of its width around it (``down``: the face's unit down direction in
-    the image; the window is an image-aligned box, so for a tilted head the reaches hold along
-    the image axes); None unless it beats the tracked polygon ``current`` by :data:`GAIN`."""
+    """Where the lips of ``frame`` are, as the placement of the outer mouth polygon ``expected``
+    that fits them best, searched :data:`RELOCATE_REACH` of its width around it at the scales of
+    :data:`RELOCATE_SCALES` (the window is an image-aligned box, so for a tilted head the reaches
+    hold along the image axes).
+
+    Parameters
+    ----------
+    frame
+        (H, W, 3) uint8 RGB: the frame searched.
+    colour
+        (w_r, w_g, bias): the lip score of the first frame
+        (:func:`facemime.track.lips.lip_colour`), in skin standard deviations.
+    expected
+        (N, 2) float array, (x, y) pixels: the outer mouth polygon (upper curve, then the lower
+        one reversed) where the mouth is expected; its x extent is the mouth's width.
+    current
+        (N, 2) float array, (x, y) pixels: the tracked outer mouth polygon, in the same order.
+    down
+        (2,) float array: the face's unit down direction in the image.
+
+    Returns
+    -------
+    Placement or None
+        How to move ``expected`` (:meth:`Placement.apply` about its centroid): scale, then
+        shift in pixels; ``contrast`` is the mean clipped lip score inside the polygon minus that
+        in the ring of skin around it (:data:`RING`). None unless it beats the contrast of
+        ``current`` by :data:`GAIN`.
+    """
     height, width = frame.shape[:2]
     size = float(np.ptp(expected[:, 0]))
     sideways, up, lower = RELOCATE_REACH

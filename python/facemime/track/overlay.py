@@ -27,9 +27,30 @@ def draw_contours(
     thickness: int | None = None,
     out: np.ndarray | None = None,
 ) -> np.ndarray:
-    """``frame`` (H, W, 3) uint8 RGB with the contours drawn as anti-aliased polylines, knots as
-    dots; curves of ``lost`` features in magenta. Drawn on a copy, or on ``out`` (an (H, W, 3)
-    uint8 array or view, e.g. half of a side-by-side canvas) after ``frame`` is copied into it."""
+    """``frame`` with the contours drawn as anti-aliased polylines in their feature's colour
+    (:data:`COLOURS`), knots as dots; curves of lost features in magenta (:data:`LOST_COLOUR`).
+
+    Parameters
+    ----------
+    frame
+        (H, W, 3) uint8 RGB: the frame drawn on (left unchanged).
+    contours
+        Contour name -> (N, 2) float array, (x, y) pixels; contours missing from it are skipped.
+    lost
+        Feature names (``mouth_outer``, ``mouth_inner``, ``brow_left``, ``brow_right``) whose
+        curves are drawn in magenta.
+    thickness
+        Line thickness, pixels (dots of radius thickness + 1); None: min(H, W) / 400 rounded, at
+        least 1.
+    out
+        (H, W, 3) uint8 array or view (e.g. half of a side-by-side canvas) to draw on, after
+        ``frame`` is copied into it; None: a new copy of ``frame``.
+
+    Returns
+    -------
+    (H, W, 3) uint8 array
+        The drawing: ``out`` itself when given.
+    """
     if out is None:
         out = np.ascontiguousarray(frame).copy()
     else:

@@ -131,5 +131,17 @@ class TrackerParams:
         return self.delta0 / (1.0 - self.sigma)
 
     def with_(self, **changes: Any) -> TrackerParams:
-        """A copy with some settings changed."""
+        """A copy with some settings changed.
+
+        Parameters
+        ----------
+        **changes
+            Field name -> new value, for any of the fields above (an unknown name raises
+            ``TypeError``).
+
+        Returns
+        -------
+        TrackerParams
+            A new instance; this one is unchanged.
+        """
         return replace(self, **changes)

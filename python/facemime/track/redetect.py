@@ -80,22 +80,64 @@ class Redetection:
 
 
 def contours_of(landmarks: np.ndarray, size: tuple[int, int]) -> dict[str, np.ndarray]:
-    """The eight tracker contours of Face Mesh ``landmarks`` ((468, 2+) pixels) in an image of
-    ``size`` (width, height), clipped to it."""
+    """The eight tracker contours of one face's Face Mesh landmarks, clipped to the image.
+
+    Parameters
+    ----------
+    landmarks
+        (468, 2+) float array (or 478 rows, with the irises): Face Mesh landmarks, (x, y) pixels
+        in the first two columns.
+    size
+        (width, height) of the image, pixels.
+
+    Returns
+    -------
+    dict of str to (N, 2) float64 array
+        Each name of ``CONTOUR_NAMES`` -> its points, (x, y) pixels image-left to image-right,
+        clipped to -0.5 .. width - 0.5 in x and -0.5 .. height - 0.5 in y.
+    """
     points = reference_points(landmarks)
     return {n: np.clip(points[n], -0.5, np.asarray(size) - 0.5) for n in CONTOUR_NAMES}
 
 
 def sparse_grid(frame: np.ndarray) -> np.ndarray:
-    """Every k-th pixel of every k-th row of an (H, W, 3) frame, k = min(H, W) // 32, as
-    float32: a glance at the whole picture for finding cuts."""
+    """Every k-th pixel of every k-th row of a frame, k = min(H, W) // 32 (at least 1), starting
+    at k // 2: a glance at the whole picture for finding cuts (:data:`CUT`).
+
+    Parameters
+    ----------
+    frame
+        (H, W, 3) uint8 RGB.
+
+    Returns
+    -------
+    (about H / k, W / k, 3) float32 array
+        The sampled pixels' levels, 0-255.
+    """
     k = max(1, min(frame.shape[:2]) // 32)
     return frame[k // 2 :: k, k // 2 :: k].astype(np.float32)
 
 
 def disagreement(tracked: Mapping[str, np.ndarray], found: Mapping[str, np.ndarray], iod: float) -> dict[str, float]:
-    """Per feature, the mean over its curves of the symmetric curve distance between
-    ``tracked`` and ``found`` contours, over ``iod`` pixels."""
+    """Per feature, the mean over its curves of the symmetric curve distance between two sets of
+    contours (:func:`facemime.metrics.curve_error`), in inter-ocular distances.
+
+    Parameters
+    ----------
+    tracked
+        Contour name -> (N, 2) float array, (x, y) pixels: all eight contours, as tracked.
+    found
+        Contour name -> (M, 2) float array, (x, y) pixels: all eight contours, as a landmark pass
+        found them.
+    iod
+        Inter-ocular distance, pixels: the unit of the result.
+
+    Returns
+    -------
+    dict of str to float
+        Feature name (``mouth_outer``, ``mouth_inner``, ``brow_left``, ``brow_right``) -> its
+        distance, in IOD (+inf where a tracked curve is malformed or not finite).
+    """
     return {
         f: float(np.mean([curve_error(tracked[n], found[n]) for n in names])) / iod for f, names in FEATURES.items()
     }
@@ -107,14 +149,16 @@ class FaceTracker:
 
     Parameters
     ----------
-    frame : (H, W, 3) uint8 array
-        The first RGB frame.
-    contours : mapping of str to (N, 2) float array, optional
-        The eight contours on ``frame``, (x, y) pixels; without them the largest face's
-        landmarks start the tracker (raises :class:`facemime.errors.NoFaceError` where there
-        is none).
-    params : TrackerParams, optional
-    redetection : Redetection, optional
+    frame
+        (H, W, 3) uint8 RGB: the first frame.
+    contours
+        Name -> (N, 2) float array: the eight contours on ``frame``, (x, y) pixels, each
+        image-left to image-right; None: the largest face's landmarks start the tracker (raises
+        :class:`facemime.errors.NoFaceError` where there is none).
+    params
+        The tracker's settings; None: the defaults of :class:`TrackerParams`.
+    redetection
+        When the landmark model checks the tracker; None: the defaults of :class:`Redetection`.
 
     Attributes
     ----------
@@ -158,8 +202,21 @@ class FaceTracker:
         self.checking_seconds = 0.0
 
     def update(self, frame: np.ndarray) -> FrameResult:
-        """Track one more frame, (H, W, 3) uint8 RGB; the result's ``redetected`` says whether
-        the landmark model put its contours right."""
+        """Track one more frame, checking it with the landmark model where the module's docs say.
+
+        Parameters
+        ----------
+        frame
+            (H, W, 3) uint8 RGB, the first frame's size: the next frame.
+
+        Returns
+        -------
+        FrameResult
+            The frame's contours ((x, y) pixels), confidences and lost features; ``index`` is
+            the frame's number (the first frame's is 0); ``redetected`` says whether the landmark
+            model put the contours right. While the face is lost and not found again: the last
+            contours, every feature lost with confidence 0, and ``motion_ok`` False.
+        """
         self.frame_index += 1
         glance, self._glance = self._glance, sparse_grid(frame)
         if not self._face:

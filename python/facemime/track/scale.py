@@ -16,14 +16,28 @@ from facemime.track.motion import HeadMotion
 
 
 class FrameScale:
-    """Frame (``width`` × ``height`` px) to working pixels, for a face ``face_width`` px wide
-    (the outer width of the brows) tracked at most ``limit`` px wide; no limit (None) or a face
+    """Frame to working pixels, for a face tracked at most ``limit`` px wide; no limit or a face
     no wider keeps the frame as it is.
 
     A frame shrinks in two steps, each fast in OpenCV (one area-averaging resize by a fraction
     took 4 ms on a 1024 × 1024 frame, longer than tracking it): averaging k × k blocks, k the
     whole number nearest to 1 / factor (the last width mod k columns and height mod k rows are
-    dropped), then bilinear resampling by the rest of the factor, about 2/3 to 3/2."""
+    dropped), then bilinear resampling by the rest of the factor, about 2/3 to 3/2.
+
+    ``size`` is the frame's (width, height) and ``work`` the working frames' (width, height),
+    pixels; ``active`` is whether they differ.
+
+    Parameters
+    ----------
+    width
+        Width of the frames, pixels.
+    height
+        Height of the frames, pixels.
+    face_width
+        The face's width (the outer width of the brows), frame pixels.
+    limit
+        Widest face tracked, pixels (a wider one is shrunk to it); None: no limit.
+    """
 
     def __init__(self, width: int, height: int, face_width: float, limit: float | None):
         self.size = (width, height)
@@ -36,7 +50,18 @@ class FrameScale:
         self._f = np.array(self.work) / (self._k * np.array(self._blocks))
 
     def frame(self, image: np.ndarray) -> np.ndarray:
-        """``image`` (frame size) resized to the working size."""
+        """An image of the frame's size resized to the working size.
+
+        Parameters
+        ----------
+        image
+            (height, width) grey or (height, width, 3) RGB uint8, the frame's size.
+
+        Returns
+        -------
+        uint8 array of the working size
+            The shrunk image, with ``image``'s channels; ``image`` itself when not :attr:`active`.
+        """
         if not self.active:
             return image
         if self._k > 1:
@@ -47,11 +72,33 @@ class FrameScale:
         return image
 
     def to_work(self, pts: np.ndarray) -> np.ndarray:
-        """(N, 2) frame pixels -> working pixels (a new array)."""
+        """Frame pixels to working pixels.
+
+        Parameters
+        ----------
+        pts
+            (N, 2) float array, (x, y) frame pixels.
+
+        Returns
+        -------
+        (N, 2) float64 array
+            (x, y) working pixels (a new array).
+        """
         return (np.asarray(pts, np.float64) + 0.5) * self._f - 0.5 if self.active else np.array(pts, np.float64)
 
     def frame_step(self, step: np.ndarray) -> np.ndarray:
-        """A 2×3 transform ``step`` of working pixels as the transform of frame pixels it is."""
+        """A transform of working pixels as the transform of frame pixels it is.
+
+        Parameters
+        ----------
+        step
+            (2, 3) float array: an affine map of (x, y) working pixels (a frame's head motion).
+
+        Returns
+        -------
+        (2, 3) float64 array
+            The same map of (x, y) frame pixels (a new array).
+        """
         out = np.array(step, np.float64)
         if self.active:
             f, c = self._f, 0.5 * self._f - 0.5  # working = f·frame + c, per axis
@@ -60,14 +107,33 @@ class FrameScale:
         return out
 
     def to_frame(self, pts: np.ndarray) -> np.ndarray:
-        """(N, 2) working pixels -> frame pixels (a new array)."""
+        """Working pixels to frame pixels.
+
+        Parameters
+        ----------
+        pts
+            (N, 2) float array, (x, y) working pixels.
+
+        Returns
+        -------
+        (N, 2) float64 array
+            (x, y) frame pixels (a new array).
+        """
         return (np.asarray(pts, np.float64) + 0.5) / self._f - 0.5 if self.active else np.array(pts, np.float64)
 
 
 class ScaledMotion:
     """The rigid points of a :class:`facemime.track.motion.HeadMotion` that runs on working
     frames, in the frame's pixels: ``points`` (M, 2) float32, ``ids`` (M,) int64,
-    ``followed`` and the last frame's 2×3 ``step``, as the head motion's own."""
+    ``followed`` and the last frame's 2×3 ``step``, as the head motion's own.
+
+    Parameters
+    ----------
+    motion
+        The head motion, fed working frames.
+    scale
+        The frame's scale to those working frames.
+    """
 
     def __init__(self, motion: HeadMotion, scale: FrameScale):
         self._motion, self._scale = motion, scale

@@ -19,6 +19,8 @@ from facemime.types import similarity
 from facemime.types.contours import FEATURES
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     from facemime.track.params import TrackerParams
 
 
@@ -38,24 +40,14 @@ class Searches:
         _mouth_knots: np.ndarray
         _mouth_lost_for: int
 
-        def _field(
-            self, frame: np.ndarray, knots: np.ndarray, bands: tuple[tuple[np.ndarray, int], ...] | None = None
-        ) -> tuple[np.ndarray, tuple[float, float]]: ...
-        def _solve(
-            self,
-            field: tuple[np.ndarray, tuple[float, float]],
-            start: np.ndarray,
-            rest: np.ndarray,
-            down: np.ndarray,
-            targets: np.ndarray,
-            curves: np.ndarray | None = None,
-            held: np.ndarray | None = None,
-        ) -> tuple[np.ndarray, int, np.ndarray]: ...
-        def _confidences(self, resp: np.ndarray) -> dict[str, float]: ...
-        def _centre_inner(self, knots: np.ndarray, rest: np.ndarray, down: np.ndarray) -> None: ...
-        def _mouth_rest(self, carried: np.ndarray, start: np.ndarray) -> np.ndarray: ...
-        def _shape_ok(self, knots: np.ndarray, rest: np.ndarray, feature: str) -> bool: ...
-        def _named(self, knots: np.ndarray) -> dict[str, np.ndarray]: ...
+        # The tracker's own steps (signatures in tracker.py).
+        _field: Callable[..., tuple[np.ndarray, tuple[float, float]]]
+        _solve: Callable[..., tuple[np.ndarray, int, np.ndarray]]
+        _confidences: Callable[[np.ndarray], dict[str, float]]
+        _centre_inner: Callable[[np.ndarray, np.ndarray, np.ndarray], None]
+        _mouth_rest: Callable[[np.ndarray, np.ndarray], np.ndarray]
+        _shape_ok: Callable[[np.ndarray, np.ndarray, str], bool]
+        _named: Callable[[np.ndarray], dict[str, np.ndarray]]
 
     def _search_brow(
         self,

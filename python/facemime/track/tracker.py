@@ -60,12 +60,15 @@ class Tracker(Searches):
 
     Parameters
     ----------
-    frame : (H, W, 3) uint8 array
-        The RGB frame the contours were drawn on.
-    contours : mapping of str to (N, 2) float array
-        All eight contours of ``facemime.types.contours.CONTOUR_NAMES``, (x, y) pixels, image-left to
-        image-right; the two curves of each mouth contour share their end points.
-    params : TrackerParams, optional
+    frame
+        (H, W, 3) uint8 RGB: the frame the contours were drawn on; every later frame has its size.
+    contours
+        Name -> (N, 2) float array: all eight contours of
+        ``facemime.types.contours.CONTOUR_NAMES``, (x, y) pixels inside the frame, at least 2
+        points each, image-left to image-right; the two curves of each mouth contour share their
+        end points (their mean where they differ).
+    params
+        The tracker's settings; None: the defaults of :class:`TrackerParams`.
 
     Examples
     --------
@@ -281,7 +284,21 @@ class Tracker(Searches):
         return dict(zip(FEATURES, self._plan.confidences(resp)[1]))
 
     def update(self, frame: np.ndarray) -> FrameResult:
-        """Track one more frame, (H, W, 3) uint8 RGB of the first frame's size."""
+        """Track one more frame.
+
+        Parameters
+        ----------
+        frame
+            (H, W, 3) uint8 RGB, the first frame's size (another size raises
+            :class:`facemime.errors.InvalidInputError`): the next frame.
+
+        Returns
+        -------
+        FrameResult
+            The frame's contours, (x, y) pixels of the frame; each feature's confidence, 0..1;
+            the features flagged lost; the solver's iterations; whether the head motion was
+            measured. ``index`` is the frame's number (the first frame's is 0).
+        """
         frame = rgb_frame("frame", frame)
         if frame.shape[1::-1] != self._scale.size:
             width, height = self._scale.size
@@ -369,14 +386,25 @@ class Tracker(Searches):
         )
 
     def reseat(self, contours: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-        """Move the contours of the frame last tracked to ``contours`` (all eight, (x, y) pixels
-        of that frame, in the convention of the first frame's: a landmark pass's), keeping what
-        the first frame set up (its shape as the rest shape, the edges' calibration, the lip
-        colour, the brow templates): the head's accumulated motion becomes the similarity that
-        best takes the first frame's brows onto these (robustly; over all the knots, the mouth's
-        outnumber the brows', and a grimace's mouth turned and scaled the head: on lp_d6 the
-        mouth then left the lips for 15 frames after a reseat).
-        Returns the contours as now reported, name -> (N, 2) float64 pixels."""
+        """Move the contours of the frame last tracked to ``contours``, keeping what the first
+        frame set up (its shape as the rest shape, the edges' calibration, the lip colour, the
+        brow templates): the head's accumulated motion becomes the similarity that best takes
+        the first frame's brows onto these (robustly; over all the knots, the mouth's outnumber
+        the brows', and a grimace's mouth turned and scaled the head: on lp_d6 the mouth then
+        left the lips for 15 frames after a reseat).
+
+        Parameters
+        ----------
+        contours
+            Name -> (N, 2) float array: all eight contours, (x, y) pixels of the frame last
+            tracked, in the convention of the first frame's (a landmark pass's), laid out in as
+            many knots as the first frame's (else :class:`facemime.errors.InvalidInputError`).
+
+        Returns
+        -------
+        dict of str to (N, 2) float64 array
+            The contours as now reported, (x, y) pixels of the frame (:attr:`contours`).
+        """
         knots = self._knots_of(contours)
         given = self._knots0 - self._offset  # the first frame's contours, as given
         total = motion.brow_similarity(self._named(given), self._named(knots))
@@ -390,10 +418,24 @@ class Tracker(Searches):
         return self.contours
 
     def recalibrate(self, contours: Mapping[str, np.ndarray], weight: float) -> dict[str, np.ndarray]:
-        """Move the convention the contours are reported in ``weight`` (0..1) of the way towards
-        ``contours`` (all eight, (x, y) pixels of the frame last tracked): the calibration
-        offset between the image edges the snakes hold and the reported contours becomes that
-        much the offset that would report these. Returns the contours as now reported."""
+        """Move the convention the contours are reported in part of the way towards ``contours``:
+        the calibration offset between the image edges the snakes hold and the reported contours
+        becomes ``weight`` of the way to the offset that would report these.
+
+        Parameters
+        ----------
+        contours
+            Name -> (N, 2) float array: all eight contours, (x, y) pixels of the frame last
+            tracked, laid out in as many knots as the first frame's (else
+            :class:`facemime.errors.InvalidInputError`).
+        weight
+            How far to move, 0..1 (0: not at all; 1: report ``contours`` for this frame).
+
+        Returns
+        -------
+        dict of str to (N, 2) float64 array
+            The contours as now reported, (x, y) pixels of the frame (:attr:`contours`).
+        """
         knots = self._knots_of(contours)
         wanted = np.linalg.solve(self._linear, (self._knots - knots).T).T  # in the first frame's orientation
         self._offset = (1.0 - weight) * self._offset + weight * wanted

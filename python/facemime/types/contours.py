@@ -59,7 +59,19 @@ FACE_MESH_IOD = (33, 263)
 
 
 def from_face_mesh(landmarks: np.ndarray) -> dict[str, np.ndarray]:
-    """The eight contours, name -> (N, 2) float64 (x, y) pixels, from one face's Face Mesh
-    landmarks, a (478, 2 or 3) array in pixels."""
+    """The eight contours of one face's Face Mesh landmarks.
+
+    Parameters
+    ----------
+    landmarks
+        (478, 2 or 3) float array: the face's Face Mesh landmarks, (x, y) pixels first (a third
+        column, depth, is ignored; the first 468 landmarks suffice).
+
+    Returns
+    -------
+    dict of str -> (K, 2) float64 array
+        Contour name (:data:`CONTOUR_NAMES` order) -> (x, y) pixels, image-left to image-right,
+        11 points per mouth contour and 5 per brow contour.
+    """
     pts = np.asarray(landmarks, dtype=np.float64)
     return {name: pts[list(idx), :2] for name, idx in FACE_MESH_INDICES.items()}

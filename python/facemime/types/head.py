@@ -53,6 +53,11 @@ class HeadModel:
         Shape units (per-person shape, CANDIDE), same layout.
     descriptions : dict of str -> str
         What each unit does.
+    name : str
+        The model's name, for messages.
+    unit : str
+        The model unit of ``vertices`` and of the units' displacements (``"mm"`` for the generic
+        head).
     """
 
     vertices: np.ndarray
@@ -73,8 +78,22 @@ class HeadModel:
     def deform(
         self, weights: Mapping[str, float] | None = None, shape: Mapping[str, float] | None = None
     ) -> np.ndarray:
-        """Vertices with deformation units (and shape units) applied: (N, 3) float64.
+        """Vertices with deformation units (and shape units) applied.
 
+        Parameters
+        ----------
+        weights
+            Deformation unit name -> activation (1: the unit's full displacement); None: none.
+        shape
+            Shape unit name -> activation; None: none.
+
+        Returns
+        -------
+        (N, 3) float64 array
+            The rest vertices plus each unit's displacement times its activation, model units.
+
+        Examples
+        --------
         >>> from facemime.head import generic_head
         >>> head = generic_head()
         >>> moved = head.deform({"jawOpen": 0.5})
@@ -97,7 +116,27 @@ def first_problem(
     groups: Mapping[str, np.ndarray],
     tables: tuple[Mapping[str, np.ndarray], ...],
 ) -> str | None:
-    """The first thing wrong with a model's arrays, as text, or None."""
+    """The first thing wrong with a model's arrays, as text.
+
+    Parameters
+    ----------
+    v
+        Vertices, expected (N, 3) float, N >= 3, finite, model units, no coordinate beyond
+        :data:`MAX_COORDINATE`.
+    t
+        Triangles, expected (F, 3) int vertex indices, F >= 1, none of zero area.
+    uv
+        Texture coordinates, expected (N, 2) within -1..2 (nominally 0..1), or None.
+    groups
+        Group name -> vertex indices, expected 1-D, non-empty, within 0..N - 1.
+    tables
+        Unit tables (deformation, shape), each name -> expected (N, 3) finite displacements.
+
+    Returns
+    -------
+    str or None
+        One line describing the problem; None when the arrays are sound.
+    """
     if not (isinstance(v, np.ndarray) and v.ndim == 2 and v.shape[1] == 3 and len(v) >= 3):
         return f"vertices must have shape (N, 3) with N >= 3, got {getattr(v, 'shape', type(v).__name__)}"
     n = len(v)
@@ -129,11 +168,33 @@ def first_problem(
 
 
 def model_iod(model: HeadModel) -> float:
-    """Distance between the model's outer eye corners, model units."""
+    """Distance between the model's outer eye corners in the frontal (x, y) plane.
+
+    Parameters
+    ----------
+    model
+        A head with the ``eye_right`` and ``eye_left`` groups.
+
+    Returns
+    -------
+    float
+        Model units, z ignored (90 for the generic head).
+    """
     g = model.groups
     return float(np.linalg.norm(model.vertices[g["eye_right"][0], :2] - model.vertices[g["eye_left"][4], :2]))
 
 
 def model_eye_centres(model: HeadModel) -> np.ndarray:
-    """Midpoints of each eye's corners, image-left eye (the subject's right) first: (2, 3)."""
+    """Midpoints of each eye's corners.
+
+    Parameters
+    ----------
+    model
+        A head with the ``eye_right`` and ``eye_left`` groups.
+
+    Returns
+    -------
+    (2, 3) float64 array
+        Model coordinates, model units; the image-left eye (the subject's right) first.
+    """
     return np.array([model.vertices[model.groups[e][[0, 4]]].mean(axis=0) for e in ("eye_right", "eye_left")])

@@ -37,20 +37,54 @@ class Look:
             object.__setattr__(self, name, _frozen(getattr(self, name), shape))
 
     def vector(self) -> np.ndarray:
-        """(6,) float64 in the order of :data:`NAMES`."""
+        """The look as one vector.
+
+        Returns
+        -------
+        (6,) float64 array
+            ``closure`` then ``iris`` row by row, in the order of :data:`NAMES`.
+        """
         return np.concatenate([self.closure, self.iris.ravel()])
 
     @classmethod
     def from_vector(cls, v: np.ndarray) -> Look:
-        """The look of a (6,) :meth:`vector`."""
+        """The look of a :meth:`vector`.
+
+        Parameters
+        ----------
+        v
+            (6,) float array in the order of :data:`NAMES`.
+
+        Returns
+        -------
+        Look
+            Its first two values the closures, the last four the iris shifts.
+        """
         v = np.asarray(v, np.float64)
         return cls(v[0:2], v[2:6].reshape(2, 2))
 
     def as_dict(self) -> dict[str, float]:
-        """name -> value, rounded for a JSON file."""
+        """The look as named values for a JSON file.
+
+        Returns
+        -------
+        dict of str -> float
+            :data:`NAMES` -> value, rounded to 4 decimals.
+        """
         return {n: round(float(x), 4) for n, x in zip(NAMES, self.vector())}
 
     @classmethod
     def from_dict(cls, d: dict) -> Look:
-        """The look of :meth:`as_dict`'s mapping; a missing name is 0."""
+        """The look of :meth:`as_dict`'s mapping.
+
+        Parameters
+        ----------
+        d
+            Name (of :data:`NAMES`) -> number; a missing name is 0, other keys are ignored.
+
+        Returns
+        -------
+        Look
+            The values in the module docstring's units.
+        """
         return cls.from_vector(np.array([float(d.get(n, 0.0)) for n in NAMES]))

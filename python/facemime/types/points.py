@@ -60,7 +60,20 @@ ReferencePoints = dict[str, np.ndarray]
 
 
 def model_chain(model: HeadModel, name: str) -> np.ndarray:
-    """The model vertex indices that reference point or curve ``name`` marks: (K,) int64."""
+    """The model vertex indices a reference point or curve marks.
+
+    Parameters
+    ----------
+    model
+        The head; it needs the groups the name maps to.
+    name
+        A reference point or curve name (:data:`NAMES`).
+
+    Returns
+    -------
+    (K,) int64 array
+        One index for a single point, the group's ordered indices for a curve.
+    """
     if name in POINTS:
         group, at = POINTS[name]
         return model.groups[group][[at]]
@@ -70,9 +83,26 @@ def model_chain(model: HeadModel, name: str) -> np.ndarray:
 
 
 def check_points(points: object, width: int, height: int, where: str = "points") -> ReferencePoints:
-    """Validate a reference-point set for a ``width`` x ``height`` image: known names, the
-    required ones present, single points as (2,) or (1, 2), curves as (K >= 2, 2), all inside
-    the image. Returns name -> (K, 2) float64 arrays."""
+    """Validate a reference-point set for an image: known names, the required ones present,
+    single points as (2,) or (1, 2), curves as (K >= 2, 2), all inside the image, the outer eye
+    corners at least :data:`MIN_EYE_DISTANCE` pixels apart.
+
+    Parameters
+    ----------
+    points
+        Name -> [x, y] pixels or a list of them (e.g. a parsed JSON object).
+    width
+        The image's width, pixels.
+    height
+        The image's height, pixels.
+    where
+        Names the points in error messages.
+
+    Returns
+    -------
+    dict of str -> (K, 2) float64 array
+        Name -> (x, y) pixels, K = 1 for a single point.
+    """
     if not isinstance(points, Mapping):
         raise InvalidInputError(f"{where} must map point names to [x, y] positions, got {type(points).__name__}")
     unknown = [n for n in points if n not in NAMES]
