@@ -18,6 +18,7 @@ import numpy as np
 
 from facemime import _core
 from facemime.track.motion import HeadMotion
+from facemime.track.scale import ScaledMotion
 from facemime.types.pose import Pose, project
 
 #: Fewest lifted points that fit a pose.
@@ -35,11 +36,29 @@ GN_ITERATIONS = 6
 
 
 def lift(points: np.ndarray, vertices: np.ndarray, triangles: np.ndarray, pose: Pose) -> tuple[np.ndarray, np.ndarray]:
-    """3D model positions of image ``points`` (M, 2) px: where the ray through each point meets
-    the front-most facing triangle of the mesh (``vertices`` (N, 3) in ``pose``), or, for a
-    point beside the mesh (the forehead above it), the plane of the facing triangle nearest to
-    it on the image. Returns the (M, 3) positions and an (M,) mask, False where no triangle faces
-    the camera."""
+    """3D model positions of image points: where the ray through each point meets the front-most
+    facing triangle of the mesh in ``pose``, or, for a point beside the mesh (the forehead above
+    it), the plane of the facing triangle nearest to it on the image.
+
+    Parameters
+    ----------
+    points
+        (M, 2) float array: (x, y) image pixels.
+    vertices
+        (N, 3) float array: the mesh's vertices, model units.
+    triangles
+        (F, 3) int array: the mesh's triangles, vertex indices; those counter-clockwise on the
+        image face the camera.
+    pose
+        The pose the mesh is seen in.
+
+    Returns
+    -------
+    positions : (M, 3) float64 array
+        Model coordinates, model units (all NaN when no triangle of the mesh faces the camera).
+    ok : (M,) bool array
+        Whether the points were placed: all True, or all False when no triangle faces the camera.
+    """
     pts = np.asarray(points, np.float64).reshape(-1, 2)
     img, depth = project(vertices, pose)
     a, b, c = (img[triangles[:, k]] for k in range(3))
@@ -82,10 +101,27 @@ def _pose(p: np.ndarray) -> Pose:
 def fit_pose(
     model_points: np.ndarray, image_points: np.ndarray, start: Pose, towards: tuple[float, float] = (0.0, 0.0)
 ) -> Pose:
-    """The pose that maps (M, 3) ``model_points`` onto (M, 2) ``image_points`` (px): Gauss-Newton
-    with Huber weights (:data:`HUBER`) from ``start`` (``facemime._core.fit_pose``, analytic
-    Jacobian); yaw and pitch are held towards ``start``'s (weight :data:`ANGLE_PRIOR`) and
-    ``towards`` (weight :data:`RELAX`), degrees."""
+    """The pose that maps model points onto image points: Gauss-Newton with Huber weights
+    (:data:`HUBER`) from ``start`` (``facemime._core.fit_pose``, analytic Jacobian); yaw and pitch
+    are held towards ``start``'s (weight :data:`ANGLE_PRIOR`) and ``towards`` (weight
+    :data:`RELAX`).
+
+    Parameters
+    ----------
+    model_points
+        (M, 3) float array: model coordinates, model units.
+    image_points
+        (M, 2) float array: where they are seen, (x, y) image pixels.
+    start
+        The pose the fit starts from (the previous frame's).
+    towards
+        (yaw, pitch), degrees, that yaw and pitch are also pulled towards (the first frame's).
+
+    Returns
+    -------
+    Pose
+        The fitted pose, yaw and pitch clipped to [-75, 75] degrees.
+    """
     x = np.ascontiguousarray(model_points, np.float64)
     target = np.ascontiguousarray(image_points, np.float64)
     p = _params(start)
@@ -96,9 +132,22 @@ def fit_pose(
 
 
 def moved(pose: Pose, step: np.ndarray) -> Pose:
-    """``pose`` followed by the image's 2×3 similarity ``step`` (pixels to pixels): the step's
-    turn added to the roll (counter-clockwise on the image, y down), its scale to the scale and
-    the model origin's image position moved by it; yaw and pitch stay."""
+    """A pose followed by an image similarity.
+
+    Parameters
+    ----------
+    pose
+        The pose before the step.
+    step
+        (2, 3) float array: the image's similarity, pixels to pixels.
+
+    Returns
+    -------
+    Pose
+        ``pose`` with the step's turn added to the roll (counter-clockwise on the image, y down),
+        its scale multiplying the scale and the model origin's image position moved by it; yaw
+        and pitch stay.
+    """
     m = np.asarray(step, np.float64)
     turn = np.degrees(np.arctan2(m[1, 0] - m[0, 1], m[0, 0] + m[1, 1]))
     origin = m[:, :2] @ (pose.tx, pose.ty) + m[:, 2]
@@ -117,16 +166,17 @@ class PoseTracker:
 
     Parameters
     ----------
-    vertices : (N, 3) float array
-        The actor's model vertices (model units).
-    triangles : (F, 3) int array
-    pose : Pose
+    vertices
+        (N, 3) float array: the actor's model vertices, model units.
+    triangles
+        (F, 3) int array: the model's triangles, vertex indices.
+    pose
         The pose on the first frame (the fitted actor's).
-    motion : HeadMotion
-        The head-motion follower, on the first frame.
+    motion
+        The head-motion follower, on the first frame: its points are lifted at ``pose``.
     """
 
-    def __init__(self, vertices: np.ndarray, triangles: np.ndarray, pose: Pose, motion: HeadMotion):
+    def __init__(self, vertices: np.ndarray, triangles: np.ndarray, pose: Pose, motion: HeadMotion | ScaledMotion):
         self._vertices = np.asarray(vertices, np.float64)
         self._triangles = np.asarray(triangles, np.int64)
         self._frontal = pose
@@ -142,12 +192,23 @@ class PoseTracker:
                 if good:
                     self._known[i] = p
 
-    def update(self, motion: HeadMotion) -> bool:
-        """Fit the pose to the points ``motion`` followed into the current frame; returns whether
-        it could be measured (at least :data:`MIN_POINTS` known points). An unmeasured frame
-        moves the last pose by the head's step in the image (``motion.step``; the step's
-        fallback, when the flow lost the points in a fast motion, drops them all). Yaw and pitch
-        relax towards the first frame's by :data:`RELAX` per frame."""
+    def update(self, motion: HeadMotion | ScaledMotion) -> bool:
+        """Fit the pose to the points the head motion followed into the current frame.
+
+        An unmeasured frame moves the last pose by the head's step in the image (``motion.step``;
+        the step's fallback, when the flow lost the points in a fast motion, drops them all). Yaw
+        and pitch relax towards the first frame's by :data:`RELAX` per frame.
+
+        Parameters
+        ----------
+        motion
+            The head-motion follower, updated to the current frame.
+
+        Returns
+        -------
+        bool
+            Whether the pose was measured (at least :data:`MIN_POINTS` known points followed).
+        """
         points, ids = motion.followed
         known = np.array([i in self._known for i in ids.tolist()], bool)
         ok = int(known.sum()) >= MIN_POINTS
@@ -161,20 +222,36 @@ class PoseTracker:
         self._keep(motion)
         return ok
 
-    def follow(self, pose: Pose, motion: HeadMotion) -> None:
-        """Take ``pose``, measured otherwise (the landmarks), as the current frame's; the points
-        ``motion`` follows are kept and new ones lifted at it, for the frames the flow measures."""
+    def follow(self, pose: Pose, motion: HeadMotion | ScaledMotion) -> None:
+        """Take a pose measured otherwise (on the landmarks) as the current frame's.
+
+        Parameters
+        ----------
+        pose
+            The current frame's pose.
+        motion
+            The head-motion follower, updated to the current frame: the points it follows are
+            kept and new ones lifted at ``pose``, for the frames the flow measures.
+        """
         self.pose = pose
         self._keep(motion)
 
-    def _keep(self, motion: HeadMotion) -> None:
+    def _keep(self, motion: HeadMotion | ScaledMotion) -> None:
         """Forget the points ``motion`` no longer follows; lift its new ones at the current pose."""
         current = set(motion.ids.tolist())
         self._known = {i: p for i, p in self._known.items() if i in current}
         self._lift(np.asarray(motion.points, np.float64), motion.ids)
 
-    def reset(self, pose: Pose, motion: HeadMotion) -> None:
-        """Start again from ``pose`` on a new first frame (after the face was lost)."""
+    def reset(self, pose: Pose, motion: HeadMotion | ScaledMotion) -> None:
+        """Start again on a new first frame (after the face was lost).
+
+        Parameters
+        ----------
+        pose
+            The pose on the new first frame.
+        motion
+            The head-motion follower, on that frame: its points are lifted at ``pose``.
+        """
         self._frontal = self.pose = pose
         self._known.clear()
         self._lift(motion.points, motion.ids)
