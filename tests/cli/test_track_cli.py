@@ -159,3 +159,35 @@ def test_without_init_tracking_starts_on_the_first_frame_with_a_face(tmp_path, c
     ]
     # Measured: mean 0.013, max 0.019 (thresholds at about 1.5x).
     assert np.mean(errors) < 0.02 and max(errors) < 0.028
+
+
+def test_track_writes_the_head_pose_that_run_measures(tmp_path, capsys, shared):
+    """The track carries each frame's head pose, the same one `run` follows: on the first 60
+    frames of lp_d3 the head turns about 15 degrees one way and 5 the other; --no-pose leaves it
+    out."""
+    clip = first_frames(shared / "video" / "lp_d3.mp4", 60, tmp_path / "clip.mp4")
+    code, _, err = run(capsys, "track", str(clip), "--out", str(tmp_path / "t.json"))
+    assert code == 0, err
+    tracked = json.loads((tmp_path / "t.json").read_text())["frames"]
+    assert len(tracked) == 60 and all("pose" in f for f in tracked)
+    code, _, err = run(capsys, "run", str(clip), "--out", str(tmp_path / "r.mp4"))
+    assert code == 0, err
+    ran = json.loads((tmp_path / "r.json").read_text())["frames"]
+    names = ("yaw", "pitch", "roll", "scale", "tx", "ty")
+    mine = np.array([[f["pose"][k] for k in names] for f in tracked])
+    theirs = np.array([[f["pose"][k] for k in names] for f in ran])
+    assert np.abs(mine - theirs).max() < 1e-3
+    assert mine[:, 0].min() < -10 and mine[:, 0].max() > 3  # the turn is measured, not held frontal
+    code, _, err = run(capsys, "track", str(clip), "--no-pose", "--out", str(tmp_path / "n.json"))
+    assert code == 0, err
+    plain = json.loads((tmp_path / "n.json").read_text())["frames"]
+    assert not any("pose" in f for f in plain)
+    assert [f["contours"] for f in plain] == [f["contours"] for f in tracked]  # the pose changes no contour
+
+
+def test_a_start_frame_without_a_face_the_landmarks_find_tracks_without_pose(tmp_path, capsys, synthetic_video):
+    video, init = synthetic_video
+    code, _, err = run(capsys, "track", str(video), "--init", str(init), "--out", str(tmp_path / "t.json"))
+    assert code == 0, err
+    assert "warning: no face the landmark model finds on frame 0" in err and "no head pose" in err
+    assert not any("pose" in f for f in json.loads((tmp_path / "t.json").read_text())["frames"])

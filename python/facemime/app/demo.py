@@ -26,7 +26,6 @@ import numpy as np
 
 from facemime.animate.analysis import analysed
 from facemime.animate.synth import Puppet, key_frame, scene_mesh, synthesize
-from facemime.app.run import pose_dict
 from facemime.fit.actor import fit_actor, generic_actor
 from facemime.fit.preview import preview_sheet
 from facemime.io import VideoWriter, write_image
@@ -69,9 +68,23 @@ class DemoResult:
 
 
 def performance(t: float) -> tuple[dict[str, float], dict[str, float]]:
-    """Scripted motion at time ``t`` seconds: (expression weights, pose angles in degrees).
-    She talks throughout, opens the mouth wide around 2.5 s, raises the brows twice and frowns
-    once, smiles, and turns and tilts the head."""
+    """Scripted motion: she talks throughout, opens the mouth wide around 2.5 s, raises the brows
+    twice and frowns once, smiles, and turns and tilts the head.
+
+    Parameters
+    ----------
+    t
+        Time from the performance's start, seconds.
+
+    Returns
+    -------
+    units : dict of str to float
+        Expression weights: the head model's deformation unit name (``jawOpen``, ...) to its
+        weight (0 to 0.4), for :meth:`~facemime.types.head.HeadModel.deform`.
+    angles : dict of str to float
+        ``yaw``, ``pitch``, ``roll``: degrees added to the actor's rest pose (within ±16, ±5
+        and ±6).
+    """
     talk = max(0.0, np.sin(2 * np.pi * 2.1 * t)) * (0.35 + 0.25 * np.sin(2 * np.pi * 0.37 * t) ** 2)
     wide = np.exp(-(((t - 2.6) / 0.35) ** 2))
     # expression weights (facemime.animate.expressions): the lower lip down up to 12 mm, the
@@ -114,8 +127,25 @@ def _still_sheet(rows: list[np.ndarray]) -> np.ndarray:
 
 
 def run_demo(out_dir: Path, force: bool = False, seconds: float = 6.0) -> DemoResult:
-    """Write the demo files into ``out_dir``, all or none; refuses to overwrite them unless
-    ``force``. A failed or interrupted demo leaves no folder it created."""
+    """Write the demo files, all or none. A failed or interrupted demo leaves no folder it
+    created.
+
+    Parameters
+    ----------
+    out_dir
+        The folder to write into (created if missing): ``astronaut.actor``, ``astronaut.png`` (the
+        fit preview), ``performance.mp4``, ``resynthesis.mp4``, ``track.json``, ``stills.png`` and
+        ``report.html`` (:data:`FILES`).
+    force
+        Overwrite those files where they exist (refused otherwise).
+    seconds
+        Length of the scripted performance, seconds (at :data:`FPS`, 25 frames/s).
+
+    Returns
+    -------
+    DemoResult
+        The files written, frames per video, the tracking and pose errors, and seconds per stage.
+    """
     files = [out_dir / n for n in FILES]
     created = not out_dir.exists()
     try:
@@ -128,8 +158,13 @@ def run_demo(out_dir: Path, force: bool = False, seconds: float = 6.0) -> DemoRe
 
 
 def astronaut_photo() -> np.ndarray:
-    """The demo's photo: the astronaut the package ships, framed by :data:`FRAMING` and scaled to
-    :data:`SIZE`, (H, W, 3) uint8 RGB."""
+    """The demo's photo: the astronaut the package ships, framed by :data:`FRAMING`.
+
+    Returns
+    -------
+    (512, 512, 3) uint8 array
+        RGB, the framed part scaled to :data:`SIZE` (bicubic).
+    """
     photo = cv2.cvtColor(
         cv2.imdecode(
             np.frombuffer(resources.files("facemime.data").joinpath("astronaut.jpg").read_bytes(), np.uint8),
@@ -231,7 +266,7 @@ def _demo(files: list[Path], paths: list[Path], seconds: float) -> DemoResult:
                     "lost": m.lost,
                     "redetected": m.redetected,
                     "face": m.face,
-                    "pose": pose_dict(m.pose),
+                    "pose": m.pose.as_dict(),
                     "offsets": m.offsets,
                     "look": m.look.as_dict(),
                 }

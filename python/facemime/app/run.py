@@ -32,12 +32,12 @@ from facemime.io.outputs import Outputs, write_text
 from facemime.io.video import CODECS, VideoReader, VideoWriter
 from facemime.progress import track as progress
 from facemime.render.raster import fill
-from facemime.shared_constants import BACKGROUND, NO_FACE_DIM, POSE_FIELDS
+from facemime.shared_constants import BACKGROUND, NO_FACE_DIM
 from facemime.track.overlay import draw_contours
 from facemime.track.params import TrackerParams
 from facemime.types.actor import Actor
 from facemime.types.head import model_iod
-from facemime.types.pose import Pose, project
+from facemime.types.pose import project
 
 
 @dataclass
@@ -70,27 +70,42 @@ class RunResult:
         return {k: self.seconds[k] / self._busy for k in ("decode", "track", "pose", "look", "synth", "compose")}
 
 
-def pose_dict(pose: Pose) -> dict[str, float]:
-    """The track file's ``pose`` entry."""
-    return {k: getattr(pose, k) for k in POSE_FIELDS}
-
-
 class SideBySide:
     """The per-frame work of ``run`` without the video encoding: each frame analysed,
     re-synthesised on the driven actor and composed side by side (the original with the tracked
-    contours | the synthesised face). Iterating yields each frame's (H, 2W, 3) uint8 canvas, one
-    buffer overwritten frame after frame.
+    contours | the synthesised face; a frame without a face shows the synthesis dimmed).
+    Iterating yields each frame's (H, 2W, 3) uint8 RGB canvas, one buffer overwritten frame after
+    frame.
 
-    ``frames``: RGB uint8 (H, W, 3) frames of one size; ``name`` names the video in messages;
-    ``target``: the actor to drive (default: the actor fitted on the first frame). While it
-    runs, the track file's per-frame entries are appended to ``records`` (a list, or a
-    :class:`facemime.io.contours_json.TrackWriter` that writes them out as they come), ``frames``
-    counts them, ``departs`` holds the ranges of frames that depart from their synthesis (only
-    measured when the video's own face is synthesised in its own scene), and ``seconds`` the
-    time per stage (``decode``: waiting for the next frame; ``track``, ``pose``, ``fit``;
-    ``synth``, the departure measure included; ``compose``). ``analysis`` is None until the
-    first frame. ``mask_only``: show the face alone on a plain backdrop, not in its scene.
-    ``fps``: the video's frame rate (frames a second), for the pose filter."""
+    While it runs, the track file's per-frame entries are appended to :attr:`records`,
+    :attr:`frames` counts them, :attr:`weights` holds each frame's (E,) expression weights,
+    :attr:`departs` the [first, last] ranges of frames that depart from their synthesis (only
+    measured when the video's own face is synthesised in its own scene), and :attr:`seconds` the
+    time per stage (``decode``: waiting for the next frame; ``track``, ``pose``, ``look``,
+    ``fit``, filled in at the end; ``synth``, the departure measure included; ``compose``).
+    :attr:`analysis` is None until the first frame.
+
+    Parameters
+    ----------
+    frames
+        (H, W, 3) uint8 RGB frames, all of one size.
+    name
+        Names the video in messages.
+    target
+        The actor to drive; None: the actor fitted on the first frame.
+    user
+        Motion added on top of the measured one (extra degrees of yaw, pitch, roll; zoom;
+        exaggeration); default none.
+    params
+        Tracker settings; None: the defaults.
+    records
+        Where the per-frame entries go: a list, or a :class:`facemime.io.contours_json.TrackWriter`
+        that writes them out as they come; None: a new list.
+    mask_only
+        Show the face alone on a plain backdrop, not in its actor's scene.
+    fps
+        The video's frame rate, frames/s, for the pose filter.
+    """
 
     def __init__(
         self,
@@ -155,7 +170,7 @@ class SideBySide:
                 "lost": motion.lost,
                 "redetected": motion.redetected,
                 "face": motion.face,
-                "pose": pose_dict(motion.pose),
+                "pose": motion.pose.as_dict(),
                 "offsets": motion.offsets,
                 "look": motion.look.as_dict(),
             }
@@ -186,8 +201,22 @@ class SideBySide:
             seconds.update(track=t.track, pose=t.pose, fit=t.fit, look=t.look)
 
     def result(self, files: list[Path], encode_seconds: float = 0.0) -> RunResult:
-        """What the run did, once iterated to the end (``encode_seconds``: the time the caller
-        spent encoding)."""
+        """What the run did, once iterated to the end; raises
+        :class:`~facemime.errors.InputFileError` when there were no frames.
+
+        Parameters
+        ----------
+        files
+            The files the run wrote, for the result.
+        encode_seconds
+            The time the caller spent encoding the canvases, seconds (``seconds["encode"]``).
+
+        Returns
+        -------
+        RunResult
+            Frames, frames without a face, ``files``, the analysis's warnings, seconds per stage
+            and the departing ranges.
+        """
         if self.analysis is None:
             raise InputFileError(f"video {self._name} has no frames")
         return RunResult(
@@ -201,9 +230,22 @@ class SideBySide:
 
 
 def weights_csv(weights: list[np.ndarray], fps: float) -> str:
-    """The expression ``weights`` (per frame (E,)) as CSV text: a header ``frame,time_s,<names>``
-    (:data:`facemime.animate.expressions.NAMES`), then a row per frame (time in seconds at
-    ``fps``; weights with 4 decimals)."""
+    """Expression weights as CSV text.
+
+    Parameters
+    ----------
+    weights
+        Per frame, an (E,) float array of the weights (0-1) in the order of
+        :data:`facemime.animate.expressions.NAMES`.
+    fps
+        The video's frame rate, frames/s (0 or less: every time is 0).
+
+    Returns
+    -------
+    str
+        A header ``frame,time_s,<names>``, then a row per frame: its 0-based index, its time in
+        seconds (``index / fps``) and the weights, 4 decimals each; newline-terminated lines.
+    """
     from facemime.animate.expressions import NAMES
 
     lines = [",".join(("frame", "time_s") + NAMES)]
@@ -213,7 +255,19 @@ def weights_csv(weights: list[np.ndarray], fps: float) -> str:
 
 
 def video_output(out: str | Path) -> Path:
-    """``out`` as a path, refused unless it names a video run writes (.mp4 or .webm)."""
+    """Check the name of a video ``run`` writes.
+
+    Parameters
+    ----------
+    out
+        The output video; refused (:class:`~facemime.errors.InvalidInputError`) unless it ends in
+        ``.mp4`` or ``.webm`` (any case).
+
+    Returns
+    -------
+    Path
+        ``out`` as a path.
+    """
     out = Path(out)
     if out.suffix.lower() not in CODECS:
         raise InvalidInputError(f"the output video must end in .mp4 or .webm, got {out.name!r}")
@@ -221,7 +275,20 @@ def video_output(out: str | Path) -> Path:
 
 
 def write_frames(writer: VideoWriter, frames: Iterable[np.ndarray]) -> float:
-    """Hands each of ``frames`` to ``writer``; returns the seconds that took (the encoding)."""
+    """Hand each frame to a video writer.
+
+    Parameters
+    ----------
+    writer
+        The open video writer.
+    frames
+        (H, W, 3) uint8 RGB images of the writer's size; made lazily, their making not timed.
+
+    Returns
+    -------
+    float
+        The seconds spent in ``writer.write`` (the encoding).
+    """
     encode = 0.0
     for image in frames:
         t0 = time.perf_counter()
@@ -241,12 +308,42 @@ def run_video(
     mask_only: bool = False,
     weights: str | Path | None = None,
 ) -> RunResult:
-    """Analyse ``video`` and write ``out`` (.mp4 or .webm, side by side) and ``track`` (default:
-    ``out`` with the suffix ``.json``), and with ``weights`` the expression weights as a .csv
-    file (:func:`weights_csv`). ``actor``: an ``.actor`` file or an :class:`Actor` to
-    drive (default: the actor fitted on the first frame), shown in its own scene unless
-    ``mask_only`` (or it has none). All outputs or none are written; existing ones are
-    refused unless ``force``, an input always."""
+    """Analyse a video, re-synthesise it on an actor and write the side-by-side video and the
+    track file (see the module docstring). All outputs or none are written; existing ones are
+    refused unless ``force``, an input always.
+
+    Parameters
+    ----------
+    video
+        The face video to analyse (any FFmpeg reads).
+    out
+        The side-by-side video to write, ``.mp4`` (H.264) or ``.webm`` (VP9), at the video's frame
+        rate: the original with the tracked contours | the synthesised picture, twice its width.
+    actor
+        The actor to drive: an ``.actor`` file or an :class:`Actor`; None: the actor fitted on the
+        first frame. Shown in its own scene unless ``mask_only`` (or it has none).
+    track
+        The ``facemime.track/1`` file to write (must end in ``.json``); None: ``out`` with the
+        suffix ``.json``.
+    user
+        Motion added on top of the measured one (extra degrees of yaw, pitch, roll; zoom;
+        exaggeration); default none.
+    force
+        Write over existing outputs.
+    params
+        Tracker settings; None: the defaults.
+    mask_only
+        Show the face alone on a plain backdrop, not in its actor's scene.
+    weights
+        A ``.csv`` file to write the expression weights to as well (:func:`weights_csv`); None:
+        none.
+
+    Returns
+    -------
+    RunResult
+        Frames, frames without a face, the files written, warnings, the departing ranges and
+        seconds per stage.
+    """
     out = video_output(out)
     track = out.with_suffix(".json") if track is None else Path(track)
     if track.suffix.lower() != ".json":
@@ -298,12 +395,35 @@ def run_track(
     force: bool = False,
     mask_only: bool = False,
 ) -> RunResult:
-    """Play the motion of the ``facemime.track/1`` file ``track`` (from :func:`run_video`, or
-    expression weights written by hand; :mod:`facemime.animate.replay`) on ``actor`` (an
-    ``.actor`` file or an :class:`Actor`; default: the generic painted head) and write the
-    synthesised picture alone to ``out`` (.mp4 or .webm) at the track's size and frame rate: in
-    the actor's scene unless ``mask_only`` (or it has none), frames without a face dimmed, with
-    ``user`` motion added. Seconds: ``decode`` reading the track, ``synth``, ``encode``."""
+    """Play the motion of a track file on an actor and write the synthesised picture alone, at
+    the track's size and frame rate, frames without a face dimmed (:mod:`facemime.animate.replay`).
+    The output is written complete or not at all.
+
+    Parameters
+    ----------
+    track
+        A ``facemime.track/1`` file (from :func:`run_video`, or expression weights written by
+        hand).
+    out
+        The video to write, ``.mp4`` (H.264) or ``.webm`` (VP9). Refused when it exists (unless
+        ``force``) or is one of the inputs.
+    actor
+        The actor to play it: an ``.actor`` file or an :class:`Actor`; None: the generic painted
+        head. Shown in its own scene unless ``mask_only`` (or it has none).
+    user
+        Motion added on top of the track's (extra degrees of yaw, pitch, roll; zoom;
+        exaggeration); default none.
+    force
+        Write over an existing ``out``.
+    mask_only
+        Show the face alone on a plain backdrop, not in its actor's scene.
+
+    Returns
+    -------
+    RunResult
+        Frames, frames without a face, ``[out]``, no warnings and seconds per stage: ``decode``
+        reading the track, ``synth``, ``encode`` (the others 0).
+    """
     from facemime.animate.replay import load_replay
 
     out = video_output(out)

@@ -10,6 +10,9 @@ from contextlib import nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
+from facemime.animate.head_pose import PoseFollower
 from facemime.errors import InputFileError, InvalidInputError, NoFaceError
 from facemime.io.contours_json import read_init, track_document, write_json
 from facemime.io.outputs import Outputs
@@ -45,13 +48,45 @@ def track_video(
     force: bool = False,
     params: TrackerParams | None = None,
     redetection: Redetection | None = None,
+    pose: bool = True,
 ) -> TrackRun:
-    """Track ``video`` from the contours in ``init`` (``facemime.init/1``) and write ``out``
-    (``facemime.track/1``) and, if given, the ``overlay`` video. Existing outputs are refused
-    unless ``force``. Without ``init`` the largest face's landmarks on the first frame that shows
-    a face start the tracker (the frames before it are not tracked, as those before an init
-    frame); the landmark model puts the contours right where they went astray
-    (:class:`facemime.track.redetect.FaceTracker`)."""
+    """Track a video and write the track file and, if asked, an overlay video, both or neither.
+    The landmark model puts the contours right where they went astray
+    (:class:`facemime.track.redetect.FaceTracker`).
+
+    Parameters
+    ----------
+    video
+        The video to track (any FFmpeg reads).
+    init
+        A ``facemime.init/1`` file: the eight contours on its frame (0 unless it names one), where
+        tracking starts. None: the largest face's landmarks on the first frame that shows a face
+        start the tracker. The frames before the start are not tracked.
+    out
+        The ``facemime.track/1`` file to write (must end in ``.json``): per tracked frame its
+        0-based index, contours ((x, y) pixels), confidence per feature, lost features and
+        whether the landmark model put it right.
+    overlay
+        A video to write as well, ``.mp4`` (H.264) or ``.webm`` (VP9): every frame of ``video``,
+        the tracked ones with the contours drawn; None: none.
+    force
+        Write over existing outputs (an input is refused all the same).
+    params
+        Tracker settings; None: the defaults.
+    redetection
+        When the landmark model checks the tracker; None: the defaults.
+    pose
+        Also measure the head pose of every frame with the face (the generic head fitted on the
+        start frame, followed as ``run`` follows it: :class:`facemime.animate.head_pose.PoseFollower`;
+        one landmark pass a frame). Where the start frame shows no face the landmark model finds
+        (an init on a face it cannot see), the track has no pose, with a warning.
+
+    Returns
+    -------
+    TrackRun
+        Frames tracked, seconds starting and tracking, frames with a lost feature, the frames put
+        right by the landmark model and warnings.
+    """
     out = Path(out)
     if out.suffix.lower() != ".json":
         raise InvalidInputError(f"the track file must end in .json, got {out.name!r}")
@@ -63,6 +98,9 @@ def track_video(
         writer = VideoWriter(outputs.stage(overlay), reader.fps) if overlay is not None else None
         frames: list[dict] = []
         tracker: FaceTracker | None = None
+        follower: PoseFollower | None = None
+        pose_warning: str | None = None
+        face_before = True
         start_seconds, seconds, lost_frames, decoded = 0.0, 0.0, 0, 0
         with writer if writer is not None else nullcontext():
             for index, frame in enumerate(progress(reader, reader.frames or None, "tracking")):
@@ -81,20 +119,28 @@ def track_video(
                         continue
                     start = index
                     result = FrameResult(index, tracker.contours, dict.fromkeys(FEATURES, 1.0))
+                    if pose:
+                        follower, pose_warning = _follow_pose(frame, index, video, tracker, reader.fps)
+                    face = True
                     start_seconds = time.perf_counter() - t0
                 else:
                     result = tracker.update(frame)
+                    face = result.motion_ok and len(result.lost) < len(FEATURES)
+                    if follower is not None:
+                        follower.update(frame, face_before, face)
                     seconds += time.perf_counter() - t0
                 lost_frames += bool(result.lost)
-                frames.append(
-                    {
-                        "index": index,
-                        "contours": result.contours,
-                        "confidence": result.confidence,
-                        "lost": result.lost,
-                        "redetected": result.redetected,
-                    }
-                )
+                entry = {
+                    "index": index,
+                    "contours": result.contours,
+                    "confidence": result.confidence,
+                    "lost": result.lost,
+                    "redetected": result.redetected,
+                }
+                if follower is not None and face:
+                    entry["pose"] = follower.pose.as_dict()
+                frames.append(entry)
+                face_before = face
                 if writer is not None:
                     writer.write(draw_contours(frame, result.contours, result.lost))
             if decoded == 0:
@@ -118,6 +164,21 @@ def track_video(
         warnings.append(f"{tracker.faces} faces found in {first} of {video}; tracking the largest")
     if init is None and start > 0:
         warnings.append(f"no face in frames 0-{start - 1} of {video}; tracking from frame {start}")
+    if pose_warning is not None:
+        warnings.append(pose_warning)
     return TrackRun(
         len(frames), start_seconds, seconds, lost_frames, [f["index"] for f in frames if f["redetected"]], warnings
     )
+
+
+def _follow_pose(
+    frame: np.ndarray, index: int, video: str | Path, tracker: FaceTracker, fps: float
+) -> tuple[PoseFollower | None, str | None]:
+    """The head pose's follower from the start frame, or None and the warning that says why not
+    (no face the landmark model finds there)."""
+    if tracker.motion is None:
+        return None, "the tracker's settings turn its head motion off: the track has no head pose"
+    try:
+        return PoseFollower.on_face(frame, f"frame {index} of {video}", tracker, fps), None
+    except NoFaceError:
+        return None, f"no face the landmark model finds on frame {index} of {video}: the track has no head pose"

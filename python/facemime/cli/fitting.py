@@ -75,12 +75,18 @@ def fit(source: Path, frame: int, points_file: Path | None, out_file: Path, forc
 @click.option(
     "--overlay", type=click.Path(path_type=Path), help="Also write the video with the contours drawn (.mp4 or .webm)."
 )
+@click.option(
+    "--pose/--no-pose",
+    default=True,
+    show_default=True,
+    help="Also write the head pose of every frame with the face (one landmark pass a frame).",
+)
 @force_option
-def track(video: Path, init: Path | None, out_file: Path, overlay: Path | None, force: bool) -> None:
+def track(video: Path, init: Path | None, out_file: Path, overlay: Path | None, pose: bool, force: bool) -> None:
     """Track the mouth and eyebrow contours through VIDEO with STB-snakes."""
     from facemime.app.track import track_video
 
-    run = track_video(video, init, out_file, overlay, force)
+    run = track_video(video, init, out_file, overlay, force, pose=pose)
     for w in run.warnings:
         click.echo(f"facemime: warning: {w}", err=True)
     click.echo(str(out_file))
