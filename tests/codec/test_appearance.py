@@ -105,6 +105,7 @@ def test_a_face_whose_cheek_reddens_is_sent_again_through_the_stream(tmp_path):
 
     from facemime.animate.synth import key_frame, scene_mesh, synthesize
     from facemime.app.coding import decode_stream, encode_video
+    from facemime.codec.stream import MotionDecoder
     from facemime.fit.actor import fit_actor
     from facemime.io.actor_file import save_actor
     from facemime.io.video import VideoReader, VideoWriter
@@ -132,16 +133,30 @@ def test_a_face_whose_cheek_reddens_is_sent_again_through_the_stream(tmp_path):
         writer.write(synthesize(actor, actor.model.vertices, actor.pose, (256, 256), scene=scene, key=key))
         for _ in range(39):
             writer.write(synthesize(tinted, actor.model.vertices, actor.pose, (256, 256), scene=scene, key=key))
-    cx, cy = np.round(project(actor.model.vertices[[cheek]], actor.pose)[0][0]).astype(int)
+    still = np.round(project(actor.model.vertices[[cheek]], actor.pose)[0][0]).astype(int)
 
-    def redness(video):
+    def drawn_cheek(stream):
+        """Where the receiver draws the cheek on frames 1 and -1: the motion measured on the
+        video moves it a little (the actor's own mouth, closed in its mesh, is tracked there)."""
+        decoder = MotionDecoder(actor=actor)
+        frames = decoder.push(stream.read_bytes()) + decoder.finish()
+        model = decoder.actor.model
+        puppet = Puppet(decoder.actor, Deformer(model).feature_sizes(), model_iod(model), decoder.reference())
+        spots = []
+        for f in (frames[1], frames[-1]):
+            puppet.render(f.pose, f.offsets, decoder.info.size)
+            vertices, pose = puppet.shown
+            spots.append(np.round(project(vertices[[cheek]], pose)[0][0]).astype(int))
+        return spots
+
+    def redness(video, spots):
         frames = list(VideoReader(video))
         return [
             float((f[cy - 3 : cy + 4, cx - 3 : cx + 4].astype(float) @ [1.0, -0.5, -0.5]).mean())
-            for f in (frames[1], frames[-1])
+            for f, (cx, cy) in zip((frames[1], frames[-1]), spots)
         ]
 
-    source = redness(tmp_path / "v.mp4")
+    source = redness(tmp_path / "v.mp4", [still, still])
     for budget, name in ((16.0, "with"), (0.0, "without")):
         result = encode_video(
             tmp_path / "v.mp4", tmp_path / f"{name}.fmstream", tmp_path / "a.actor", appearance=budget
@@ -150,7 +165,11 @@ def test_a_face_whose_cheek_reddens_is_sent_again_through_the_stream(tmp_path):
         assert result.appearance_kbit_s <= budget + 1e-9
         decoded = decode_stream(tmp_path / f"{name}.fmstream", tmp_path / f"{name}.mp4", tmp_path / "a.actor")
         assert decoded.appearance_updates == result.appearance_updates and decoded.appearance_refused == 0
-    with_, without = redness(tmp_path / "with.mp4"), redness(tmp_path / "without.mp4")
+    spots = drawn_cheek(tmp_path / "without.fmstream")
+    with_, without = redness(tmp_path / "with.mp4", spots), redness(tmp_path / "without.mp4", spots)
     assert source[1] > without[1] + 30  # the held texture's cheek is not as red as the video's
     assert with_[0] < without[0] + 10  # no update before frame 5 (the first one looked at)
-    assert with_[1] - without[1] > 0.6 * (source[1] - without[1])  # sent again, it reddens
+    # sent again, it reddens: measured 0.60 of the source's redness (0.75 before the actor's mesh
+    # closed her open smile with her own teeth, fit.actor.mouth_cap: the video then showed drawn
+    # ones, on whose edges the tracked mouth, and with it the cheek, moved less)
+    assert with_[1] - without[1] > 0.5 * (source[1] - without[1])

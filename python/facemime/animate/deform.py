@@ -22,31 +22,12 @@ import numpy as np
 from facemime.errors import InvalidInputError
 from facemime.metrics import resample
 from facemime.shared_constants import CONTOUR_GROUPS, REACH, SOFTEN
-from facemime.types.head import HeadModel, model_iod
+from facemime.types.head import HeadModel, model_iod, mouth_width
 from facemime.types.pose import Pose, head_plane
 
 UPPER = ("mouth_outer_upper", "mouth_inner_upper")
 LOWER = ("mouth_outer_lower", "mouth_inner_lower")
 BROWS = tuple(n for n in CONTOUR_GROUPS if n.startswith("brow"))
-
-
-def mouth_width(model: HeadModel, vertices: np.ndarray) -> float:
-    """Distance between the mouth's corners (the outer lips' ends) in the model's (x, y) plane.
-
-    Parameters
-    ----------
-    model
-        The head model whose ``mouth_outer_upper`` group names the corners.
-    vertices
-        (N, 3) float array: a shape of ``model``'s (its own vertices or deformed ones), model units.
-
-    Returns
-    -------
-    float
-        The corner-to-corner distance, model units.
-    """
-    first, last = model.groups["mouth_outer_upper"][[0, -1]]
-    return float(np.hypot(*(vertices[last, :2] - vertices[first, :2])))
 
 
 class Deformer:

@@ -14,7 +14,7 @@ from dataclasses import dataclass, replace
 import cv2
 import numpy as np
 
-from facemime.animate.deform import Deformer, mouth_width
+from facemime.animate.deform import Deformer
 from facemime.animate.eyes import LookPainter
 from facemime.errors import InvalidInputError
 from facemime.render.raster import fill, render_mesh_into
@@ -36,7 +36,7 @@ from facemime.shared_constants import (
     UPPER_TEETH,
 )
 from facemime.types.actor import Actor
-from facemime.types.head import model_iod
+from facemime.types.head import model_iod, mouth_width
 from facemime.types.look import Look
 from facemime.types.pose import Pose, project
 

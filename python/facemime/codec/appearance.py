@@ -13,8 +13,9 @@ receiver's texture plus the smoothed difference, :data:`SMOOTH`): where the geom
 few texels, the frame's details land beside the texture's, and sending them made the face worse
 (lp_d3, 8 kbit/s: 23.2 dB against 23.5 without updates; smoothed, 23.7). The blocks of
 :data:`BLOCK` texels it covers whole are compared with the receiver's texture (mean absolute grey
-difference). The eyes are left out
-(their look moves them). The rectangle around the blocks that differ by more than
+difference). The eyes are left out (their look moves them), and so is a mouth opening the actor's
+mesh closes (:func:`facemime.fit.actor.mouth_cap`: its teeth and tongue move with the lips).
+The rectangle around the blocks that differ by more than
 :data:`THRESHOLD` levels is sent when the bits saved for it allow (a bucket filled at the budget,
 holding at most :data:`WINDOW` seconds of it); otherwise the rectangle around the worst half of
 them is tried, and so on. Texture pixels: (x, y), (0, 0) the centre of the top-left texel.
@@ -222,7 +223,10 @@ class AppearanceSender:
         eye = np.zeros(len(model.vertices), bool)
         for e in EYES:
             eye[model.groups[e]] = True
-        self._triangles = tri[~eye[tri].all(axis=1)]  # the eye openings: the look moves them
+        mouth = np.zeros(len(model.vertices), bool)
+        mouth[np.concatenate([model.groups["mouth_inner_upper"], model.groups["mouth_inner_lower"]])] = True
+        # the eye openings (the look moves them) and a mouth opening the mesh closes (the lips move it)
+        self._triangles = tri[~eye[tri].all(axis=1) & ~mouth[tri].all(axis=1)]
         v = model.vertices
         n = np.cross(
             v[self._triangles[:, 1]] - v[self._triangles[:, 0]], v[self._triangles[:, 2]] - v[self._triangles[:, 0]]

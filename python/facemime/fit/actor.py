@@ -18,9 +18,10 @@ from facemime.fit.adjust import Fit, fit_model
 from facemime.fit.auto import AutoPoints, auto_points
 from facemime.head.generic import generic_head
 from facemime.head.texture import painted_texture
+from facemime.shared_constants import SEAL
 from facemime.types.actor import Actor
 from facemime.types.contours import CONTOUR_NAMES
-from facemime.types.head import HeadModel
+from facemime.types.head import HeadModel, mouth_width
 from facemime.types.points import ReferencePoints
 from facemime.types.pose import Pose, project
 
@@ -30,6 +31,13 @@ TEXTURE_MARGIN = 0.08
 TEXTURE_MAX_SIDE = 1024
 #: The scene (the whole source photo) is shrunk, if needed, to at most this many pixels a side.
 SCENE_MAX_SIDE = 2048
+#: A photo whose inner lips stand further apart than this share of the mouth's width somewhere
+#: (twice the gap the synthesis seals, :data:`~facemime.shared_constants.SEAL`: an opening it
+#: shows at its full size) has the opening closed in the actor's mesh by triangles between the
+#: inner lips (:func:`mouth_cap`), so that the actor shows the photo's own teeth and mouth where
+#: the synthesis would otherwise draw an interior over them. Of the shared videos' first frames
+#: only st_aoc's is that open (0.35); the others are at most 0.03.
+CAP_OPENING = 2 * SEAL
 
 
 def smear_texture(model: HeadModel, photo: np.ndarray, fit: Fit, points: ReferencePoints, source: dict) -> Actor:
@@ -68,7 +76,11 @@ def smear_texture(model: HeadModel, photo: np.ndarray, fit: Fit, points: Referen
         raise InvalidInputError(f"the fitted face covers only {x1 - x0}x{y1 - y0} pixels of the image")
     crop = _shrunk(photo[y0:y1, x0:x1], TEXTURE_MAX_SIDE)
     uv = np.clip((px - [x0, y0] + 0.5) / [x1 - x0, y1 - y0], 0.0, 1.0)
-    adjusted = replace(model, vertices=fit.vertices, uv=uv, name=f"{source.get('file', 'photo')} actor")
+    capped = {frozenset(t) for t in _lip_strip(model).tolist()}  # a cap of an earlier fit goes
+    kept = np.array([frozenset(t) not in capped for t in model.triangles.tolist()], bool)
+    triangles = np.concatenate([model.triangles[kept], mouth_cap(model, fit.vertices, px)])
+    name = f"{source.get('file', 'photo')} actor"
+    adjusted = replace(model, vertices=fit.vertices, uv=uv, name=name, triangles=triangles)
     return Actor(
         adjusted,
         crop,
@@ -77,6 +89,59 @@ def smear_texture(model: HeadModel, photo: np.ndarray, fit: Fit, points: Referen
         {k: np.asarray(v, float) for k, v in points.items()},
         _shrunk(photo, SCENE_MAX_SIDE),
     )
+
+
+def _lip_strip(model: HeadModel) -> np.ndarray:
+    """The strip between the inner lips, knot to knot, as (M, 3) vertex indices: two triangles a
+    pair of knots, none where the lips share a vertex (the corners); empty where the inner lips'
+    knot counts differ."""
+    upper, lower = model.groups["mouth_inner_upper"], model.groups["mouth_inner_lower"]
+    if len(upper) != len(lower):
+        return np.zeros((0, 3), np.int64)
+    quads = [(upper[i], upper[i + 1], lower[i + 1], lower[i]) for i in range(len(upper) - 1)]
+    triangles = [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d)) if len({*t}) == 3]
+    return np.array(triangles, np.int64).reshape(-1, 3)
+
+
+def mouth_cap(model: HeadModel, vertices: np.ndarray, px: np.ndarray) -> np.ndarray:
+    """Triangles that close the mouth's opening between the inner lips, where a photo shows it
+    open wider than :data:`CAP_OPENING` of the mouth's width.
+
+    The strip between the two inner lips, knot to knot, two triangles a pair of knots (none where
+    the lips share a vertex: the corners). Textured at the photo's positions of those vertices,
+    they show the photo's own mouth; as the lips close they fold away, and the synthesis's drawn
+    interior, behind the mesh, is covered wherever they stand.
+
+    Parameters
+    ----------
+    model
+        The head, with the inner lips' groups.
+    vertices
+        (N, 3) float array: the model's vertices as fitted to the photo, model units.
+    px
+        (N, 2) float array: where the vertices project in the photo, (x, y) pixels; sets each
+        triangle's winding, front-facing as the renderer culls (clockwise on the image, y down).
+
+    Returns
+    -------
+    (M, 3) int64 array
+        Vertex indices; (0, 3) where the lips are closer, or the inner lips' knot counts differ.
+    """
+    upper, lower = model.groups["mouth_inner_upper"], model.groups["mouth_inner_lower"]
+    none = np.zeros((0, 3), np.int64)
+    width = mouth_width(model, vertices)
+    if len(upper) != len(lower) or width <= 0.0:
+        return none
+    first, last = model.groups["mouth_outer_upper"][[0, -1]]
+    along = (vertices[last, :2] - vertices[first, :2]) / width
+    gap = (vertices[upper, :2] - vertices[lower, :2]) @ np.array([-along[1], along[0]])  # model y is up
+    if gap.max() <= CAP_OPENING * width:
+        return none
+    out = _lip_strip(model)
+    e1, e2 = px[out[:, 1]] - px[out[:, 0]], px[out[:, 2]] - px[out[:, 0]]
+    back = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0] > 0.0  # the renderer's back faces
+    out[back] = out[back][:, ::-1]
+    return out
 
 
 def _shrunk(image: np.ndarray, side: int) -> np.ndarray:

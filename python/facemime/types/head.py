@@ -198,3 +198,22 @@ def model_eye_centres(model: HeadModel) -> np.ndarray:
         Model coordinates, model units; the image-left eye (the subject's right) first.
     """
     return np.array([model.vertices[model.groups[e][[0, 4]]].mean(axis=0) for e in ("eye_right", "eye_left")])
+
+
+def mouth_width(model: HeadModel, vertices: np.ndarray) -> float:
+    """Distance between the mouth's corners (the outer lips' ends) in the model's (x, y) plane.
+
+    Parameters
+    ----------
+    model
+        The head model whose ``mouth_outer_upper`` group names the corners.
+    vertices
+        (N, 3) float array: a shape of ``model``'s (its own vertices or deformed ones), model units.
+
+    Returns
+    -------
+    float
+        The corner-to-corner distance, model units.
+    """
+    first, last = model.groups["mouth_outer_upper"][[0, -1]]
+    return float(np.hypot(*(vertices[last, :2] - vertices[first, :2])))
