@@ -37,7 +37,8 @@ from facemime.animate.deform import Deformer
 from facemime.animate.synth import Puppet
 from facemime.codec.appearance import Appearance
 from facemime.codec.clip import analyse, encode_clip, with_appearance
-from facemime.codec.stream import MotionDecoder, Settings
+from facemime.codec.decoder import MotionDecoder
+from facemime.codec.stream import Settings
 from facemime.io.video import VideoReader
 from facemime.types.head import model_iod
 from fidelity import regions, scores

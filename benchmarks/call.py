@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 from playwright.sync_api import sync_playwright
 
-from facemime.codec.stream import MotionDecoder
+from facemime.codec.decoder import MotionDecoder
 
 ROOT = Path(__file__).resolve().parents[1]
 ARGS = [

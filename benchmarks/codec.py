@@ -50,8 +50,9 @@ from facemime import _core
 from facemime.animate.deform import Deformer
 from facemime.animate.synth import Puppet
 from facemime.codec.clip import MAX_COEFFICIENTS, Clip, analyse, encode_clip
+from facemime.codec.decoder import MotionDecoder
 from facemime.codec.params import Basis
-from facemime.codec.stream import MotionDecoder, MotionEncoder, Settings
+from facemime.codec.stream import MotionEncoder, Settings
 from facemime.io.video import VideoReader
 from facemime.shared_constants import BASIS_ONE
 from facemime.types.head import model_iod

@@ -30,7 +30,7 @@ from facemime.animate.deform import Deformer
 from facemime.animate.synth import Puppet
 from facemime.app.coding import encode_video
 from facemime.codec.appearance import Appearance
-from facemime.codec.stream import MotionDecoder
+from facemime.codec.decoder import MotionDecoder
 from facemime.io.video import VideoReader
 from facemime.shared_constants import NO_FACE_DIM
 from facemime.types.head import model_iod

@@ -49,7 +49,7 @@ _API = {
     "Pose": "facemime.types.pose",
     "Look": "facemime.types.look",
     "MotionEncoder": "facemime.codec.stream",
-    "MotionDecoder": "facemime.codec.stream",
+    "MotionDecoder": "facemime.codec.decoder",
 }
 
 __all__ = [

@@ -19,7 +19,8 @@ import numpy as np
 import pytest
 
 from facemime.app.run import run_video
-from facemime.app.view import HELP, Viewer, make_server
+from facemime.app.view import HELP, Viewer
+from facemime.app.view_server import make_server
 from facemime.errors import InvalidInputError
 from facemime.io.video import VideoReader
 from facemime.shared_constants import BACKGROUND
@@ -191,7 +192,7 @@ def test_a_track_with_wrong_fields_gives_one_line(recorded, tmp_path, capsys, mo
     def serving(*args, **kwargs):
         raise AssertionError("the track was taken")  # refused at start, not served
 
-    monkeypatch.setattr("facemime.app.view.make_server", serving)
+    monkeypatch.setattr("facemime.app.view_server.make_server", serving)
     doc = json.loads(recorded[1].read_text())
     if field is None:
         doc[block] = value

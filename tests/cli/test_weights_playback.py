@@ -10,7 +10,8 @@ from facemime.animate.deform import Deformer
 from facemime.animate.expressions import NAMES, Expressions
 from facemime.animate.motion_file import read_motion
 from facemime.codec.clip import read_stream
-from facemime.codec.stream import COEFFICIENT_STEP, DEFAULT_QUALITY, LADDER, MotionDecoder
+from facemime.codec.decoder import MotionDecoder
+from facemime.codec.stream import COEFFICIENT_STEP, DEFAULT_QUALITY, LADDER
 from facemime.fit.actor import generic_actor
 from facemime.head import generic_head
 from facemime.io.video import VideoReader

@@ -105,7 +105,7 @@ def test_a_face_whose_cheek_reddens_is_sent_again_through_the_stream(tmp_path):
 
     from facemime.animate.synth import key_frame, scene_mesh, synthesize
     from facemime.app.coding import decode_stream, encode_video
-    from facemime.codec.stream import MotionDecoder
+    from facemime.codec.decoder import MotionDecoder
     from facemime.fit.actor import fit_actor
     from facemime.io.actor_file import save_actor
     from facemime.io.video import VideoReader, VideoWriter

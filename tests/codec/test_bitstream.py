@@ -12,7 +12,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from facemime import _core
-from facemime.codec.stream import MotionDecoder, StreamError
+from facemime.codec.decoder import MotionDecoder
+from facemime.codec.stream import StreamError
 
 from . import golden
 from .reference_decoder import chunks as reference_chunks

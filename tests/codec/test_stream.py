@@ -9,8 +9,9 @@ import pytest
 
 from facemime import _core
 from facemime.codec.clip import analyse, encode_clip
+from facemime.codec.decoder import MotionDecoder
 from facemime.codec.params import LOOK_KINDS, Basis, pose_vector, topology_id
-from facemime.codec.stream import LOOK_STEPS, MotionDecoder, MotionEncoder, Settings, StreamError
+from facemime.codec.stream import LOOK_STEPS, MotionEncoder, Settings, StreamError
 from facemime.errors import InvalidInputError
 from facemime.io.actor_file import actor_bytes, actor_from_bytes, actor_id
 from facemime.types.look import Look

@@ -13,8 +13,8 @@ import numpy as np
 
 from facemime.call.sender import FileSource, Sender
 from facemime.call.server import Hub, make_server
+from facemime.codec.decoder import MotionDecoder
 from facemime.codec.params import pose_from_vector
-from facemime.codec.stream import MotionDecoder
 from facemime.io.video import VideoReader
 
 INTRA, INTER = 3, 4  # packet kinds

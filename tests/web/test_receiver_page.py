@@ -12,8 +12,9 @@ from facemime.animate.deform import Deformer
 from facemime.animate.synth import Puppet
 from facemime.app.coding import encode_video
 from facemime.codec.appearance import Appearance
+from facemime.codec.decoder import MotionDecoder
 from facemime.codec.params import look_from_extras, pose_from_vector
-from facemime.codec.stream import MotionDecoder, Settings
+from facemime.codec.stream import Settings
 from facemime.shared_constants import NO_FACE_DIM
 from facemime.types.head import model_iod
 

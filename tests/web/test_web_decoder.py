@@ -1,5 +1,5 @@
 """The browser receiver's decoder (``web/src/stream``, TypeScript, run under Node) against the Rust
-one as :class:`~facemime.codec.stream.MotionDecoder` presents it: streams from the real encoder,
+one as :class:`~facemime.codec.decoder.MotionDecoder` presents it: streams from the real encoder,
 whole and damaged in many ways, fed in pieces of several sizes, must give the same frames (index,
 face, lost features, concealment and every value bit for bit), the same appearance updates in the
 same places, and the same stats.
@@ -17,8 +17,9 @@ import numpy as np
 import pytest
 
 from facemime import _core
+from facemime.codec.decoder import MotionDecoder
 from facemime.codec.params import Basis, look_from_extras, pose_from_vector
-from facemime.codec.stream import MotionDecoder, MotionEncoder, Settings
+from facemime.codec.stream import MotionEncoder, Settings
 from facemime.fit.actor import generic_actor
 from facemime.types.contours import FEATURES
 from facemime.types.look import Look

@@ -25,8 +25,9 @@ from facemime.codec.clip import (
     track_clip,
     with_appearance,
 )
+from facemime.codec.decoder import MotionDecoder
 from facemime.codec.params import Basis
-from facemime.codec.stream import LADDER, MotionDecoder, Settings, StreamError
+from facemime.codec.stream import LADDER, Settings, StreamError
 from facemime.errors import InvalidInputError
 from facemime.io.actor_file import load_actor
 from facemime.io.outputs import check_outputs, write_bytes

@@ -150,7 +150,7 @@ def _summarise_stream(path: Path) -> dict[str, Any]:
     """Frames and frames with a lost feature of a ``.fmstream`` decoded to its end (the motion
     only: nothing is drawn)."""
     from facemime.codec.clip import read_stream
-    from facemime.codec.stream import MotionDecoder
+    from facemime.codec.decoder import MotionDecoder
 
     decoder = MotionDecoder(name=str(path))
     frames = decoder.push(read_stream(path)) + decoder.finish()

@@ -110,7 +110,8 @@ def view(source: Path, actor_file: Path | None, port: int, no_browser: bool, mas
     Stop with Ctrl-C."""
     import webbrowser
 
-    from facemime.app.view import HELP, Viewer, make_server
+    from facemime.app.view import HELP, Viewer
+    from facemime.app.view_server import make_server
     from facemime.io.actor_file import load_actor
 
     actor = load_actor(actor_file) if actor_file is not None else None

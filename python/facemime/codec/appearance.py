@@ -323,10 +323,10 @@ class Appearance:
         (H, W, 3) uint8 RGB: the actor's texture (copied).
     payloads
         The appearance chunks' payloads, in stream order
-        (:attr:`~facemime.codec.stream.MotionDecoder.appearance`).
+        (:attr:`~facemime.codec.decoder.MotionDecoder.appearance`).
     after
         For each payload, how many frames the decoder had output before it
-        (:attr:`~facemime.codec.stream.MotionDecoder.appearance_after`).
+        (:attr:`~facemime.codec.decoder.MotionDecoder.appearance_after`).
     """
 
     def __init__(self, texture: np.ndarray, payloads: list[bytes], after: list[int]):

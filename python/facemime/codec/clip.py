@@ -26,8 +26,9 @@ from facemime.animate.analysis import FrameMotion, analysed
 from facemime.animate.deform import Deformer
 from facemime.animate.synth import Puppet
 from facemime.codec.appearance import AppearanceSender
+from facemime.codec.decoder import MotionDecoder
 from facemime.codec.params import Basis, pose_vector
-from facemime.codec.stream import LADDER, MotionDecoder, MotionEncoder, Settings
+from facemime.codec.stream import LADDER, MotionEncoder, Settings
 from facemime.errors import InputFileError
 from facemime.io.video import VideoReader
 from facemime.progress import track as progress

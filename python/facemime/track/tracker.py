@@ -2,35 +2,10 @@
 STB-snakes over one shared knot array, solved jointly each frame after head-motion
 compensation (docs/method.md §1).
 
-Per frame:
-
-1. the head's similarity motion from the previous frame (:mod:`facemime.track.motion`) moves the
-   previous knots (the snakes' start and their temporal anchor) and the rest shape (the first
-   frame's knots carried along by the accumulated head motion; each mouth feature's rest shape
-   also follows, in part, the affine change of its knots, so an "O" or a wide-open mouth is not
-   pulled back to the neutral shape); when the optical flow lost most of the mouth's knots, those
-   it lost first move sideways with the previous frame's mouth region, matched in this one
-   (:mod:`facemime.track.mouth`); a mouth knot the flow could not follow, or that it left inside
-   the lips as the mouth opened, starts at the lip edge found along its curve's normal on a
-   lip-colour score (:mod:`facemime.track.lips`);
-2. the sign-descent solver (``facemime._core.SnakeSolver``) moves every knot at most δ0/(1−σ) px
-   per pass: one pass for the brows, ``mouth_passes`` for the mouth, whose lips move fastest;
-3. each feature's confidence is its mean edge response relative to the first frame's. A brow
-   one of whose curves lost its edge (a brow raised fast, a head that jumped between frames) is
-   looked for again by matching the first frame's brow around where the head motion put it
-   (:mod:`facemime.track.brows`) and settled there by another solver run, kept when its
-   confidence rose. A feature whose confidence still collapses or whose shape degenerates is
-   flagged ``lost``, so that it never drifts silently. A lost brow goes to where the search
-   matched it, or else to its first-frame shape carried by the head motion, from where the next
-   frame's snakes find it again (a brow that slid onto the eye otherwise stays there); a lost
-   mouth stays where it is (measured: its rest shape follows the head, not the mouth, and
-   resetting it made the tracks worse), and is looked for by its lip colour near where the brows
-   put it once it has been lost ``mouth_relocate`` frames in a row (:mod:`facemime.track.mouth`),
-   then settled there by another solver run: a mouth that holds its edges there is not lost, one
-   that does not stays where it was (lip colour alone put a grimace's wide mouth, teeth bared,
-   onto its lower lip). An inner mouth still lost then is looked for up and down the face
-   around where it was, its lips settled by the solver with the outer mouth held, and is not
-   lost once it holds its edges there.
+Per frame: the head's motion moves the previous knots and the rest shape (where the flow lost the
+mouth, the mouth region or the lip colour places it); the solver settles the snakes on the edges;
+a feature whose edges collapse is searched for more widely or flagged ``lost`` — the steps in
+docs/tracker.md, "One frame, step by step".
 
 Coordinates are (x, y) pixels, origin at the centre of the top-left pixel, y down.
 """

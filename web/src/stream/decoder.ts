@@ -1,6 +1,6 @@
 /** The stream decoder (docs/bitstream.md, "Decoding with loss"): reads chunks from bytes as they
  * arrive, survives damage, loss and reordering, and conceals what it cannot decode with the last
- * good frame. Its output is the Rust decoder's as `facemime.codec.stream.MotionDecoder` presents
+ * good frame. Its output is the Rust decoder's as `facemime.codec.decoder.MotionDecoder` presents
  * it: frame by frame, each push's frames in index order, concealed frames filled in. */
 
 import { APPEARANCE_PREFIX, ByteQueue, KIND_ACTOR, KIND_APPEARANCE, KIND_HEADER, KIND_INTRA, readChunk,
