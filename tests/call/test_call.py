@@ -20,9 +20,9 @@ from websockets.sync.client import connect
 
 from cli.test_cli import run
 from facemime.app.call import Call
-from facemime.call.sender import FileSource, Sender
+from facemime.call.sender import FileSource, Sender, SenderStats
 from facemime.call.server import MAX_MESSAGE
-from facemime.codec.stream import MotionDecoder
+from facemime.codec.decoder import MotionDecoder
 
 HEADER, ACTOR, INTRA, INTER = 1, 2, 3, 4
 PAGE = b"<!doctype html><title>stand-in</title>"
@@ -147,7 +147,11 @@ def test_a_client_gets_hello_header_actor_then_frames_and_packets_that_decode(li
 def test_an_intra_request_makes_the_next_packet_intra_once(live):
     keyframe = live.sender.keyframe_packets
     with client(live) as ws:
-        until_packets(ws, 2)
+        last = until_packets(ws, 2)[-1]
+        # asked after an inter packet, the next one not the schedule's intra (just after an intra
+        # packet, a request is not honoured: that packet is on its way)
+        while kind(last) == INTRA or (live.sender.stats.packets % keyframe) in (0, keyframe - 1):
+            last = until_packets(ws, 1)[-1]
         asked, honoured = live.sender.stats.intra_asked, live.sender.stats.intra_honoured
         ws.send('{"type": "intra"}')
         ws.send('{"type": "intra"}')  # while the next packet is intra already: nothing more
@@ -156,6 +160,21 @@ def test_an_intra_request_makes_the_next_packet_intra_once(live):
     intra = [s for s, p in packets if kind(p) == INTRA]
     assert intra and intra[0] <= packets[1][0] and intra[0] % keyframe != 0  # not the schedule's
     assert live.sender.stats.intra_asked == asked + 2 and live.sender.stats.intra_honoured == honoured + 1
+
+
+def test_a_request_just_after_an_intra_packet_is_answered_by_it():
+    """A receiver out of sync asks every 250 ms; one request may come after the intra packet it
+    asked for was made, before it arrived: that packet answers it, and no second intra follows.
+    After one more packet a request is honoured again (the intra may have been lost)."""
+    sender = Sender.__new__(Sender)  # the request's bookkeeping alone, without a source
+    sender._lock, sender.stats, sender.encoder = threading.Lock(), SenderStats(), object()
+    sender.keyframe_packets, sender._forced, sender._packets_made, sender._last_intra = 25, False, 7, False
+    assert sender.request_intra() and sender._forced  # packet 7 will be intra
+    sender._packets_made, sender._forced, sender._last_intra = 8, False, True  # it was made
+    assert not sender.request_intra() and not sender._forced
+    sender._packets_made, sender._last_intra = 9, False  # and an inter packet after it
+    assert sender.request_intra() and sender._forced
+    assert (sender.stats.intra_asked, sender.stats.intra_honoured) == (3, 2)
 
 
 @pytest.mark.parametrize(

@@ -318,6 +318,7 @@ class Sender(threading.Thread):
         self._lock = threading.Lock()  # the intra requests' state, shared with the clients' threads
         self._forced = False  # an intra packet was asked for and is not made yet
         self._packets_made = 0
+        self._last_intra = False  # the last packet made was an intra packet
         self._frames = source.frames(self._stopping)
         self._arrived = 0.0  # when the frame being analysed arrived (wall clock, ms)
         self._analysed = analysed(self._pictures(), source.name, actor=actor, fps=source.fps)
@@ -338,7 +339,9 @@ class Sender(threading.Thread):
 
     def request_intra(self) -> bool:
         """A receiver asks for an intra packet: the next packet is made one, unless it is one
-        already.
+        already, or the last packet made was one (on its way: a receiver that asks again every
+        250 ms while out of sync asked before it came; if it was lost, the next request, after
+        one more packet, is honoured).
 
         Returns
         -------
@@ -348,7 +351,8 @@ class Sender(threading.Thread):
         """
         with self._lock:
             self.stats.intra_asked += 1
-            if self.encoder is None or self._forced or self._packets_made % self.keyframe_packets == 0:
+            next_is_intra = self._forced or self._packets_made % self.keyframe_packets == 0
+            if self.encoder is None or next_is_intra or self._last_intra:
                 return False
             self._forced = True
             self.stats.intra_honoured += 1
@@ -455,7 +459,8 @@ class Sender(threading.Thread):
         self.stats.packet_bytes += len(data)
         with self._lock:
             self._packets_made += 1
-            if data[0] >> 5 == 3:
+            self._last_intra = data[0] >> 5 == 3
+            if self._last_intra:
                 self._forced = False
         now = time.time() * 1000
         self.stats.delays.append(((now - arrived[0]) / 1000, (now - arrived[-1]) / 1000))
