@@ -18,6 +18,13 @@ def render_mesh_into(
     depth_mode: str,
     cull_back_faces: bool,
 ) -> tuple[int, int, int, int]: ...
+def sample_affine(
+    image: npt.NDArray[np.uint8],
+    m: npt.NDArray[np.float64],
+    width: int,
+    height: int,
+    border: str,
+) -> npt.NDArray[np.uint8]: ...
 def coverage(
     points: npt.NDArray[np.float64],
     triangles: npt.NDArray[np.uint32],

@@ -1,8 +1,9 @@
 //! Bindings of `facemime_core::raster`.
 
-use facemime_core::raster::{self, DepthMode, Filter, ImageMut, ImageRef, RenderOptions};
+use facemime_core::raster::{self, Border, DepthMode, Filter, ImageMut, ImageRef, RenderOptions};
 use numpy::{
-    IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyReadwriteArray3,
+    IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+    PyReadwriteArray3,
 };
 use pyo3::prelude::*;
 
@@ -88,8 +89,57 @@ fn coverage<'py>(
     Ok(cov.into_pyarray(py))
 }
 
+/// (height, width, C) uint8: `image` (H, W, C) sampled bilinearly through the affine map `m`
+/// (2, 3) from output pixels to image pixels; `border` "replicate" or "zero". See
+/// `facemime.render.bilinear.sample_affine`.
+#[pyfunction]
+fn sample_affine<'py>(
+    py: Python<'py>,
+    image: PyReadonlyArray3<u8>,
+    m: PyReadonlyArray2<f64>,
+    width: usize,
+    height: usize,
+    border: &str,
+) -> PyResult<Bound<'py, PyArray3<u8>>> {
+    let border = match border {
+        "replicate" => Border::Replicate,
+        "zero" => Border::Zero,
+        other => {
+            return Err(invalid(format!(
+                "border must be 'replicate' or 'zero', got {other:?}"
+            )))
+        }
+    };
+    let m = m.as_array();
+    if m.shape() != [2, 3] {
+        return Err(invalid(format!(
+            "the affine map must be 2x3, got {:?}",
+            m.shape()
+        )));
+    }
+    let map = [
+        [m[[0, 0]], m[[0, 1]], m[[0, 2]]],
+        [m[[1, 0]], m[[1, 1]], m[[1, 2]]],
+    ];
+    let shape = image.as_array().shape().to_vec();
+    let data = contiguous("image", image.as_slice().ok())?;
+    let channels = shape[2];
+    let out = py.detach(|| -> Result<_, CoreErr> {
+        let img = ImageRef::named("image", data, shape[1], shape[0], channels)?;
+        raster::image::check_size("the sampled picture", width, height)?;
+        let mut buf = vec![0u8; width * height * channels];
+        let mut out = ImageMut::new(&mut buf, width, height, channels)?;
+        raster::sample_affine(&img, map, &mut out, border)?;
+        Ok(buf)
+    })?;
+    let array = numpy::ndarray::Array3::from_shape_vec((height, width, channels), out)
+        .map_err(|e| invalid(e.to_string()))?;
+    Ok(array.into_pyarray(py))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(render_mesh_into, m)?)?;
+    m.add_function(wrap_pyfunction!(sample_affine, m)?)?;
     m.add_function(wrap_pyfunction!(coverage, m)?)?;
     m.add("MAX_IMAGE_SIDE", raster::MAX_IMAGE_SIDE)?;
     m.add("MAX_IMAGE_PIXELS", raster::MAX_IMAGE_PIXELS)?;

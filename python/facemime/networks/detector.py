@@ -19,6 +19,7 @@ import cv2
 import numpy as np
 
 from facemime.networks.network import load_network
+from facemime.render.bilinear import sample_affine
 
 #: Side of the detector's square input, pixels.
 INPUT = 128
@@ -256,9 +257,7 @@ def _search(rgb: np.ndarray, back: np.ndarray) -> list[Detection]:
     input pixels to image pixels; zero beyond the image), detections of :data:`MIN_SCORE` or
     more in image pixels."""
     net = load_network("face_detection_short_range.tflite")
-    crop = cv2.warpAffine(
-        rgb, back, (INPUT, INPUT), flags=cv2.INTER_AREA | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_CONSTANT
-    )
+    crop = sample_affine(rgb, back, (INPUT, INPUT), border="zero")
     # MediaPipe feeds this model pixels scaled to [-1, 1].
     net.setInput(cv2.dnn.blobFromImage(crop, 2.0 / 255.0, mean=(127.5, 127.5, 127.5)))
     scores, regressors = net.forward(["classificators", "regressors"])

@@ -21,6 +21,7 @@ import numpy as np
 
 from facemime.networks.detector import Detection
 from facemime.networks.network import load_network
+from facemime.render.bilinear import sample_affine
 
 #: Side of the landmark model's square input, pixels.
 INPUT = 192
@@ -92,13 +93,7 @@ class Crop:
         (size, size, 3) uint8 array
             The crop, RGB, turned so that its x axis lies along ``angle``.
         """
-        return cv2.warpAffine(
-            rgb,
-            self.affine(size),
-            (size, size),
-            flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-            borderMode=cv2.BORDER_REPLICATE,
-        )
+        return sample_affine(rgb, self.affine(size), (size, size))
 
 
 def crop_from_detection(detection: Detection) -> Crop:

@@ -4,7 +4,9 @@
 //!   functions so that triangles sharing an edge cover every pixel exactly once.
 //! - [`sampler`]: nearest and bilinear texture lookups in 16.16 fixed point.
 //! - [`mesh`]: a whole textured mesh: back-face culling, far-to-near order or a z-buffer.
+//! - [`affine`]: a picture resampled through an affine map (the face networks' crops, eye patches).
 
+pub mod affine;
 pub mod image;
 pub mod mesh;
 pub mod sampler;
@@ -12,5 +14,6 @@ pub mod sampler;
 mod simd;
 pub mod span;
 
+pub use affine::{sample_affine, Border};
 pub use image::{ImageMut, ImageRef, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};
 pub use mesh::{coverage, render_mesh_into, DepthMode, Filter, RenderOptions, RenderStats};
