@@ -106,6 +106,15 @@ def model_doc():
         (lambda d: d["groups"].pop("brow_left_upper"), "missing vertex groups brow_left_upper"),
         (lambda d: d["vertices"][3].__setitem__(0, "x"), "malformed model"),
         (lambda d: d["deformation_units"]["jawOpen"]["displacements"].append([500, 0, 0, 0]), "names vertex 500"),
+        # indices are integers, never rounded into another vertex
+        (lambda d: d["triangles"][0].__setitem__(2, 2.5), "triangles must list vertex indices as integers"),
+        (lambda d: d["triangles"][0].__setitem__(2, "2"), "triangles must list vertex indices as integers"),
+        (lambda d: d["groups"]["nose"].__setitem__(0, 3.0), "group 'nose' must list vertex indices as integers"),
+        # the lips are drawn and sealed pair by pair, corner to corner
+        (
+            lambda d: d["groups"]["mouth_inner_lower"].insert(1, d["groups"]["mouth_inner_upper"].pop(1)),
+            "mouth_inner_upper and mouth_inner_lower must have the same number of vertices, got 10 and 12",
+        ),
     ],
 )
 def test_bad_model_files_are_refused_with_a_message(tmp_path, edit, message):

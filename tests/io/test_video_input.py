@@ -122,6 +122,15 @@ def test_a_video_no_frame_of_which_decodes_is_refused_as_such(tmp_path):
         VideoReader(tmp_path / "zeros.mp4")
 
 
+def test_a_video_whose_codec_is_damaged_is_refused_in_one_line(tmp_path):
+    """A damaged header can leave the stream's codec unknown (FFmpeg opens it with no decoder)."""
+    data = _clip(tmp_path / "good.mp4", 10)
+    at = data.index(b"avc1", data.index(b"moov"))
+    (tmp_path / "bad.mp4").write_bytes(data[:at] + b"zzzz" + data[at + 4 :])
+    with pytest.raises(InputFileError, match=r"bad\.mp4: its video stream's codec is unknown"):
+        VideoReader(tmp_path / "bad.mp4")
+
+
 def test_a_stream_header_without_frames_is_refused_as_such(tmp_path):
     """An MPEG-TS cut after its stream tables: FFmpeg guesses 90000 fps from the time base."""
     with av.open(str(tmp_path / "c.ts"), "w") as out:

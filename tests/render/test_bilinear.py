@@ -62,6 +62,9 @@ def test_beyond_the_picture_a_zero_border_reads_zero_and_a_bad_map_is_one_error(
         args = {"m": np.array([[1.0, 0, 0], [0, 1.0, 0]]), "border": "replicate"} | bad
         with pytest.raises(InvalidInputError):
             sample_affine(IMAGE, args["m"], (4, 4), border=args["border"])
+    with pytest.raises(InvalidInputError) as told:  # a long argument is shown cut, not echoed whole
+        sample_affine(IMAGE, np.array([[1.0, 0, 0], [0, 1.0, 0]]), (4, 4), border="x" * 10**6)
+    assert len(str(told.value)) < 120
 
 
 def test_the_face_networks_crops_do_not_depend_on_opencvs_warp(monkeypatch, lp_d0):

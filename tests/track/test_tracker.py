@@ -197,6 +197,7 @@ def test_a_lost_brow_goes_back_to_its_rest_shape_and_is_found_again():
         (lambda c: c.__setitem__("mouth_outer_upper", [[1.0, 2.0]]), "needs at least 2 points"),
         (lambda c: c.__setitem__("brow_right_upper", [[1.0, 2.0], [np.nan, 3.0]]), "must be finite"),
         (lambda c: c.__setitem__("brow_right_upper", [[1.0, 2.0], [900.0, 3.0]]), "outside the 256x256 image"),
+        (lambda c: c.__setitem__("mouth_outer_upper", [[90.0, 70.0]] * 5), "mouth_outer_upper ends where it starts"),
     ],
 )
 def test_bad_contours_are_refused(change, message):

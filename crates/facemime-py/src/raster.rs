@@ -9,6 +9,16 @@ use pyo3::prelude::*;
 
 use crate::error::{invalid, CoreErr};
 
+/// A string argument as an error message shows it: quoted, at most 40 characters of it.
+fn shown(s: &str) -> String {
+    let head: String = s.chars().take(40).collect();
+    if head.len() < s.len() {
+        format!("{head:?}...")
+    } else {
+        format!("{s:?}")
+    }
+}
+
 fn contiguous<'a>(name: &str, s: Option<&'a [u8]>) -> PyResult<&'a [u8]> {
     s.ok_or_else(|| invalid(format!("{name} must be a C-contiguous uint8 array")))
 }
@@ -35,7 +45,8 @@ fn render_mesh_into(
         "bilinear" => Filter::Bilinear,
         other => {
             return Err(invalid(format!(
-                "filter must be 'nearest' or 'bilinear', got {other:?}"
+                "filter must be 'nearest' or 'bilinear', got {}",
+                shown(other)
             )))
         }
     };
@@ -44,7 +55,8 @@ fn render_mesh_into(
         "zbuffer" => DepthMode::ZBuffer,
         other => {
             return Err(invalid(format!(
-                "depth must be 'painter' or 'zbuffer', got {other:?}"
+                "depth must be 'painter' or 'zbuffer', got {}",
+                shown(other)
             )))
         }
     };
@@ -106,7 +118,8 @@ fn sample_affine<'py>(
         "zero" => Border::Zero,
         other => {
             return Err(invalid(format!(
-                "border must be 'replicate' or 'zero', got {other:?}"
+                "border must be 'replicate' or 'zero', got {}",
+                shown(other)
             )))
         }
     };

@@ -174,6 +174,15 @@ def head_document(model: HeadModel) -> dict[str, Any]:
     }
 
 
+def _indices(value: object, where: str, what: str) -> np.ndarray:
+    """Vertex indices as an int64 array; JSON numbers that are not integers (2.5, "2", true) are
+    refused rather than rounded into another vertex."""
+    raw = np.asarray(value)
+    if raw.size and raw.dtype.kind not in "iu":
+        raise ModelFormatError(f"{where}: {what} must list vertex indices as integers (of 64 bits at most)")
+    return raw.astype(np.int64)
+
+
 def head_from_document(doc: object, where: str) -> HeadModel:
     """Validate a parsed ``facemime.head/1`` document and build the model.
 
@@ -204,9 +213,9 @@ def head_from_document(doc: object, where: str) -> HeadModel:
     try:
         vertices = np.asarray(doc["vertices"], dtype=np.float64)
         n = len(vertices)
-        triangles = np.asarray(doc["triangles"], dtype=np.int64)
+        triangles = _indices(doc["triangles"], where, "triangles")
         uv = np.asarray(doc["uv"], dtype=np.float64) if doc.get("uv") is not None else None
-        groups = {str(k): np.asarray(g, dtype=np.int64) for k, g in doc["groups"].items()}
+        groups = {str(k): _indices(g, where, f"group {k!r}") for k, g in doc["groups"].items()}
         units, descriptions = {}, {}
         for name, u in doc.get("deformation_units", {}).items():
             dense = np.zeros((n, 3))
@@ -234,6 +243,12 @@ def head_from_document(doc: object, where: str) -> HeadModel:
     short = [f"{g} has {len(groups[g])} (needs {n})" for g, n in MIN_GROUP_SIZES.items() if len(groups[g]) < n]
     if short:
         raise ModelFormatError(f"{where}: vertex groups too short: {'; '.join(short)}")
+    for lips in ("mouth_outer", "mouth_inner"):  # drawn and sealed pairwise, corner to corner
+        upper, lower = len(groups[f"{lips}_upper"]), len(groups[f"{lips}_lower"])
+        if upper != lower:
+            raise ModelFormatError(
+                f"{where}: {lips}_upper and {lips}_lower must have the same number of vertices, got {upper} and {lower}"
+            )
     return HeadModel(
         vertices,
         triangles,

@@ -245,6 +245,11 @@ class VideoReader:
         self._stream = self._container.streams.video[0]
         self._stream.thread_type = "AUTO"
         codec = self._stream.codec_context
+        if codec is None:  # a damaged header: the stream's codec is not known
+            self._container.close()
+            raise InputFileError(
+                f"cannot read video {self.path}: its video stream's codec is unknown (a damaged file?)"
+            )
         if self.DECODE_THREADS:
             codec.thread_count = self.DECODE_THREADS
         elif codec.width * codec.height > LARGE_DECODE:

@@ -115,6 +115,8 @@ def check_contours(contours: Mapping[str, object], width: int, height: int) -> d
             raise InvalidInputError(f"contour {n} needs at least 2 points, got {len(pts)}")
         if (pts < -0.5).any() or (pts[:, 0] > width - 0.5).any() or (pts[:, 1] > height - 0.5).any():
             raise InvalidInputError(f"contour {n} has points outside the {width}x{height} image")
+        if np.hypot(*(pts[-1] - pts[0])) < 1.0:  # the features' directions come from their ends
+            raise InvalidInputError(f"contour {n} ends where it starts: it must run across its feature, left to right")
         out[n] = pts
     return out
 
