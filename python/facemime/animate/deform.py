@@ -22,7 +22,7 @@ import numpy as np
 from facemime.errors import InvalidInputError
 from facemime.metrics import resample
 from facemime.shared_constants import CONTOUR_GROUPS, REACH, SOFTEN
-from facemime.types.head import HeadModel, model_iod, mouth_width
+from facemime.types.head import HeadModel, model_iod, mouth_up, mouth_width
 from facemime.types.pose import Pose, head_plane
 
 UPPER = ("mouth_outer_upper", "mouth_inner_upper")
@@ -161,16 +161,12 @@ class Deformer:
             A sealed copy; ``vertices`` itself where the inner lips' knot counts differ or the
             mouth has no width.
         """
-        g = self.model.groups
         upper, lower = self._inner
-        corners = g["mouth_outer_upper"][[0, -1]]
-        along = vertices[corners[1], :2] - vertices[corners[0], :2]
-        width = mouth_width(self.model, vertices)
-        if len(upper) != len(lower) or width <= 0.0:
+        up = mouth_up(self.model, vertices)
+        if len(upper) != len(lower) or up is None:
             return vertices
-        up = np.array([-along[1], along[0]]) / width  # model y is up
         gap = (vertices[upper, :2] - vertices[lower, :2]) @ up
-        limit = closed * width
+        limit = closed * mouth_width(self.model, vertices)
         shown = np.where(gap < limit, 0.0, np.where(gap < 2.0 * limit, 2.0 * (gap - limit), gap))
         close = np.zeros((len(self.knots), 2))
         half = 0.5 * (gap - shown)[:, None] * up

@@ -21,7 +21,7 @@ from facemime.head.texture import painted_texture
 from facemime.shared_constants import SEAL
 from facemime.types.actor import Actor
 from facemime.types.contours import CONTOUR_NAMES
-from facemime.types.head import HeadModel, mouth_width
+from facemime.types.head import HeadModel, mouth_up, mouth_width
 from facemime.types.points import ReferencePoints
 from facemime.types.pose import Pose, project
 
@@ -129,13 +129,11 @@ def mouth_cap(model: HeadModel, vertices: np.ndarray, px: np.ndarray) -> np.ndar
     """
     upper, lower = model.groups["mouth_inner_upper"], model.groups["mouth_inner_lower"]
     none = np.zeros((0, 3), np.int64)
-    width = mouth_width(model, vertices)
-    if len(upper) != len(lower) or width <= 0.0:
+    up = mouth_up(model, vertices)
+    if len(upper) != len(lower) or up is None:
         return none
-    first, last = model.groups["mouth_outer_upper"][[0, -1]]
-    along = (vertices[last, :2] - vertices[first, :2]) / width
-    gap = (vertices[upper, :2] - vertices[lower, :2]) @ np.array([-along[1], along[0]])  # model y is up
-    if gap.max() <= CAP_OPENING * width:
+    gap = (vertices[upper, :2] - vertices[lower, :2]) @ up
+    if gap.max() <= CAP_OPENING * mouth_width(model, vertices):
         return none
     out = _lip_strip(model)
     e1, e2 = px[out[:, 1]] - px[out[:, 0]], px[out[:, 2]] - px[out[:, 0]]

@@ -217,3 +217,25 @@ def mouth_width(model: HeadModel, vertices: np.ndarray) -> float:
     """
     first, last = model.groups["mouth_outer_upper"][[0, -1]]
     return float(np.hypot(*(vertices[last, :2] - vertices[first, :2])))
+
+
+def mouth_up(model: HeadModel, vertices: np.ndarray) -> np.ndarray | None:
+    """The unit vector across the mouth's corner line, towards the nose, in the model's (x, y)
+    plane: the direction the lips' gap is measured along.
+
+    Parameters
+    ----------
+    model
+        The head model whose ``mouth_outer_upper`` group names the corners.
+    vertices
+        (N, 3) float array: a shape of ``model``'s (its own vertices or deformed ones), model units.
+
+    Returns
+    -------
+    (2,) float64 array or None
+        Model (x, y), y up; None where the corners coincide.
+    """
+    first, last = model.groups["mouth_outer_upper"][[0, -1]]
+    along = vertices[last, :2] - vertices[first, :2]
+    width = mouth_width(model, vertices)
+    return None if width <= 0.0 else np.array([-along[1], along[0]]) / width
