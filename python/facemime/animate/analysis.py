@@ -141,7 +141,7 @@ class Analysis:
         t0 = time.perf_counter()
         result = self.tracker.update(frame)
         t1 = time.perf_counter()
-        face = result.motion_ok and len(result.lost) < len(FEATURES)
+        face = result.face
         fitted = self.pose.fit_seconds
         pose = self.pose.update(frame, self.last.face, face)
         elsewhere = self.pose.fit_seconds - fitted  # seconds after t1 counted as fitting or look, not as the pose's

@@ -64,8 +64,8 @@ def track_video(
         start the tracker. The frames before the start are not tracked.
     out
         The ``facemime.track/1`` file to write (must end in ``.json``): per tracked frame its
-        0-based index, contours ((x, y) pixels), confidence per feature, lost features and
-        whether the landmark model put it right.
+        0-based index, contours ((x, y) pixels), confidence per feature, lost features, whether
+        the landmark model put it right and, with ``pose``, the head pose.
     overlay
         A video to write as well, ``.mp4`` (H.264) or ``.webm`` (VP9): every frame of ``video``,
         the tracked ones with the contours drawn; None: none.
@@ -125,7 +125,7 @@ def track_video(
                     start_seconds = time.perf_counter() - t0
                 else:
                     result = tracker.update(frame)
-                    face = result.motion_ok and len(result.lost) < len(FEATURES)
+                    face = result.face
                     if follower is not None:
                         follower.update(frame, face_before, face)
                     seconds += time.perf_counter() - t0

@@ -33,6 +33,11 @@ class FrameResult:
     motion_ok: bool = True
     redetected: bool = False
 
+    @property
+    def face(self) -> bool:
+        """Whether the face is still held: its head motion measured and not every feature lost."""
+        return self.motion_ok and len(self.lost) < len(FEATURES)
+
 
 def layout(contours: Mapping[str, np.ndarray], params: TrackerParams) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Shared knot array and each contour's knot indices; mouth corners are shared.
