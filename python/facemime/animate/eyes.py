@@ -159,6 +159,12 @@ class LookPainter:
         self._eyes = [_Eye(actor.texture, model.uv[r] * size - 0.5) for r in self.rings]
         self._work = actor.texture.copy()
 
+    @property
+    def eye_boxes(self) -> list[tuple[int, int, int, int]]:
+        """Each eye's region of the texture that :meth:`texture` repaints: (x0, y0, x1, y1)
+        texels, x1 and y1 exclusive, the rings' order."""
+        return [tuple(int(c) for c in e.box) for e in self._eyes]  # type: ignore[misc]
+
     def vertices(self, vertices: np.ndarray, look: Look) -> np.ndarray:
         """The vertices with the lids closed by a look's closure.
 

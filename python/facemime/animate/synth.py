@@ -16,6 +16,7 @@ import numpy as np
 
 from facemime.animate.deform import Deformer
 from facemime.animate.eyes import LookPainter
+from facemime.animate.samples import SamplePainter
 from facemime.errors import InvalidInputError
 from facemime.render.raster import fill, render_mesh_into
 from facemime.render.scene import SceneMesh
@@ -324,6 +325,9 @@ class Puppet:
         self.shown: tuple[np.ndarray, Pose] | None = None
         self.deformer = Deformer(actor.model)
         self.painter = LookPainter(actor)
+        self.samples = (
+            None if actor.samples is None else SamplePainter(actor.samples, actor.model.groups, self.deformer.knots)
+        )
         sizes = np.asarray(source_sizes, np.float64)
         if sizes.shape != (len(self.deformer.knots),) or not np.isfinite(sizes).all() or (sizes <= 0).any():
             raise InvalidInputError(
@@ -439,7 +443,10 @@ class Puppet:
             RGB, the frame: ``out`` when given.
         """
         vertices, pose = self.vertices(offsets, user, look), self.pose(measured, user)
-        texture = self.painter.texture(Look(look.closure, look.iris * user.gain))
+        shown_look = Look(look.closure * user.gain, look.iris * user.gain)
+        texture = self.painter.texture(shown_look)
+        if self.samples is not None:
+            texture = self.samples.paint(texture, offsets * self._ratio * user.gain, shown_look)
         self.shown = (vertices, pose)
         if self.scene is None:
             return synthesize(self.actor, vertices, pose, size, out=out, texture=texture)

@@ -20,13 +20,14 @@ from facemime.codec.clip import (
     SUFFIX,
     analyse,
     encode_clip,
+    member_bytes,
     read_stream,
-    scene_bytes,
     track_clip,
     with_appearance,
 )
 from facemime.codec.decoder import MotionDecoder
 from facemime.codec.params import Basis
+from facemime.codec.samples import build_samples
 from facemime.codec.stream import LADDER, Settings, StreamError
 from facemime.errors import InvalidInputError
 from facemime.io.actor_file import load_actor
@@ -41,8 +42,9 @@ from facemime.types.head import model_iod
 @dataclass
 class EncodeResult:
     """What :func:`encode_video` wrote: frames, the quality used, bytes of the header (with the
-    basis), of the actor (0 when only named; its scene's image ``scene_bytes`` of them), of the
-    motion (packets), of the appearance updates and how many, and seconds (analysis, coding)."""
+    basis), of the actor (0 when only named; its scene's image ``scene_bytes`` and its sample
+    library ``samples_bytes`` of them), of the motion (packets), of the appearance updates and how
+    many, and seconds (analysis, coding)."""
 
     frames: int
     fps: float
@@ -55,6 +57,7 @@ class EncodeResult:
     scene_bytes: int = 0
     appearance_bytes: int = 0
     appearance_updates: int = 0
+    samples_bytes: int = 0
 
     @property
     def motion_kbit_s(self) -> float:
@@ -76,6 +79,7 @@ def encode_video(
     carry_actor: bool | None = None,
     force: bool = False,
     appearance: float = 0.0,
+    samples: bool = True,
 ) -> EncodeResult:
     """Analyse a video and write its motion as a stream (``docs/bitstream.md``).
 
@@ -104,6 +108,10 @@ def encode_video(
     appearance
         kbit/s for appearance updates (the face's look sent again where it changes), 0 to 1000;
         0: none (a track file has no appearance).
+    samples
+        Send, with the actor the stream carries, a library of the face's own mouth and eyes
+        chosen from the video (:mod:`facemime.codec.samples`); the receiver draws them instead of
+        a drawn mouth interior and moved irises. Ignored for a track file or an actor not carried.
 
     Returns
     -------
@@ -143,6 +151,14 @@ def encode_video(
                 f"the coarsest quality needs {sum(map(len, packets)) * 8 / 1000 / duration:.2f} kbit/s, "
                 f"more than the {rate:g} asked for"
             )
+    if samples and carry and not from_track:
+        decoder = MotionDecoder()
+        decoded = decoder.push(header + actor_chunk + b"".join(packets)) + decoder.finish()
+        assert decoder.actor is not None  # the stream carries it
+        library = build_samples(video, decoder.actor, decoded)
+        if library is not None:
+            clip = replace(clip, actor=replace(clip.actor, samples=library))
+            header, actor_chunk, packets = encode_clip(clip, chosen, carry, basis)
     motion_bytes, updates, sent = sum(map(len, packets)), 0, 0
     if appearance > 0:
         chunks, sender = with_appearance(video, clip, header, actor_chunk, packets, chosen, appearance)
@@ -159,9 +175,10 @@ def encode_video(
         motion_bytes,
         seconds,
         warnings,
-        scene_bytes(actor_chunk),
+        member_bytes(actor_chunk, "scene."),
         sent,
         updates,
+        member_bytes(actor_chunk, "samples"),
     )
 
 

@@ -43,6 +43,12 @@ from facemime.cli.app import actor_option, cli, force_option, mask_only_option, 
     show_default=True,
     help="kbit/s for sending the face's appearance again where it changes (light, skin); 0: never.",
 )
+@click.option(
+    "--samples/--no-samples",
+    default=True,
+    show_default=True,
+    help="Send with the actor a library of the face's own mouth and eyes taken from VIDEO (about 30 kB once).",
+)
 @out_option("X.fmstream to write.")
 @force_option
 def encode(
@@ -54,6 +60,7 @@ def encode(
     packet: float,
     embed_actor: bool,
     appearance: float,
+    samples: bool,
     out_file: Path,
     force: bool,
 ) -> None:
@@ -67,11 +74,14 @@ def encode(
     if quality is not None and rate is not None:
         raise InvalidInputError("give --quality or --rate, not both")
     settings = Settings(quality=DEFAULT_QUALITY if quality is None else quality, keyframe=keyframe, packet=packet)
-    result = encode_video(video, out_file, actor_file, settings, rate, True if embed_actor else None, force, appearance)
+    result = encode_video(
+        video, out_file, actor_file, settings, rate, True if embed_actor else None, force, appearance, samples
+    )
     for w in result.warnings:
         click.echo(f"facemime: warning: {w}", err=True)
     click.echo(str(out_file))
     scene = f", its scene {result.scene_bytes} of them" if result.scene_bytes else ""
+    scene += f", its mouth and eye samples {result.samples_bytes}" if result.samples_bytes else ""
     actor = (
         f"the actor {result.actor_bytes} bytes once{scene}" if result.actor_bytes else f"the actor named ({actor_file})"
     )

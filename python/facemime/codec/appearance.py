@@ -29,13 +29,12 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from facemime.render.paste import BLEND, paste_faded
 from facemime.render.raster import render_mesh_into
 from facemime.shared_constants import EYES
 from facemime.types.head import HeadModel
 from facemime.types.pose import Pose, project, rotation_matrix
 
-#: Texels over which an update's edges fade into the texture (the spec's B).
-BLEND = 8
 #: Frames between two looks at the face, texels per side of a compared block, the mean grey
 #: difference (levels) above which a block is sent again, seconds of budget the bucket holds,
 #: WebP quality of an update, and halvings of the block set tried before giving up for now.
@@ -113,11 +112,7 @@ def parse(payload: bytes) -> Update | None:
 
 def paste(texture: np.ndarray, update: Update) -> bool:
     """Paste an update into a texture, its edges blended as the spec says (``docs/bitstream.md``,
-    "Appearance (version 2)").
-
-    A texel at distance d (texels) from the nearest edge of the update that is not on or beyond
-    the texture's border weighs k / 8, k = min(8, d + 1), and becomes
-    ``(k * u + (8 - k) * t + 4) // 8``; the update's texels beyond the texture are ignored.
+    "Appearance (version 2)"; :func:`facemime.render.paste.paste_faded`).
 
     Parameters
     ----------
@@ -131,22 +126,7 @@ def paste(texture: np.ndarray, update: Update) -> bool:
     bool
         False (texture untouched) when the update lies wholly outside the texture, else True.
     """
-    h, w = texture.shape[:2]
-    uh, uw = update.image.shape[:2]
-    x1, y1 = min(update.x + uw, w), min(update.y + uh, h)
-    if update.x >= w or update.y >= h:
-        return False
-    far = np.full(max(uw, uh), BLEND)
-    i, j = np.arange(uw), np.arange(uh)
-    d = np.minimum(
-        np.minimum(j if update.y > 0 else far[:uh], uh - 1 - j if update.y + uh < h else far[:uh])[:, None],
-        np.minimum(i if update.x > 0 else far[:uw], uw - 1 - i if update.x + uw < w else far[:uw])[None, :],
-    )
-    k = np.minimum(BLEND, d + 1)[: y1 - update.y, : x1 - update.x, None].astype(np.int32)
-    u = update.image[: y1 - update.y, : x1 - update.x].astype(np.int32)
-    t = texture[update.y : y1, update.x : x1].astype(np.int32)
-    texture[update.y : y1, update.x : x1] = ((k * u + (BLEND - k) * t + BLEND // 2) // BLEND).astype(np.uint8)
-    return True
+    return paste_faded(texture, update.image, update.x, update.y)
 
 
 def lay_back(
@@ -212,9 +192,14 @@ class AppearanceSender:
         The updates' rate, at most, kbit/s (chunk framing included).
     fps
         The video's frame rate, frames/s.
+    keep_out
+        (R, 4) rectangles never sent (x, y, width, height, texels): the actor's sample boxes,
+        which the receiver paints over; None: none.
     """
 
-    def __init__(self, model: HeadModel, texture: np.ndarray, budget: float, fps: float):
+    def __init__(
+        self, model: HeadModel, texture: np.ndarray, budget: float, fps: float, keep_out: np.ndarray | None = None
+    ):
         self.model, self.texture = model, texture.copy()
         self._per_frame = budget * 1000.0 / fps
         self._cap = budget * 1000.0 * WINDOW
@@ -238,6 +223,8 @@ class AppearanceSender:
             ring = np.round((model.uv[model.groups[e]] * [w, h] - 0.5) * 16).astype(np.int32)
             cv2.fillPoly(self._eyes, [ring], 255, cv2.LINE_AA, 4)
         grow = 2 * BLEND + 1
+        for x, y, bw, bh in () if keep_out is None else keep_out:
+            self._eyes[y : y + bh, x : x + bw] = 255
         self._eyes = cv2.dilate(self._eyes, np.ones((grow, grow), np.uint8))
         self.updates = 0
 

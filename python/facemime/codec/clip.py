@@ -221,7 +221,8 @@ def with_appearance(
     decoded = decoder.push(header + actor_chunk + b"".join(packets)) + decoder.finish()
     held = decoder.actor  # the actor as the receiver holds it: its texture as the stream carries it
     puppet = Puppet(held, Deformer(held.model).feature_sizes(), model_iod(held.model), mask_only=True)
-    sender = AppearanceSender(held.model, held.texture, budget, clip.fps)
+    boxes = None if held.samples is None else np.vstack([g.boxes for g in held.samples.groups])
+    sender = AppearanceSender(held.model, held.texture, budget, clip.fps, boxes)
     per_packet = settings.framing(clip.fps)[0]
     before: dict[int, list[bytes]] = {}
     with VideoReader(video) as reader:
@@ -233,19 +234,22 @@ def with_appearance(
     return [c for k, p in enumerate(packets) for c in before.get(k, []) + [p]], sender
 
 
-def scene_bytes(actor_chunk: bytes) -> int:
-    """Bytes of the scene image inside a stream's actor chunk.
+def member_bytes(actor_chunk: bytes, prefix: str) -> int:
+    """Bytes of some members of the actor file inside a stream's actor chunk.
 
     Parameters
     ----------
     actor_chunk
         The whole chunk (``docs/bitstream.md``, "Chunks" and "Actor": tag, seq, LEB128 length,
         payload = the actor file, CRC-32), or b"".
+    prefix
+        The members counted: those whose names start with it (``"scene."``: the scene's image;
+        ``"samples"``: the sample library).
 
     Returns
     -------
     int
-        The scene's compressed bytes in the actor file; 0 without a chunk or a scene.
+        Their compressed bytes in the actor file; 0 without a chunk or such members.
     """
     if not actor_chunk:
         return 0
@@ -253,7 +257,7 @@ def scene_bytes(actor_chunk: bytes) -> int:
     while actor_chunk[at] & 0x80:  # the length's bytes
         at += 1
     with zipfile.ZipFile(io.BytesIO(actor_chunk[at + 1 : -4])) as z:
-        return sum(i.compress_size for i in z.infolist() if i.filename.startswith("scene."))
+        return sum(i.compress_size for i in z.infolist() if i.filename.startswith(prefix))
 
 
 def read_stream(path: str | Path) -> bytes:

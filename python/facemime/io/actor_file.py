@@ -12,6 +12,8 @@ The file is a ZIP archive of two or three members and nothing executable:
   ``actor.json``: the whole source picture the face is synthesised in
   (:mod:`facemime.render.scene`). Files written before scenes existed have none, and their face
   is shown alone.
+- optionally the actor's sample library of its own mouth and eyes: ``samples.json`` and
+  ``samples/...`` (:mod:`facemime.io.samples_file`).
 
 Loading reads only those members, refuses oversized ones before reading them, parses JSON
 and PNG (no pickle, no code) and validates every array, so a corrupt, truncated, foreign or
@@ -34,6 +36,7 @@ import numpy as np
 from facemime.errors import FacemimeError, InputFileError, InvalidInputError, ModelFormatError
 from facemime.io.head_file import head_document, head_from_document
 from facemime.io.outputs import OutputFileError, check_outputs, write_bytes
+from facemime.io.samples_file import SAMPLE_QUALITY, SAMPLES_JSON, samples_from_members, samples_members
 from facemime.limits import image_size, limit, parse_json, pose_in_range
 from facemime.types.actor import Actor
 from facemime.types.pose import Pose
@@ -85,7 +88,7 @@ def actor_json(actor: Actor) -> bytes:
     return json.dumps(doc).encode()
 
 
-def actor_bytes(actor: Actor, texture: str = "png", quality: int = 90) -> bytes:
+def actor_bytes(actor: Actor, texture: str = "png", quality: int = 90, sample_quality: int = SAMPLE_QUALITY) -> bytes:
     """``actor`` as the bytes of an actor file (a ZIP archive, see the module docstring).
 
     Parameters
@@ -97,6 +100,8 @@ def actor_bytes(actor: Actor, texture: str = "png", quality: int = 90) -> bytes:
         ``"webp"`` (the smaller form a stream carries).
     quality
         WebP quality, 1-100; PNG is lossless and ignores it.
+    sample_quality
+        WebP quality of the sample library's images (the texture's ``"webp"`` form only).
 
     Returns
     -------
@@ -111,6 +116,14 @@ def actor_bytes(actor: Actor, texture: str = "png", quality: int = 90) -> bytes:
             if image is not None:
                 data = _encoded(image, what, texture, quality)
                 z.writestr(zipfile.ZipInfo(f"{what}.{texture}"), data, zipfile.ZIP_STORED)
+        if actor.samples is not None:
+            members = samples_members(
+                actor.samples, texture, lambda im: _encoded(im, "samples", texture, sample_quality)
+            )
+            for name, data in members.items():
+                z.writestr(
+                    zipfile.ZipInfo(name), data, zipfile.ZIP_DEFLATED if name == SAMPLES_JSON else zipfile.ZIP_STORED
+                )
     return buf.getvalue()
 
 
@@ -228,6 +241,16 @@ def actor_from_bytes(source: str | Path | bytes, where: str) -> Actor:
             image = _member(z, member, MAX_TEXTURE_BYTES, where)
             scene_member = next((name for name in SCENES if name in names), None)
             scene = None if scene_member is None else _member(z, scene_member, MAX_TEXTURE_BYTES, where)
+            samples = None
+            if SAMPLES_JSON in names:
+                try:
+                    samples = samples_from_members(
+                        _member(z, SAMPLES_JSON, MAX_JSON_BYTES, where),
+                        lambda name: _member(z, name, MAX_TEXTURE_BYTES, where) if name in names else None,
+                        where,
+                    )
+                except InvalidInputError as e:
+                    raise ActorFileError(str(e)) from None
     except (zipfile.BadZipFile, EOFError, zipfile.LargeZipFile, NotImplementedError, zlib.error) as e:
         raise ActorFileError(f"{where}: not a facemime actor file, or truncated ({e})") from None
     except RuntimeError:  # zipfile's word for a member marked encrypted
@@ -276,7 +299,7 @@ def actor_from_bytes(source: str | Path | bytes, where: str) -> Actor:
     if scene_image is not None:
         _check_scene_source(source, scene_image, where)
     try:
-        return Actor(model, texture, pose, source, points, scene_image)
+        return Actor(model, texture, pose, source, points, scene_image, samples)
     except InvalidInputError as e:
         raise ActorFileError(f"{where}: malformed actor ({e})") from None
 

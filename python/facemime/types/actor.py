@@ -16,6 +16,7 @@ from facemime.errors import InvalidInputError
 from facemime.types.head import HeadModel
 from facemime.types.points import ReferencePoints
 from facemime.types.pose import Pose
+from facemime.types.samples import Samples
 
 
 @dataclass(frozen=True, eq=False)
@@ -38,6 +39,10 @@ class Actor:
         RGB, the whole source photo (shrunk to at most :data:`facemime.fit.actor.SCENE_MAX_SIDE` pixels a side):
         the picture the face is synthesised in (:mod:`facemime.render.scene`); None for an
         actor without one (the face is then shown alone).
+    samples : Samples or None
+        The actor's own mouth and eyes as frames of a clip showed them
+        (:mod:`facemime.types.samples`); None: the mouth's interior is drawn and the irises are
+        moved in the texture.
     """
 
     model: HeadModel
@@ -46,6 +51,7 @@ class Actor:
     source: dict = field(default_factory=dict)
     points: ReferencePoints = field(default_factory=dict)
     scene: np.ndarray | None = None
+    samples: Samples | None = None
 
     def __post_init__(self) -> None:
         for name, t in (("texture", self.texture), ("scene", self.scene)):
@@ -67,3 +73,8 @@ class Actor:
             raise InvalidInputError("an actor with a scene needs its source picture's width and height")
         if self.model.uv is None:
             raise InvalidInputError("actor model needs texture coordinates (uv)")
+        if self.samples is not None:
+            h, w = self.texture.shape[:2]
+            for g in self.samples.groups:
+                if ((g.boxes[:, 0] + g.boxes[:, 2]) > w).any() or ((g.boxes[:, 1] + g.boxes[:, 3]) > h).any():
+                    raise InvalidInputError(f"sample group {g.name!r} has a box outside the {w}x{h} texture")

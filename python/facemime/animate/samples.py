@@ -1,0 +1,154 @@
+"""The actor's own mouth and eyes in the synthesis: per frame, each sample group's sample whose
+shape is nearest the frame's is pasted into the texture (:mod:`facemime.types.samples`).
+
+The nearest sample: the smallest Euclidean distance between keys, the look's iris shifts weighed
+:data:`IRIS_WEIGHT` times its lid closures (an iris shift of a tenth of the eye's width looks as
+different as a lid a half closed); the mouth's key is its knots' offsets, model units. The key
+frame itself is a sample of every group, at key zero, that pastes nothing: where the frame's shape
+is nearer the key frame's than any sample's, the texture is drawn as it is (the irises moved by
+:class:`~facemime.animate.eyes.LookPainter` as without samples). A sample is pasted with its edges
+faded into the texture over :data:`~facemime.render.paste.BLEND` texels
+(:func:`~facemime.render.paste.paste_faded`), so that no seam shows.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from facemime.render.paste import paste_faded
+from facemime.shared_constants import LOOK_NAMES
+from facemime.types.look import Look
+from facemime.types.samples import Samples
+
+#: The weight of the iris shifts (eye widths) against the lid closures (shares of the opening) in
+#: the eyes' distance.
+IRIS_WEIGHT = 5.0
+#: The head model's groups whose knots key the mouth's samples.
+MOUTH_GROUPS = ("mouth_outer_upper", "mouth_outer_lower", "mouth_inner_upper", "mouth_inner_lower")
+
+
+def weigh_eyes(keys: np.ndarray) -> np.ndarray:
+    """Eye keys weighed for distances.
+
+    Parameters
+    ----------
+    keys
+        (..., 6) float array: look vectors (:data:`~facemime.shared_constants.LOOK_NAMES`' order).
+
+    Returns
+    -------
+    (..., 6) float64 array
+        The same, the iris shifts multiplied by :data:`IRIS_WEIGHT`.
+    """
+    return np.asarray(keys, np.float64) * np.where(np.arange(len(LOOK_NAMES)) < 2, 1.0, IRIS_WEIGHT)
+
+
+def mouth_knots(groups: dict[str, np.ndarray], knots: np.ndarray) -> np.ndarray:
+    """Which knots key the mouth's samples.
+
+    Parameters
+    ----------
+    groups
+        The head model's vertex groups.
+    knots
+        (K,) the model's knots' vertex indices (:attr:`facemime.animate.deform.Deformer.knots`).
+
+    Returns
+    -------
+    (K,) bool array
+        True for the knots on the lips.
+    """
+    return np.isin(knots, np.concatenate([groups[g] for g in MOUTH_GROUPS]))
+
+
+def nearest(keys: np.ndarray, key: np.ndarray) -> int | None:
+    """The sample nearest a shape, or None where the key frame is nearer.
+
+    Parameters
+    ----------
+    keys
+        (S, D) float array: the samples' keys, as weighed for distances.
+    key
+        (D,) float array: the frame's key, weighed the same way.
+
+    Returns
+    -------
+    int or None
+        The index of the nearest sample (the first of equals); None when the key frame (key zero)
+        is at least as near.
+    """
+    d = np.linalg.norm(keys - key, axis=1)
+    k = int(np.argmin(d))
+    return None if np.linalg.norm(key) <= d[k] else k
+
+
+class SamplePainter:
+    """Pastes an actor's samples into its texture, frame by frame.
+
+    Parameters
+    ----------
+    samples
+        The actor's sample library.
+    groups
+        The actor's head model's vertex groups.
+    knots
+        (K,) the model's knots' vertex indices (:attr:`facemime.animate.deform.Deformer.knots`).
+    """
+
+    def __init__(self, samples: Samples, groups: dict[str, np.ndarray], knots: np.ndarray):
+        self.samples = samples
+        self._mouth = mouth_knots(groups, knots)
+        self._keys = {g.name: weigh_eyes(g.keys) if g.name == "eyes" else g.keys for g in samples.groups}
+        self._work: np.ndarray | None = None
+
+    def choose(self, offsets: np.ndarray, look: Look) -> dict[str, int | None]:
+        """Each group's sample for a frame's shape.
+
+        Parameters
+        ----------
+        offsets
+            (K, 2) float array: the frame's knot offsets in the actor's model units.
+        look
+            The frame's look.
+
+        Returns
+        -------
+        dict of str -> int or None
+            Group name -> the sample pasted (None: the key frame's, nothing pasted).
+        """
+        frame_keys = {"eyes": weigh_eyes(look.vector()), "mouth": np.asarray(offsets, np.float64)[self._mouth].ravel()}
+        return {
+            name: nearest(keys, frame_keys[name]) if keys.shape[1] == len(frame_keys[name]) else None
+            for name, keys in self._keys.items()
+        }
+
+    def paint(self, texture: np.ndarray, offsets: np.ndarray, look: Look) -> np.ndarray:
+        """The texture with the frame's samples pasted in.
+
+        Parameters
+        ----------
+        texture
+            (H, W, 3) uint8 RGB: the texture the frame is drawn with otherwise (not changed).
+        offsets
+            (K, 2) float array: the frame's knot offsets in the actor's model units.
+        look
+            The frame's look.
+
+        Returns
+        -------
+        (H, W, 3) uint8 array
+            ``texture`` itself when no sample is pasted, else a working copy with the samples,
+            valid until the next call.
+        """
+        chosen = self.choose(offsets, look)
+        if all(k is None for k in chosen.values()):
+            return texture
+        if self._work is None or self._work.shape != texture.shape:
+            self._work = np.empty_like(texture)
+        np.copyto(self._work, texture)
+        for group in self.samples.groups:
+            k = chosen[group.name]
+            if k is not None:
+                for (x, y, _, _), image in zip(group.boxes, group.images[k]):
+                    paste_faded(self._work, image, int(x), int(y))
+        return self._work

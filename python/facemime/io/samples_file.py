@@ -1,0 +1,153 @@
+"""An actor's sample library (:mod:`facemime.types.samples`) as members of its ``.actor`` file.
+
+- ``samples.json``: ``{"format": "facemime.samples/1", "groups": [{"name": "eyes" | "mouth",
+  "boxes": [[x, y, width, height], ...] (texels of the actor's texture), "samples": [{"frame": F,
+  "key": [...]}, ...]}, ...]}``;
+- ``samples/<group>/<sample>_<box>.png`` (or ``.webp``, in a stream): each sample's image of
+  each box, RGB, the box's size.
+
+The member is absent from actors without samples; ``actor.json`` does not mention it, so an
+actor's id (the SHA-256 of ``actor.json``) is the same with or without its samples.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+
+import cv2
+import numpy as np
+
+from facemime.errors import InvalidInputError
+from facemime.limits import parse_json
+from facemime.types.samples import SampleGroup, Samples
+
+SAMPLES_FORMAT = "facemime.samples/1"
+#: The library's description member.
+SAMPLES_JSON = "samples.json"
+#: WebP quality of the samples' images in a stream (the library's size is chosen at it).
+SAMPLE_QUALITY = 70
+#: At most this many samples a group, and boxes a group.
+MAX_SAMPLES = 64
+MAX_BOXES = 4
+
+
+def image_name(group: str, sample: int, box: int, kind: str) -> str:
+    """The member holding one sample's image of one box.
+
+    Parameters
+    ----------
+    group
+        The group's name.
+    sample
+        The sample's index in the group.
+    box
+        The box's index in the group.
+    kind
+        ``"png"`` or ``"webp"``.
+
+    Returns
+    -------
+    str
+        ``samples/<group>/<sample>_<box>.<kind>``.
+    """
+    return f"samples/{group}/{sample}_{box}.{kind}"
+
+
+def samples_members(samples: Samples, kind: str, encode: Callable[[np.ndarray], bytes]) -> dict[str, bytes]:
+    """The members that store a library.
+
+    Parameters
+    ----------
+    samples
+        The library.
+    kind
+        How the images are encoded, ``"png"`` or ``"webp"`` (names their members).
+    encode
+        Encodes one RGB image as ``kind``.
+
+    Returns
+    -------
+    dict of str -> bytes
+        Member name -> content: :data:`SAMPLES_JSON` first, then the images.
+    """
+    doc = {
+        "format": SAMPLES_FORMAT,
+        "groups": [
+            {
+                "name": g.name,
+                "boxes": g.boxes.astype(int).tolist(),
+                "samples": [
+                    {"frame": int(f), "key": [round(float(v), 6) for v in k]} for f, k in zip(g.frames, g.keys)
+                ],
+            }
+            for g in samples.groups
+        ],
+    }
+    out = {SAMPLES_JSON: json.dumps(doc, separators=(",", ":")).encode()}
+    for g in samples.groups:
+        for s, images in enumerate(g.images):
+            for b, image in enumerate(images):
+                out[image_name(g.name, s, b, kind)] = encode(image)
+    return out
+
+
+def samples_from_members(text: bytes, read: Callable[[str], bytes | None], where: str) -> Samples:
+    """A library from its members.
+
+    Parameters
+    ----------
+    text
+        The content of :data:`SAMPLES_JSON`.
+    read
+        Reads a member by name (bounded in size); None when the file has no such member.
+    where
+        Names the file in error messages.
+
+    Returns
+    -------
+    Samples
+        The library. A malformed one raises :class:`~facemime.errors.InvalidInputError` naming
+        ``where`` and the problem.
+    """
+    try:
+        doc = parse_json(text, f"{where}: {SAMPLES_JSON}")
+    except (UnicodeDecodeError, ValueError) as e:
+        raise InvalidInputError(f"{where}: {SAMPLES_JSON} is not valid JSON ({e})") from None
+    if not isinstance(doc, dict) or doc.get("format") != SAMPLES_FORMAT or not isinstance(doc.get("groups"), list):
+        raise InvalidInputError(f"{where}: {SAMPLES_JSON} is not a {SAMPLES_FORMAT!r} document")
+    groups = []
+    for g in doc["groups"]:
+        try:
+            name = str(g["name"])
+            boxes = np.asarray(g["boxes"])
+            entries = g["samples"]
+            if boxes.dtype.kind not in "iu" or boxes.ndim != 2 or not 1 <= len(boxes) <= MAX_BOXES:
+                raise ValueError(f"boxes must be 1-{MAX_BOXES} rows of 4 integers")
+            if not isinstance(entries, list) or not 1 <= len(entries) <= MAX_SAMPLES:
+                raise ValueError(f"a group holds 1-{MAX_SAMPLES} samples")
+            keys = np.array([np.asarray(e["key"], np.float64) for e in entries])
+            frames = np.array([int(e["frame"]) for e in entries], np.int64)
+        except (KeyError, TypeError, ValueError, OverflowError) as e:
+            raise InvalidInputError(f"{where}: malformed sample group in {SAMPLES_JSON} ({e})") from None
+        images = [[_image(read, name, s, b, where) for b in range(len(boxes))] for s in range(len(entries))]
+        try:
+            groups.append(SampleGroup(name, boxes.astype(np.int64), images, keys, frames))
+        except InvalidInputError as e:
+            raise InvalidInputError(f"{where}: {e}") from None
+    try:
+        return Samples(tuple(groups))
+    except InvalidInputError as e:
+        raise InvalidInputError(f"{where}: {e}") from None
+
+
+def _image(read: Callable[[str], bytes | None], group: str, sample: int, box: int, where: str) -> np.ndarray:
+    """One sample image, PNG or WebP, as RGB."""
+    for kind in ("png", "webp"):
+        data = read(image_name(group, sample, box, kind))
+        if data is not None:
+            image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
+            if image is None or image.ndim != 3:
+                raise InvalidInputError(f"{where}: sample image {image_name(group, sample, box, kind)} does not decode")
+            return cv2.cvtColor(image, cv2.COLOR_BGR2RGB)
+    raise InvalidInputError(f"{where}: sample {sample} of group {group!r} has no image of box {box}")

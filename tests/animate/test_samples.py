@@ -1,0 +1,63 @@
+"""The actor's own mouth and eyes: the nearest sample is pasted, the key frame's shape pastes none."""
+
+import numpy as np
+import pytest
+
+from facemime.animate.samples import IRIS_WEIGHT, SamplePainter, nearest, weigh_eyes
+from facemime.errors import InvalidInputError
+from facemime.types.look import Look
+from facemime.types.samples import SampleGroup, Samples
+
+
+def test_nearest_picks_the_exact_sample_at_its_own_key_and_none_at_the_key_frames():
+    keys = np.array([[1.0, 0.0], [0.0, 2.0], [1.0, 0.0]])
+    assert nearest(keys, np.array([0.0, 2.0])) == 1
+    assert nearest(keys, np.array([1.0, 0.0])) == 0  # the first of equals
+    assert nearest(keys, np.zeros(2)) is None  # the key frame itself
+    assert nearest(keys, np.array([0.3, 0.0])) is None  # nearer the key frame than any sample
+    assert nearest(keys, np.array([0.7, 0.0])) == 0
+
+
+def test_the_irises_weigh_more_than_the_lids():
+    w = weigh_eyes(np.ones(6))
+    assert w.tolist() == [1.0, 1.0] + [IRIS_WEIGHT] * 4
+
+
+def _painter(texture_shape=(40, 60)):
+    boxes = np.array([[2, 2, 24, 18], [32, 2, 24, 18]])
+    eyes = SampleGroup(
+        "eyes",
+        boxes,
+        [[np.full((18, 24, 3), 200, np.uint8)] * 2, [np.full((18, 24, 3), 50, np.uint8)] * 2],
+        np.array([[1.0, 1.0, 0, 0, 0, 0], [0.0, 0.0, 0.1, 0, 0.1, 0]]),
+        np.array([3, 7]),
+    )
+    groups = {"mouth_outer_upper": np.array([0]), "mouth_outer_lower": np.array([1]),
+              "mouth_inner_upper": np.array([0]), "mouth_inner_lower": np.array([1])}  # fmt: skip
+    return SamplePainter(Samples((eyes,)), groups, np.array([0, 1, 5]))
+
+
+def test_a_closed_eye_look_pastes_the_closed_eye_sample_and_nothing_outside_its_boxes():
+    painter = _painter()
+    texture = np.full((40, 60, 3), 100, np.uint8)
+    out = painter.paint(texture, np.zeros((3, 2)), Look(closure=[0.9, 1.0]))
+    assert out is not texture and (texture == 100).all()  # the texture given is left alone
+    assert out[10, 14].tolist() == [200, 200, 200] and out[10, 44].tolist() == [200, 200, 200]  # inside, past the fade
+    assert out[30, 30].tolist() == [100, 100, 100]
+    assert 100 < out[2, 14, 0] < 200  # the box's edge fades into the texture
+    looked_aside = painter.paint(texture, np.zeros((3, 2)), Look(iris=[[0.09, 0.0], [0.11, 0.0]]))
+    assert looked_aside[10, 14].tolist() == [50, 50, 50]
+
+
+def test_the_key_frames_look_draws_the_texture_as_it_is():
+    texture = np.full((40, 60, 3), 100, np.uint8)
+    assert _painter().paint(texture, np.zeros((3, 2)), Look()) is texture
+
+
+def test_a_group_needs_an_image_of_each_box_and_six_values_for_an_eye_key():
+    with pytest.raises(InvalidInputError, match="image of each box"):
+        SampleGroup("eyes", np.array([[0, 0, 4, 4]]), [[np.zeros((3, 4, 3), np.uint8)]], np.zeros((1, 6)), np.zeros(1))
+    with pytest.raises(InvalidInputError, match="6 values"):
+        SampleGroup("eyes", np.array([[0, 0, 4, 4]]), [[np.zeros((4, 4, 3), np.uint8)]], np.zeros((1, 5)), np.zeros(1))
+    with pytest.raises(InvalidInputError, match="one of"):
+        SampleGroup("nose", np.array([[0, 0, 4, 4]]), [[np.zeros((4, 4, 3), np.uint8)]], np.zeros((1, 6)), np.zeros(1))
