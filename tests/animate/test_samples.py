@@ -40,18 +40,20 @@ def _painter(texture_shape=(40, 60)):
 def test_a_closed_eye_look_pastes_the_closed_eye_sample_and_nothing_outside_its_boxes():
     painter = _painter()
     texture = np.full((40, 60, 3), 100, np.uint8)
-    out = painter.paint(texture, np.zeros((3, 2)), Look(closure=[0.9, 1.0]))
+    out, interior = painter.paint(texture, np.zeros((3, 2)), Look(closure=[0.9, 1.0]))
+    assert interior is None  # no mouth samples
     assert out is not texture and (texture == 100).all()  # the texture given is left alone
     assert out[10, 14].tolist() == [200, 200, 200] and out[10, 44].tolist() == [200, 200, 200]  # inside, past the fade
     assert out[30, 30].tolist() == [100, 100, 100]
     assert 100 < out[2, 14, 0] < 200  # the box's edge fades into the texture
-    looked_aside = painter.paint(texture, np.zeros((3, 2)), Look(iris=[[0.09, 0.0], [0.11, 0.0]]))
+    looked_aside, _ = painter.paint(texture, np.zeros((3, 2)), Look(iris=[[0.09, 0.0], [0.11, 0.0]]))
     assert looked_aside[10, 14].tolist() == [50, 50, 50]
 
 
 def test_the_key_frames_look_draws_the_texture_as_it_is():
     texture = np.full((40, 60, 3), 100, np.uint8)
-    assert _painter().paint(texture, np.zeros((3, 2)), Look()) is texture
+    out, interior = _painter().paint(texture, np.zeros((3, 2)), Look())
+    assert out is texture and interior is None
 
 
 def test_a_group_needs_an_image_of_each_box_and_six_values_for_an_eye_key():
@@ -61,3 +63,23 @@ def test_a_group_needs_an_image_of_each_box_and_six_values_for_an_eye_key():
         SampleGroup("eyes", np.array([[0, 0, 4, 4]]), [[np.zeros((4, 4, 3), np.uint8)]], np.zeros((1, 5)), np.zeros(1))
     with pytest.raises(InvalidInputError, match="one of"):
         SampleGroup("nose", np.array([[0, 0, 4, 4]]), [[np.zeros((4, 4, 3), np.uint8)]], np.zeros((1, 6)), np.zeros(1))
+
+
+def test_an_open_mouth_shows_the_samples_interior_between_the_lips_instead_of_drawn_teeth():
+    from facemime.animate.samples import interior_strip
+    from facemime.animate.synth import synthesize
+    from facemime.fit.actor import generic_actor
+
+    actor = generic_actor((256, 256))
+    model = actor.model
+    vertices = model.vertices.copy()
+    lower = model.groups["mouth_inner_lower"][1:-1]  # the corners stay
+    vertices[lower, 1] -= 0.15 * np.ptp(model.vertices[:, 1])  # the mouth opens wide
+    green = np.zeros((40, 96, 3), np.uint8)
+    green[..., 1] = 255
+    drawn = synthesize(actor, vertices, actor.pose, (256, 256))
+    sampled = synthesize(actor, vertices, actor.pose, (256, 256), interior=(green, *interior_strip(model)))
+    is_green = (sampled[..., 1] > 200) & (sampled[..., 0] < 60) & (sampled[..., 2] < 60)
+    assert is_green.sum() > 100  # the opening shows the sample
+    assert not ((drawn[..., 1] > 200) & (drawn[..., 0] < 60)).any()
+    assert (sampled[~is_green] == drawn[~is_green]).mean() > 0.97  # the rest of the face is as drawn

@@ -34,6 +34,7 @@ def test_the_stream_carries_a_library_of_both_groups_within_30_kB(coded):
     result, decoder, _ = coded[True]
     library = decoder.actor.samples
     assert [g.name for g in library.groups] == ["eyes", "mouth"]
+    assert any(i is not None for i in library.group("mouth").interiors)  # she talks: open mouths
     assert 0 < result.samples_bytes <= 30_000
     assert coded[False][1].actor.samples is None and coded[False][0].samples_bytes == 0
 
@@ -80,6 +81,8 @@ def test_an_actor_file_keeps_its_samples_and_its_id(coded):
     for a, b in zip(actor.samples.groups, again.samples.groups):
         assert a.name == b.name and (a.boxes == b.boxes).all() and np.allclose(a.keys, b.keys, atol=1e-6)
         assert all((x == y).all() for s, t in zip(a.images, b.images) for x, y in zip(s, t))  # PNG: lossless
+        assert [i is None for i in a.interiors or []] == [i is None for i in b.interiors or []]
+        assert all((x == y).all() for x, y in zip(a.interiors or [], b.interiors or []) if x is not None)
     assert actor_id(actor) == actor_id(replace(actor, samples=None))
     assert actor_from_bytes(actor_bytes(replace(actor, samples=None)), "plain").samples is None
 

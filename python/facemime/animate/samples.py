@@ -9,6 +9,12 @@ is nearer the key frame's than any sample's, the texture is drawn as it is (the 
 :class:`~facemime.animate.eyes.LookPainter` as without samples). A sample is pasted with its edges
 faded into the texture over :data:`~facemime.render.paste.BLEND` texels
 (:func:`~facemime.render.paste.paste_faded`), so that no seam shows.
+
+A mouth sample taken from an open mouth also holds its *interior*: the opening between the inner
+lips, laid out on a rectangle (:func:`interior_uv`: the upper inner lip along its top edge, the
+lower along its bottom, corner to corner left to right). Where the chosen sample has one, the
+synthesis draws the opening from it, stretched between the frame's inner lips
+(:func:`interior_strip`), instead of a drawn cavity and teeth.
 """
 
 from __future__ import annotations
@@ -17,14 +23,59 @@ import numpy as np
 
 from facemime.render.paste import paste_faded
 from facemime.shared_constants import LOOK_NAMES
+from facemime.types.head import HeadModel, lip_strip
 from facemime.types.look import Look
 from facemime.types.samples import Samples
 
 #: The weight of the iris shifts (eye widths) against the lid closures (shares of the opening) in
 #: the eyes' distance.
 IRIS_WEIGHT = 5.0
+#: The interior image's (width, height), texels.
+INTERIOR_SIZE = (96, 40)
 #: The head model's groups whose knots key the mouth's samples.
 MOUTH_GROUPS = ("mouth_outer_upper", "mouth_outer_lower", "mouth_inner_upper", "mouth_inner_lower")
+
+
+def interior_uv(model: HeadModel) -> np.ndarray:
+    """Where the inner lips' vertices lie on the interior image.
+
+    Parameters
+    ----------
+    model
+        The head, with the inner lips' groups.
+
+    Returns
+    -------
+    (N, 2) float64 array
+        Per vertex of the model, (u, v) in [0, 1] of the interior image from its top-left corner:
+        knot i of the K on the upper inner lip at (i / (K - 1), 0), on the lower at
+        (i / (K - 1), 1), one on both (a corner) at (i / (K - 1), 0.5); 0 for the other vertices.
+    """
+    uv = np.zeros((len(model.vertices), 2))
+    upper, lower = model.groups["mouth_inner_upper"], model.groups["mouth_inner_lower"]
+    for curve, v in ((upper, 0.0), (lower, 1.0)):
+        uv[curve] = np.column_stack([np.linspace(0.0, 1.0, len(curve)), np.full(len(curve), v)])
+    shared = np.intersect1d(upper, lower)
+    uv[shared, 1] = 0.5
+    return uv
+
+
+def interior_strip(model: HeadModel) -> tuple[np.ndarray, np.ndarray]:
+    """The mesh an interior image is drawn on.
+
+    Parameters
+    ----------
+    model
+        The head, with the inner lips' groups.
+
+    Returns
+    -------
+    uv : (N, 2) float64 array
+        :func:`interior_uv`.
+    triangles : (M, 3) int64 array
+        The strip between the inner lips (:func:`~facemime.types.head.lip_strip`).
+    """
+    return interior_uv(model), lip_strip(model)
 
 
 def weigh_eyes(keys: np.ndarray) -> np.ndarray:
@@ -122,8 +173,8 @@ class SamplePainter:
             for name, keys in self._keys.items()
         }
 
-    def paint(self, texture: np.ndarray, offsets: np.ndarray, look: Look) -> np.ndarray:
-        """The texture with the frame's samples pasted in.
+    def paint(self, texture: np.ndarray, offsets: np.ndarray, look: Look) -> tuple[np.ndarray, np.ndarray | None]:
+        """The texture with the frame's samples pasted in, and the mouth's interior.
 
         Parameters
         ----------
@@ -136,13 +187,18 @@ class SamplePainter:
 
         Returns
         -------
-        (H, W, 3) uint8 array
+        texture : (H, W, 3) uint8 array
             ``texture`` itself when no sample is pasted, else a working copy with the samples,
             valid until the next call.
+        interior : (h, w, 3) uint8 array or None
+            The chosen mouth sample's interior (:func:`interior_uv`); None where it has none or no
+            mouth sample is chosen.
         """
         chosen = self.choose(offsets, look)
+        mouth, k = self.samples.group("mouth"), chosen.get("mouth")
+        interior = None if mouth is None or mouth.interiors is None or k is None else mouth.interiors[k]
         if all(k is None for k in chosen.values()):
-            return texture
+            return texture, interior
         if self._work is None or self._work.shape != texture.shape:
             self._work = np.empty_like(texture)
         np.copyto(self._work, texture)
@@ -151,4 +207,4 @@ class SamplePainter:
             if k is not None:
                 for (x, y, _, _), image in zip(group.boxes, group.images[k]):
                     paste_faded(self._work, image, int(x), int(y))
-        return self._work
+        return self._work, interior

@@ -16,7 +16,7 @@ import numpy as np
 
 from facemime.animate.deform import Deformer
 from facemime.animate.eyes import LookPainter
-from facemime.animate.samples import SamplePainter
+from facemime.animate.samples import SamplePainter, interior_strip
 from facemime.errors import InvalidInputError
 from facemime.render.raster import fill, render_mesh_into
 from facemime.render.scene import SceneMesh
@@ -180,6 +180,7 @@ def synthesize(
     scene: SceneMesh | None = None,
     key: np.ndarray | None = None,
     texture: np.ndarray | None = None,
+    interior: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray:
     """The actor's textured model, deformed and posed, over a background, with the mouth interior.
 
@@ -207,6 +208,11 @@ def synthesize(
     texture
         (Ht, Wt, 3) uint8 RGB, the size of the actor's texture: drawn instead of it (its eyes
         repainted, :class:`~facemime.animate.eyes.LookPainter`); None: the actor's own.
+    interior
+        The mouth's opening as a sample showed it: (h, w, 3) uint8 RGB image, (N, 2) its texture
+        coordinates per vertex and (M, 3) the triangles between the inner lips
+        (:func:`~facemime.animate.samples.interior_strip`), drawn there instead of the painted
+        cavity and teeth; None: painted.
 
     Returns
     -------
@@ -223,9 +229,14 @@ def synthesize(
     points, depth = project(vertices, pose)
     if scene is not None:
         scene.draw(out, key, points[scene.anchors])
-    g = actor.model.groups
-    spread = mouth_width(actor.model, vertices) / max(mouth_width(actor.model, actor.model.vertices), 1e-9)
-    draw_mouth_interior(out, points[g["mouth_inner_upper"]], points[g["mouth_inner_lower"]], teeth_uncovered(spread))
+    if interior is None:
+        g = actor.model.groups
+        spread = mouth_width(actor.model, vertices) / max(mouth_width(actor.model, actor.model.vertices), 1e-9)
+        upper, lower = points[g["mouth_inner_upper"]], points[g["mouth_inner_lower"]]
+        draw_mouth_interior(out, upper, lower, teeth_uncovered(spread))
+    else:
+        image, uv, strip = interior
+        render_mesh_into(out, image, uv, points, depth, strip, cull=False)
     render_mesh_into(
         out, actor.texture if texture is None else texture, actor.model.uv, points, depth, actor.model.triangles
     )
@@ -328,6 +339,7 @@ class Puppet:
         self.samples = (
             None if actor.samples is None else SamplePainter(actor.samples, actor.model.groups, self.deformer.knots)
         )
+        self._strip = interior_strip(actor.model)
         sizes = np.asarray(source_sizes, np.float64)
         if sizes.shape != (len(self.deformer.knots),) or not np.isfinite(sizes).all() or (sizes <= 0).any():
             raise InvalidInputError(
@@ -444,17 +456,26 @@ class Puppet:
         """
         vertices, pose = self.vertices(offsets, user, look), self.pose(measured, user)
         shown_look = Look(look.closure * user.gain, look.iris * user.gain)
-        texture = self.painter.texture(shown_look)
+        texture, inside = self.painter.texture(shown_look), None
         if self.samples is not None:
-            texture = self.samples.paint(texture, offsets * self._ratio * user.gain, shown_look)
+            texture, inside = self.samples.paint(texture, offsets * self._ratio * user.gain, shown_look)
+        interior = None if inside is None else (inside, *self._strip)
         self.shown = (vertices, pose)
         if self.scene is None:
-            return synthesize(self.actor, vertices, pose, size, out=out, texture=texture)
+            return synthesize(self.actor, vertices, pose, size, out=out, texture=texture, interior=interior)
         if out is None:
             out = np.empty((size[1], size[0], 3), np.uint8)
         if tuple(size) == self.scene.size:
             return synthesize(
-                self.actor, vertices, pose, size, out=out, scene=self.scene, key=self._key, texture=texture
+                self.actor,
+                vertices,
+                pose,
+                size,
+                out=out,
+                scene=self.scene,
+                key=self._key,
+                texture=texture,
+                interior=interior,
             )
         synthesize(
             self.actor,
@@ -465,6 +486,7 @@ class Puppet:
             scene=self.scene,
             key=self._key,
             texture=texture,
+            interior=interior,
         )
         return letterbox(self._picture, out)
 

@@ -21,16 +21,17 @@ import numpy as np
 
 from facemime.animate.deform import Deformer
 from facemime.animate.eyes import LookPainter
-from facemime.animate.samples import mouth_knots, weigh_eyes
+from facemime.animate.samples import INTERIOR_SIZE, interior_strip, mouth_knots, weigh_eyes
 from facemime.animate.synth import Puppet
 from facemime.codec.appearance import FACING, lay_back
 from facemime.codec.decoder import DecodedFrame
 from facemime.io.samples_file import SAMPLE_QUALITY
 from facemime.io.video import VideoReader
 from facemime.progress import track as progress
+from facemime.shared_constants import SEAL
 from facemime.types.actor import Actor
-from facemime.types.head import model_iod
-from facemime.types.pose import project, rotation_matrix
+from facemime.types.head import HeadModel, model_iod, mouth_up, mouth_width
+from facemime.types.pose import Pose, project, rotation_matrix
 from facemime.types.samples import SampleGroup, Samples
 
 #: The library's size at most, bytes of WebP images as the stream carries them (issue 64: 30 kB).
@@ -39,6 +40,10 @@ BUDGET = 28_000
 MOST = 16
 #: The mouth's box: the outer lips' extent in the texture grown this much about its centre.
 MOUTH_GROW = 1.4
+#: A frame's mouth is open, and its interior kept, where its decoded inner lips stand further
+#: apart than this share of the mouth's width somewhere (where the synthesis shows an opening at
+#: its full size: twice the gap it seals, :data:`~facemime.shared_constants.SEAL`).
+OPEN = 2 * SEAL
 #: Frames laid back at most (evenly spread over the clip): bounds the memory the choice takes.
 CANDIDATES = 600
 
@@ -96,7 +101,13 @@ def _centres(keys: np.ndarray, most: int) -> list[int]:
 
 
 def choose_group(
-    name: str, boxes: np.ndarray, crops: list[list[np.ndarray]], keys: np.ndarray, frames: np.ndarray, budget: int
+    name: str,
+    boxes: np.ndarray,
+    crops: list[list[np.ndarray]],
+    keys: np.ndarray,
+    frames: np.ndarray,
+    budget: int,
+    interiors: list[np.ndarray | None] | None = None,
 ) -> tuple[SampleGroup | None, int]:
     """One group's samples, within a byte budget.
 
@@ -114,6 +125,9 @@ def choose_group(
         (N,) per candidate, its frame index.
     budget
         Bytes the group's images may take as the stream carries them.
+    interiors
+        ``mouth`` only: per candidate, its interior image (None: its mouth was closed); None:
+        none.
 
     Returns
     -------
@@ -129,20 +143,52 @@ def choose_group(
     all_keys = np.vstack([np.zeros(keys.shape[1]), keys[centres]])
     owner = np.argmin(np.linalg.norm(keys[:, None, :] - all_keys[None, :, :], axis=2), axis=1) - 1
     chosen, images, size = [], [], 0
+    kept: list[np.ndarray | None] = []
     for c, centre in enumerate(centres):
         members = np.flatnonzero(owner == c)
         flat = np.array([np.concatenate([b.ravel() for b in crops[i]]) for i in members], np.float32)
         best = int(members[np.argmin(((flat - flat.mean(axis=0)) ** 2).sum(axis=1))]) if len(members) else centre
-        encoded = [_webp(b) for b in crops[best]]
-        cost = sum(map(len, encoded))
+        inside = None if interiors is None else interiors[best]
+        cost = sum(len(_webp(b)) for b in crops[best] + ([] if inside is None else [inside]))
         if size + cost > budget:
             break
         size += cost
         chosen.append(best)
         images.append([_as_carried(b) for b in crops[best]])
+        kept.append(None if inside is None else _as_carried(inside))
     if not chosen:
         return None, 0
-    return SampleGroup(name, boxes, images, keys[chosen], frames[chosen]), size
+    carried = kept if any(k is not None for k in kept) else None
+    return SampleGroup(name, boxes, images, keys[chosen], frames[chosen], carried), size
+
+
+def _interior(
+    frame: np.ndarray,
+    vertices: np.ndarray,
+    pose: Pose,
+    model: HeadModel,
+    strip_uv: np.ndarray,
+    strip: np.ndarray,
+    upper: np.ndarray,
+    lower: np.ndarray,
+) -> np.ndarray | None:
+    """A frame's mouth opening laid out on the interior image (:func:`interior_uv`), or None where
+    the decoded inner lips are closer than :data:`OPEN` of the mouth's width. Texels no triangle
+    covers take the covered ones' mean colour (the renderer's bilinear lookups reach them)."""
+    up = mouth_up(model, vertices)
+    if up is None or not len(strip):
+        return None
+    gap = (vertices[upper, :2] - vertices[lower, :2]) @ up
+    if gap.max() <= OPEN * mouth_width(model, vertices):
+        return None
+    image, cover = lay_back(
+        frame, strip_uv, strip, project(vertices, pose)[0], np.ones(len(strip), bool), INTERIOR_SIZE
+    )
+    covered = cover == 255
+    if not covered.any():
+        return None
+    image[~covered] = np.round(image[covered].mean(axis=0)).astype(np.uint8)
+    return image
 
 
 def build_samples(video: str | Path, actor: Actor, decoded: list[DecodedFrame], budget: int = BUDGET) -> Samples | None:
@@ -180,6 +226,11 @@ def build_samples(video: str | Path, actor: Actor, decoded: list[DecodedFrame], 
     crops: dict[str, list[list[np.ndarray]]] = {g: [] for g in boxes}
     keys: dict[str, list[np.ndarray]] = {g: [] for g in boxes}
     frames: list[int] = []
+    interiors: list[np.ndarray | None] = []
+    strip_uv, strip = interior_strip(model)
+    if {frozenset(t) for t in strip.tolist()} & {frozenset(t) for t in tri.tolist()}:
+        strip = strip[:0]  # a capped mouth (fit.actor.mouth_cap): its own texture shows the opening
+    upper, lower = model.groups["mouth_inner_upper"], model.groups["mouth_inner_lower"]
     with VideoReader(video) as reader:
         for i, (frame, f) in enumerate(zip(progress(reader, len(decoded), "samples"), decoded)):
             if i not in keep:
@@ -198,6 +249,7 @@ def build_samples(video: str | Path, actor: Actor, decoded: list[DecodedFrame], 
                         for x, y, bw, bh in bs
                     ]
                 )
+            interiors.append(_interior(frame, vertices, pose, model, strip_uv, strip, upper, lower))
             keys["eyes"].append(weigh_eyes(f.look.vector()))
             keys["mouth"].append(np.asarray(f.offsets)[mouth].ravel())
             frames.append(i)
@@ -206,7 +258,13 @@ def build_samples(video: str | Path, actor: Actor, decoded: list[DecodedFrame], 
     groups, left = [], budget
     for g in ("eyes", "mouth"):
         group, size = choose_group(
-            g, boxes[g], crops[g], np.array(keys[g]), np.array(frames, np.int64), left // (2 if g == "eyes" else 1)
+            g,
+            boxes[g],
+            crops[g],
+            np.array(keys[g]),
+            np.array(frames, np.int64),
+            left // (2 if g == "eyes" else 1),
+            interiors if g == "mouth" else None,
         )
         if group is not None:
             if g == "eyes":

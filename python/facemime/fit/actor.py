@@ -21,7 +21,7 @@ from facemime.head.texture import painted_texture
 from facemime.shared_constants import SEAL
 from facemime.types.actor import Actor
 from facemime.types.contours import CONTOUR_NAMES
-from facemime.types.head import HeadModel, mouth_up, mouth_width
+from facemime.types.head import HeadModel, lip_strip, mouth_up, mouth_width
 from facemime.types.points import ReferencePoints
 from facemime.types.pose import Pose, project
 
@@ -76,7 +76,7 @@ def smear_texture(model: HeadModel, photo: np.ndarray, fit: Fit, points: Referen
         raise InvalidInputError(f"the fitted face covers only {x1 - x0}x{y1 - y0} pixels of the image")
     crop = _shrunk(photo[y0:y1, x0:x1], TEXTURE_MAX_SIDE)
     uv = np.clip((px - [x0, y0] + 0.5) / [x1 - x0, y1 - y0], 0.0, 1.0)
-    capped = {frozenset(t) for t in _lip_strip(model).tolist()}  # a cap of an earlier fit goes
+    capped = {frozenset(t) for t in lip_strip(model).tolist()}  # a cap of an earlier fit goes
     kept = np.array([frozenset(t) not in capped for t in model.triangles.tolist()], bool)
     triangles = np.concatenate([model.triangles[kept], mouth_cap(model, fit.vertices, px)])
     name = f"{source.get('file', 'photo')} actor"
@@ -89,18 +89,6 @@ def smear_texture(model: HeadModel, photo: np.ndarray, fit: Fit, points: Referen
         {k: np.asarray(v, float) for k, v in points.items()},
         _shrunk(photo, SCENE_MAX_SIDE),
     )
-
-
-def _lip_strip(model: HeadModel) -> np.ndarray:
-    """The strip between the inner lips, knot to knot, as (M, 3) vertex indices: two triangles a
-    pair of knots, none where the lips share a vertex (the corners); empty where the inner lips'
-    knot counts differ."""
-    upper, lower = model.groups["mouth_inner_upper"], model.groups["mouth_inner_lower"]
-    if len(upper) != len(lower):
-        return np.zeros((0, 3), np.int64)
-    quads = [(upper[i], upper[i + 1], lower[i + 1], lower[i]) for i in range(len(upper) - 1)]
-    triangles = [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d)) if len({*t}) == 3]
-    return np.array(triangles, np.int64).reshape(-1, 3)
 
 
 def mouth_cap(model: HeadModel, vertices: np.ndarray, px: np.ndarray) -> np.ndarray:
@@ -135,7 +123,7 @@ def mouth_cap(model: HeadModel, vertices: np.ndarray, px: np.ndarray) -> np.ndar
     gap = (vertices[upper, :2] - vertices[lower, :2]) @ up
     if gap.max() <= CAP_OPENING * mouth_width(model, vertices):
         return none
-    out = _lip_strip(model)
+    out = lip_strip(model)
     e1, e2 = px[out[:, 1]] - px[out[:, 0]], px[out[:, 2]] - px[out[:, 0]]
     back = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0] > 0.0  # the renderer's back faces
     out[back] = out[back][:, ::-1]

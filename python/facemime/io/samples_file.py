@@ -4,7 +4,9 @@
   "boxes": [[x, y, width, height], ...] (texels of the actor's texture), "samples": [{"frame": F,
   "key": [...]}, ...]}, ...]}``;
 - ``samples/<group>/<sample>_<box>.png`` (or ``.webp``, in a stream): each sample's image of
-  each box, RGB, the box's size.
+  each box, RGB, the box's size; for a mouth sample with ``"interior": true``,
+  ``samples/mouth/<sample>_interior.png`` too: the mouth's opening laid out between the inner
+  lips (:func:`facemime.animate.samples.interior_uv`).
 
 The member is absent from actors without samples; ``actor.json`` does not mention it, so an
 actor's id (the SHA-256 of ``actor.json``) is the same with or without its samples.
@@ -30,9 +32,11 @@ SAMPLE_QUALITY = 70
 #: At most this many samples a group, and boxes a group.
 MAX_SAMPLES = 64
 MAX_BOXES = 4
+#: Names a mouth sample's interior image in place of a box's index.
+INTERIOR = "interior"
 
 
-def image_name(group: str, sample: int, box: int, kind: str) -> str:
+def image_name(group: str, sample: int, box: int | str, kind: str) -> str:
     """The member holding one sample's image of one box.
 
     Parameters
@@ -42,7 +46,7 @@ def image_name(group: str, sample: int, box: int, kind: str) -> str:
     sample
         The sample's index in the group.
     box
-        The box's index in the group.
+        The box's index in the group, or :data:`INTERIOR`.
     kind
         ``"png"`` or ``"webp"``.
 
@@ -78,7 +82,9 @@ def samples_members(samples: Samples, kind: str, encode: Callable[[np.ndarray], 
                 "name": g.name,
                 "boxes": g.boxes.astype(int).tolist(),
                 "samples": [
-                    {"frame": int(f), "key": [round(float(v), 6) for v in k]} for f, k in zip(g.frames, g.keys)
+                    {"frame": int(f), "key": [round(float(v), 6) for v in k]}
+                    | ({"interior": True} if g.interiors is not None and g.interiors[i] is not None else {})
+                    for i, (f, k) in enumerate(zip(g.frames, g.keys))
                 ],
             }
             for g in samples.groups
@@ -89,6 +95,9 @@ def samples_members(samples: Samples, kind: str, encode: Callable[[np.ndarray], 
         for s, images in enumerate(g.images):
             for b, image in enumerate(images):
                 out[image_name(g.name, s, b, kind)] = encode(image)
+            interior = None if g.interiors is None else g.interiors[s]
+            if interior is not None:
+                out[image_name(g.name, s, INTERIOR, kind)] = encode(interior)
     return out
 
 
@@ -128,11 +137,15 @@ def samples_from_members(text: bytes, read: Callable[[str], bytes | None], where
                 raise ValueError(f"a group holds 1-{MAX_SAMPLES} samples")
             keys = np.array([np.asarray(e["key"], np.float64) for e in entries])
             frames = np.array([int(e["frame"]) for e in entries], np.int64)
+            inside = [e.get("interior") is True for e in entries]
         except (KeyError, TypeError, ValueError, OverflowError) as e:
             raise InvalidInputError(f"{where}: malformed sample group in {SAMPLES_JSON} ({e})") from None
         images = [[_image(read, name, s, b, where) for b in range(len(boxes))] for s in range(len(entries))]
+        interiors = [_image(read, name, s, INTERIOR, where) if i else None for s, i in enumerate(inside)]
         try:
-            groups.append(SampleGroup(name, boxes.astype(np.int64), images, keys, frames))
+            groups.append(
+                SampleGroup(name, boxes.astype(np.int64), images, keys, frames, interiors if any(inside) else None)
+            )
         except InvalidInputError as e:
             raise InvalidInputError(f"{where}: {e}") from None
     try:
@@ -141,7 +154,7 @@ def samples_from_members(text: bytes, read: Callable[[str], bytes | None], where
         raise InvalidInputError(f"{where}: {e}") from None
 
 
-def _image(read: Callable[[str], bytes | None], group: str, sample: int, box: int, where: str) -> np.ndarray:
+def _image(read: Callable[[str], bytes | None], group: str, sample: int, box: int | str, where: str) -> np.ndarray:
     """One sample image, PNG or WebP, as RGB."""
     for kind in ("png", "webp"):
         data = read(image_name(group, sample, box, kind))
@@ -150,4 +163,5 @@ def _image(read: Callable[[str], bytes | None], group: str, sample: int, box: in
             if image is None or image.ndim != 3:
                 raise InvalidInputError(f"{where}: sample image {image_name(group, sample, box, kind)} does not decode")
             return cv2.cvtColor(image, cv2.COLOR_BGR2RGB)
-    raise InvalidInputError(f"{where}: sample {sample} of group {group!r} has no image of box {box}")
+    what = "its interior" if box == INTERIOR else f"box {box}"
+    raise InvalidInputError(f"{where}: sample {sample} of group {group!r} has no image of {what}")

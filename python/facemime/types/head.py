@@ -239,3 +239,26 @@ def mouth_up(model: HeadModel, vertices: np.ndarray) -> np.ndarray | None:
     along = vertices[last, :2] - vertices[first, :2]
     width = mouth_width(model, vertices)
     return None if width <= 0.0 else np.array([-along[1], along[0]]) / width
+
+
+def lip_strip(model: HeadModel) -> np.ndarray:
+    """The strip between the inner lips, knot to knot: two triangles a pair of knots, none where
+    the lips share a vertex (the corners).
+
+    Parameters
+    ----------
+    model
+        The head, with the inner lips' groups.
+
+    Returns
+    -------
+    (M, 3) int64 array
+        Vertex indices, winding as the lips run (upper i, upper i + 1, lower i + 1; upper i, lower
+        i + 1, lower i); (0, 3) where the inner lips' knot counts differ.
+    """
+    upper, lower = model.groups["mouth_inner_upper"], model.groups["mouth_inner_lower"]
+    if len(upper) != len(lower):
+        return np.zeros((0, 3), np.int64)
+    quads = [(upper[i], upper[i + 1], lower[i + 1], lower[i]) for i in range(len(upper) - 1)]
+    triangles = [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d)) if len({*t}) == 3]
+    return np.array(triangles, np.int64).reshape(-1, 3)

@@ -42,6 +42,10 @@ class SampleGroup:
         (x, y) offsets flattened (``mouth``, model units).
     frames : (S,) int64 array
         Per sample, the index of the frame it was taken from (informative).
+    interiors : list of ((h, w, 3) uint8 array or None) or None
+        ``mouth`` only: per sample, the mouth's opening as its frame showed it, laid out between
+        the inner lips (:func:`facemime.animate.samples.interior_uv`); None for a sample whose
+        mouth was closed. None: no sample has one.
     """
 
     name: str
@@ -49,6 +53,7 @@ class SampleGroup:
     images: list[list[np.ndarray]]
     keys: np.ndarray
     frames: np.ndarray
+    interiors: list[np.ndarray | None] | None = None
 
     def __post_init__(self) -> None:
         if self.name not in GROUPS:
