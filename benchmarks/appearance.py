@@ -77,7 +77,7 @@ def one_video(path: Path, ref: dict, budgets: list[float], every: int) -> dict:
             if updates.due(f.index):
                 puppet.retexture(updates.texture)
             if f.index in masks:
-                pictures[f.index] = puppet.render(f.pose, f.offsets, clip.size, look=f.look).copy()
+                pictures[f.index] = puppet.render(f.pose, f.offsets, clip.size, look=f.look, samples=f.samples).copy()
         kbit = sum(map(len, chunks)) * 8 / 1000 / seconds
         curve.append(
             {

@@ -223,7 +223,7 @@ def speed(scene: Scene) -> dict:
         for label, seq in (("decoded", frames), ("analysed", scene.clip.motion)):
             t0 = time.perf_counter()
             for f in seq:
-                scene.puppet.render(f.pose, f.offsets, size, out=out, look=f.look)
+                scene.puppet.render(f.pose, f.offsets, size, out=out, look=f.look, samples=f.samples)
             fps[label] = max(fps[label], n / (time.perf_counter() - t0))
     picture_fps, synth_fps = fps["decoded"], fps["analysed"]
     t0 = time.perf_counter()

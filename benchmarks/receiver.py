@@ -106,7 +106,7 @@ def measure(video: Path, reference: Path, every: int, samples: bool = True) -> d
                 puppet.retexture(updates.texture)
             if not ref["valid"][i] or (i % every and i):
                 continue
-            puppet.render(f.pose, f.offsets, (w, h), out=image, look=f.look)
+            puppet.render(f.pose, f.offsets, (w, h), out=image, look=f.look, samples=f.samples)
             picture = image if f.face else (image * NO_FACE_DIM).astype(np.uint8)
             regions = masks(ref["landmarks"][i].astype(np.float64), float(ref["iod"][i]), (h, w))
             a, b = luma(picture), luma(real)

@@ -18,6 +18,13 @@ LOOK_NAMES = (
 )
 #: Entries of a basis vector are sent ×BASIS_ONE as int16.
 BASIS_ONE = 32767
+#: The extra parameters' kinds that choose the actor's mouth and eye samples per frame, in the order
+#: of the sample groups (eyes, mouth): the value is the index of the sample drawn plus one, 0 for
+#: none (the key frame's own).
+SAMPLE_KINDS = (7, 8)
+#: Their quantiser step: a sample index is 8 steps, so that the encoder's hysteresis (at most 4
+#: steps) never holds a change of sample back.
+SAMPLE_STEP = 0.125
 #: The eight contour groups whose vertices are the knots, in the bitstream's order (each curve
 #: image-left to image-right, one vertex per knot).
 CONTOUR_GROUPS = (
@@ -40,6 +47,11 @@ REACH = 0.45
 #: width as closed: the tracked inner lips of a closed mouth lie a pixel or two apart, and the dark
 #: line that gap drew cost up to 8 dB in the mouth region.
 SEAL = 0.05
+#: The actor's samples of its own mouth and eyes: the sample groups, in the order they are painted.
+SAMPLE_GROUPS = ("eyes", "mouth")
+#: The weight of the iris shifts (eye widths) against the lid closures (shares of the opening) in
+#: the distance between two looks that chooses an eye sample.
+IRIS_WEIGHT = 5.0
 #: The colour (RGB) behind a face drawn without its scene.
 BACKGROUND = (38, 40, 46)
 #: Tint of the synthesised picture in frames without a face.

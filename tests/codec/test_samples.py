@@ -61,7 +61,7 @@ def _face_psnr(decoder, frames, video, shared):
         for i, (real, f) in enumerate(zip(reader, frames)):
             if i % 4 or not ref["valid"][i]:
                 continue
-            image = puppet.render(f.pose, f.offsets, (w, h), look=f.look).astype(np.float64)
+            image = puppet.render(f.pose, f.offsets, (w, h), look=f.look, samples=f.samples).astype(np.float64)
             x0, y0 = ref["landmarks"][i][:, :2].min(axis=0).astype(int)
             x1, y1 = ref["landmarks"][i][:, :2].max(axis=0).astype(int)
             errors.append(((image[y0:y1, x0:x1] - real[y0:y1, x0:x1]) ** 2).mean())
@@ -123,3 +123,14 @@ def test_the_mouth_is_keyed_by_the_lips_knots_only(actor):
     assert set(knots[on_lips]) <= set(
         np.concatenate([actor.model.groups[g] for g in actor.model.groups if g.startswith("mouth")])
     )
+
+
+def test_the_stream_sends_which_sample_each_frame_draws(coded):
+    _, decoder, frames = coded[True]
+    assert decoder.info.extras[-2:] == (7, 8)
+    chosen = [f.samples for f in frames if f.face]
+    assert all(c is not None and len(c) == 2 for c in chosen)
+    for g, group in enumerate(decoder.actor.samples.groups):
+        assert any(c[g] is not None for c in chosen)  # each group's samples are drawn somewhere
+        assert all(c[g] is None or c[g] < len(group.keys) for c in chosen)
+    assert all(f.samples is None for f in coded[False][2])

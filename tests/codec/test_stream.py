@@ -347,3 +347,39 @@ def test_two_streams_one_after_the_other_decode_each_with_its_own_header(clip, w
     assert [f.index for f in frames] == list(range(n)) * 2
     assert all(same(f, e) for f, e in zip(frames, recon1 + recon2))
     assert len(dec.info.basis.raw) == Settings(quality=2).basis_size
+
+
+def test_sample_choices_round_trip_exactly_whatever_the_hysteresis(clip):
+    rng = np.random.default_rng(3)
+    given = [
+        tuple(None if k < 0 else int(k) for k in rng.integers(-1, 16, 2)) if i % 7 else (None, None)
+        for i in range(len(clip.motion))
+    ]
+    for hysteresis in (0.0, 4.0):  # the core's widest: a change of one sample is still sent
+        enc = MotionEncoder(
+            clip.actor,
+            clip.fps,
+            clip.size,
+            Basis.learn(np.array([m.offsets for m in clip.motion]), 8),
+            Settings(hysteresis=hysteresis),
+            False,
+            look=True,
+            samples=True,
+        )
+        recon = [enc.push(m.face, m.lost, m.pose, m.offsets, None, s) for m, s in zip(clip.motion, given)]
+        dec = MotionDecoder(clip.actor)
+        frames = dec.push(enc.header + b"".join(r.data for r in recon) + enc.finish()) + dec.finish()
+        assert dec.info.extras == LOOK_KINDS + (7, 8)
+        faces = [(f.samples, s, r.samples) for f, s, r, m in zip(frames, given, recon, clip.motion) if m.face]
+        assert faces and all(f == s == r for f, s, r in faces)
+
+
+def test_a_stream_without_sample_choices_decodes_none_and_an_encoder_without_them_refuses_one(clip):
+    basis = Basis.learn(np.array([m.offsets for m in clip.motion]), 8)
+    enc = MotionEncoder(clip.actor, clip.fps, clip.size, basis, Settings(), False, look=True)
+    m = clip.motion[0]
+    with pytest.raises(InvalidInputError, match="no sample choice"):
+        enc.push(m.face, m.lost, m.pose, m.offsets, None, (1, None))
+    recon = [enc.push(m.face, m.lost, m.pose, m.offsets, None, (None, None)) for m in clip.motion]
+    frames = MotionDecoder(clip.actor).push(enc.header + b"".join(r.data for r in recon) + enc.finish())
+    assert frames and all(f.samples is None for f in frames)

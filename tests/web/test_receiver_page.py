@@ -59,7 +59,7 @@ def python_picture(decoder: MotionDecoder, frames: list, index: int) -> np.ndarr
         if updates.due(f.index):
             puppet.retexture(updates.texture)
     f = frames[index]
-    puppet.render(f.pose, f.offsets, (w, h), out=image, look=f.look)
+    puppet.render(f.pose, f.offsets, (w, h), out=image, look=f.look, samples=f.samples)
     return image if f.face else (image * NO_FACE_DIM).astype(np.uint8)
 
 

@@ -22,14 +22,11 @@ from __future__ import annotations
 import numpy as np
 
 from facemime.render.paste import paste_faded
-from facemime.shared_constants import LOOK_NAMES
+from facemime.shared_constants import IRIS_WEIGHT, LOOK_NAMES
 from facemime.types.head import HeadModel, lip_strip
 from facemime.types.look import Look
-from facemime.types.samples import Samples
+from facemime.types.samples import GROUPS, Samples
 
-#: The weight of the iris shifts (eye widths) against the lid closures (shares of the opening) in
-#: the eyes' distance.
-IRIS_WEIGHT = 5.0
 #: The interior image's (width, height), texels.
 INTERIOR_SIZE = (96, 40)
 #: The head model's groups whose knots key the mouth's samples.
@@ -173,7 +170,9 @@ class SamplePainter:
             for name, keys in self._keys.items()
         }
 
-    def paint(self, texture: np.ndarray, offsets: np.ndarray, look: Look) -> tuple[np.ndarray, np.ndarray | None]:
+    def paint(
+        self, texture: np.ndarray, offsets: np.ndarray, look: Look, sent: tuple[int | None, ...] | None = None
+    ) -> tuple[np.ndarray, np.ndarray | None]:
         """The texture with the frame's samples pasted in, and the mouth's interior.
 
         Parameters
@@ -184,6 +183,10 @@ class SamplePainter:
             (K, 2) float array: the frame's knot offsets in the actor's model units.
         look
             The frame's look.
+        sent
+            The samples the stream chose for the frame, per group of
+            :data:`~facemime.types.samples.GROUPS` (None: the key frame's); an index beyond a
+            group's samples draws none. None: chosen here by the shapes (:meth:`choose`).
 
         Returns
         -------
@@ -194,7 +197,11 @@ class SamplePainter:
             The chosen mouth sample's interior (:func:`interior_uv`); None where it has none or no
             mouth sample is chosen.
         """
-        chosen = self.choose(offsets, look)
+        if sent is None:
+            chosen = self.choose(offsets, look)
+        else:
+            sizes = {g.name: len(g.keys) for g in self.samples.groups}
+            chosen = {n: k if k is not None and k < sizes.get(n, 0) else None for n, k in zip(GROUPS, sent)}
         mouth, k = self.samples.group("mouth"), chosen.get("mouth")
         interior = None if mouth is None or mouth.interiors is None or k is None else mouth.interiors[k]
         if all(k is None for k in chosen.values()):
@@ -203,7 +210,7 @@ class SamplePainter:
             self._work = np.empty_like(texture)
         np.copyto(self._work, texture)
         for group in self.samples.groups:
-            k = chosen[group.name]
+            k = chosen.get(group.name)
             if k is not None:
                 for (x, y, _, _), image in zip(group.boxes, group.images[k]):
                     paste_faded(self._work, image, int(x), int(y))

@@ -426,6 +426,7 @@ class Puppet:
         user: UserMotion = UserMotion(),
         out: np.ndarray | None = None,
         look: Look = Look(),
+        samples: tuple[int | None, ...] | None = None,
     ) -> np.ndarray:
         """The synthesised frame. A scene of another size is drawn at its own and fitted into
         ``size`` (its aspect kept, the rest :data:`BACKGROUND`); without a scene the face is drawn
@@ -448,6 +449,10 @@ class Puppet:
             (H, W, 3) uint8 RGB of ``size`` to draw into; None: a new image.
         look
             The eyes: lid closures and iris shifts.
+        samples
+            The actor's samples a stream chose for the frame, per group (eyes, mouth; None: the
+            key frame's own); None: chosen by the shapes
+            (:meth:`~facemime.animate.samples.SamplePainter.paint`).
 
         Returns
         -------
@@ -458,7 +463,7 @@ class Puppet:
         shown_look = Look(look.closure * user.gain, look.iris * user.gain)
         texture, inside = self.painter.texture(shown_look), None
         if self.samples is not None:
-            texture, inside = self.samples.paint(texture, offsets * self._ratio * user.gain, shown_look)
+            texture, inside = self.samples.paint(texture, offsets * self._ratio * user.gain, shown_look, samples)
         interior = None if inside is None else (inside, *self._strip)
         self.shown = (vertices, pose)
         if self.scene is None:

@@ -27,7 +27,7 @@ from facemime.codec.clip import (
 )
 from facemime.codec.decoder import MotionDecoder
 from facemime.codec.params import Basis
-from facemime.codec.samples import build_samples
+from facemime.codec.samples import build_samples, choose_samples
 from facemime.codec.stream import LADDER, Settings, StreamError
 from facemime.errors import InvalidInputError
 from facemime.io.actor_file import load_actor
@@ -157,8 +157,9 @@ def encode_video(
         assert decoder.actor is not None  # the stream carries it
         library = build_samples(video, decoder.actor, decoded)
         if library is not None:
+            choices = choose_samples(video, replace(decoder.actor, samples=library), decoded)
             clip = replace(clip, actor=replace(clip.actor, samples=library))
-            header, actor_chunk, packets = encode_clip(clip, chosen, carry, basis)
+            header, actor_chunk, packets = encode_clip(clip, chosen, carry, basis, choices)
     motion_bytes, updates, sent = sum(map(len, packets)), 0, 0
     if appearance > 0:
         chunks, sender = with_appearance(video, clip, header, actor_chunk, packets, chosen, appearance)
@@ -251,7 +252,7 @@ def decode_stream(
             if not f.concealed:
                 if puppet.scene is None:
                     fill(image, BACKGROUND)
-                puppet.render(f.pose, f.offsets, (w, h), out=image, look=f.look)
+                puppet.render(f.pose, f.offsets, (w, h), out=image, look=f.look, samples=f.samples)
                 shown[:] = image if f.face else (image * NO_FACE_DIM).astype(np.uint8)
             writer.write(shown)
     return DecodeResult(

@@ -32,6 +32,7 @@ from facemime.codec.stream import LADDER, MotionEncoder, Settings
 from facemime.errors import InputFileError
 from facemime.io.video import VideoReader
 from facemime.progress import track as progress
+from facemime.shared_constants import SAMPLE_KINDS, SAMPLE_STEP
 from facemime.types.actor import Actor
 from facemime.types.head import model_iod
 from facemime.types.look import Look
@@ -126,7 +127,11 @@ def _look(frame: FrameMotion) -> Look:
 
 
 def encode_clip(
-    clip: Clip, settings: Settings, carry_actor: bool, basis: Basis | None = None
+    clip: Clip,
+    settings: Settings,
+    carry_actor: bool,
+    basis: Basis | None = None,
+    samples: list[tuple[int | None, ...]] | None = None,
 ) -> tuple[bytes, bytes, list[bytes]]:
     """The stream of an analysed clip.
 
@@ -144,6 +149,10 @@ def encode_clip(
     basis
         The clip's basis, cut to the settings' :attr:`~facemime.codec.stream.Settings.basis_size`
         vectors; None: learned from the clip's frames with a face.
+    samples
+        Per frame of the clip, the actor's samples the receiver draws, per group (eyes, mouth;
+        :func:`facemime.codec.samples.choose_samples`), sent with each frame; None: not sent (the
+        receiver chooses by the shapes).
 
     Returns
     -------
@@ -161,17 +170,38 @@ def encode_clip(
     basis = Basis(basis.raw[:m])
     look = any(np.any(_look(f).vector() != 0) for f in faces)
     steps = settings.steps(m, look)
+    chosen = [np.array([0.0 if k is None else k + 1.0 for k in c]) for c in samples] if samples is not None else None
+    steps += [SAMPLE_STEP] * len(SAMPLE_KINDS) if chosen is not None else []
     values = np.array(
         [
-            np.concatenate([pose_vector(f.pose), basis.coefficients(f.offsets)] + ([_look(f).vector()] if look else []))
-            for f in faces
+            np.concatenate(
+                [pose_vector(f.pose), basis.coefficients(f.offsets)]
+                + ([_look(f).vector()] if look else [])
+                + ([chosen[i]] if chosen is not None else [])
+            )
+            for i, f in enumerate(clip.motion)
+            if f.face
         ]
     )
     classes = _core.choose_classes(steps, settings.hysteresis, values.reshape(len(faces), len(steps)))
     enc = MotionEncoder(
-        clip.actor, clip.fps, clip.size, basis, settings, carry_actor, classes, reference=clip.motion[0].pose, look=look
+        clip.actor,
+        clip.fps,
+        clip.size,
+        basis,
+        settings,
+        carry_actor,
+        classes,
+        reference=clip.motion[0].pose,
+        look=look,
+        samples=samples is not None,
     )
-    packets = [enc.push(f.face, f.lost, f.pose, f.offsets, _look(f) if look else None).data for f in clip.motion]
+    packets = [
+        enc.push(
+            f.face, f.lost, f.pose, f.offsets, _look(f) if look else None, None if samples is None else samples[i]
+        ).data
+        for i, f in enumerate(clip.motion)
+    ]
     packets.append(enc.finish())
     start = enc.start()
     return enc.header, start[len(enc.header) :], [p for p in packets if p]

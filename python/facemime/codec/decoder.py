@@ -19,6 +19,7 @@ from facemime.codec.params import (
     Basis,
     look_from_extras,
     pose_from_vector,
+    samples_from_extras,
     topology_id,
 )
 from facemime.codec.stream import StreamError
@@ -34,8 +35,10 @@ from facemime.types.pose import Pose
 class DecodedFrame:
     """One frame out of the decoder: its ``index`` from the stream's start, ``face`` (False: show
     the last face, dimmed), the features ``lost``, ``pose``, (K, 2) ``offsets`` (model units),
-    ``concealed``: it was lost or damaged and repeats the last good frame, and its ``look``
-    (neutral for a version-1 stream, which carries none, and before the first decoded frame)."""
+    ``concealed``: it was lost or damaged and repeats the last good frame, its ``look``
+    (neutral for a version-1 stream, which carries none, and before the first decoded frame), and
+    ``samples``: per sample group (eyes, mouth) the index of the actor's sample the stream chose,
+    None for the key frame's own (None whole when the stream carries no choice)."""
 
     index: int
     face: bool
@@ -44,6 +47,7 @@ class DecodedFrame:
     offsets: np.ndarray
     concealed: bool = False
     look: Look = field(default_factory=Look)
+    samples: tuple[int | None, ...] | None = None
 
 
 @dataclass
@@ -187,6 +191,7 @@ class MotionDecoder:
         for i, f, lost_bits, v in zip(index, face, lost, values):
             assert info is not None  # frames come after a header
             look = look_from_extras(info.extras, v[POSE_PARAMETERS + m :]) if info.extras else Look()
+            chosen = samples_from_extras(info.extras, v[POSE_PARAMETERS + m :])
             out.append(
                 (
                     int(i),
@@ -197,6 +202,7 @@ class MotionDecoder:
                         pose_from_vector(v[:POSE_PARAMETERS]),
                         info.basis.offsets(v[POSE_PARAMETERS : POSE_PARAMETERS + m]),
                         look=look,
+                        samples=chosen,
                     ),
                     0,
                 )
@@ -215,7 +221,9 @@ class MotionDecoder:
                     frames.append(DecodedFrame(first + k, False, list(FEATURES), self.reference(), self._rest(), True))
                 else:
                     frames.append(
-                        DecodedFrame(first + k, last.face, last.lost, last.pose, last.offsets, True, last.look)
+                        DecodedFrame(
+                            first + k, last.face, last.lost, last.pose, last.offsets, True, last.look, last.samples
+                        )
                     )
         return frames
 

@@ -20,7 +20,7 @@ from functools import cached_property
 import numpy as np
 
 from facemime.animate.deform import Deformer
-from facemime.shared_constants import BASIS_ONE, LOOK_NAMES, POSE_FIELDS
+from facemime.shared_constants import BASIS_ONE, LOOK_NAMES, POSE_FIELDS, SAMPLE_KINDS
 from facemime.types.head import HeadModel
 from facemime.types.look import Look
 from facemime.types.pose import Pose
@@ -95,6 +95,35 @@ def look_from_extras(kinds: tuple[int, ...], values: np.ndarray) -> Look:
         if kind in LOOK_KINDS:
             v[kind - 1] = value
     return Look.from_vector(v)
+
+
+def samples_from_extras(kinds: tuple[int, ...], values: np.ndarray) -> tuple[int | None, ...] | None:
+    """The samples a stream chose for a frame (``docs/bitstream.md``, "Sample choices").
+
+    Parameters
+    ----------
+    kinds
+        (X,) the extra parameters' kinds, in the header's order.
+    values
+        (X,) float array: the extra parameters' values, in the order of ``kinds``.
+
+    Returns
+    -------
+    tuple of (int or None) or None
+        Per sample group (eyes, mouth), the index of the sample drawn, None for the key frame's
+        own; None when the stream carries no choice (the receiver chooses by the shapes).
+
+    Examples
+    --------
+    >>> samples_from_extras((1, 7, 8), np.array([0.5, 3.0, 0.0]))
+    (2, None)
+    >>> samples_from_extras((1,), np.array([0.5])) is None
+    True
+    """
+    if not any(k in SAMPLE_KINDS for k in kinds):
+        return None
+    sent = dict(zip(kinds, values))
+    return tuple(None if (k := int(round(float(sent.get(kind, 0.0))))) < 1 else k - 1 for kind in SAMPLE_KINDS)
 
 
 @dataclass(frozen=True, eq=False)

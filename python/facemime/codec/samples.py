@@ -28,11 +28,11 @@ from facemime.codec.decoder import DecodedFrame
 from facemime.io.samples_file import SAMPLE_QUALITY
 from facemime.io.video import VideoReader
 from facemime.progress import track as progress
-from facemime.shared_constants import SEAL
+from facemime.shared_constants import CAVITY, SEAL
 from facemime.types.actor import Actor
 from facemime.types.head import HeadModel, model_iod, mouth_up, mouth_width
 from facemime.types.pose import Pose, project, rotation_matrix
-from facemime.types.samples import SampleGroup, Samples
+from facemime.types.samples import GROUPS, SampleGroup, Samples
 
 #: The library's size at most, bytes of WebP images as the stream carries them (issue 64: 30 kB).
 BUDGET = 28_000
@@ -44,6 +44,9 @@ MOUTH_GROW = 1.4
 #: apart than this share of the mouth's width somewhere (where the synthesis shows an opening at
 #: its full size: twice the gap it seals, :data:`~facemime.shared_constants.SEAL`).
 OPEN = 2 * SEAL
+#: A frame keeps its predecessor's sample unless another's error is this share smaller (fewer
+#: switches: fewer bits, and no flicker between samples that fit about as well).
+SWITCH = 0.25
 #: Frames laid back at most (evenly spread over the clip): bounds the memory the choice takes.
 CANDIDATES = 600
 
@@ -163,14 +166,7 @@ def choose_group(
 
 
 def _interior(
-    frame: np.ndarray,
-    vertices: np.ndarray,
-    pose: Pose,
-    model: HeadModel,
-    strip_uv: np.ndarray,
-    strip: np.ndarray,
-    upper: np.ndarray,
-    lower: np.ndarray,
+    frame: np.ndarray, vertices: np.ndarray, pose: Pose, model: HeadModel, strip_uv: np.ndarray, strip: np.ndarray
 ) -> np.ndarray | None:
     """A frame's mouth opening laid out on the interior image (:func:`interior_uv`), or None where
     the decoded inner lips are closer than :data:`OPEN` of the mouth's width. Texels no triangle
@@ -178,6 +174,7 @@ def _interior(
     up = mouth_up(model, vertices)
     if up is None or not len(strip):
         return None
+    upper, lower = model.groups["mouth_inner_upper"], model.groups["mouth_inner_lower"]
     gap = (vertices[upper, :2] - vertices[lower, :2]) @ up
     if gap.max() <= OPEN * mouth_width(model, vertices):
         return None
@@ -189,6 +186,51 @@ def _interior(
         return None
     image[~covered] = np.round(image[covered].mean(axis=0)).astype(np.uint8)
     return image
+
+
+class _Regions:
+    """Lays frames back onto an actor's texture through the geometry the receiver draws, and cuts
+    out the sample groups' boxes and the mouth's interior."""
+
+    def __init__(self, actor: Actor):
+        self.actor = actor
+        self.puppet = Puppet(actor, Deformer(actor.model).feature_sizes(), model_iod(actor.model), mask_only=True)
+        self.boxes = sample_boxes(actor)
+        self.mouth = mouth_knots(actor.model.groups, self.puppet.deformer.knots)
+        model = actor.model
+        assert model.uv is not None  # an actor's model has texture coordinates
+        self.triangles = tri = np.asarray(model.triangles)
+        v = model.vertices
+        normals = np.cross(v[tri[:, 1]] - v[tri[:, 0]], v[tri[:, 2]] - v[tri[:, 0]])
+        self.normals = normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
+        self.strip_uv, self.strip = interior_strip(model)
+        if {frozenset(t) for t in self.strip.tolist()} & {frozenset(t) for t in tri.tolist()}:
+            self.strip = self.strip[:0]  # a capped mouth (fit.actor.mouth_cap): its own texture shows the opening
+
+    def key(self, group: str, f: DecodedFrame) -> np.ndarray:
+        """A decoded frame's key in a group, weighed for distances."""
+        return weigh_eyes(f.look.vector()) if group == "eyes" else np.asarray(f.offsets)[self.mouth].ravel()
+
+    def laid(
+        self, frame: np.ndarray, f: DecodedFrame
+    ) -> tuple[dict[str, list[np.ndarray]], dict[str, list[np.ndarray]], np.ndarray | None]:
+        """A frame's boxes per group (texels no facing triangle covers keep the texture's), their
+        coverage masks, and its interior (:func:`_interior`)."""
+        model, texture = self.actor.model, self.actor.texture
+        assert model.uv is not None
+        vertices, pose = self.puppet.vertices(f.offsets, look=f.look), self.puppet.pose(f.pose)
+        facing = (self.normals @ rotation_matrix(pose.yaw, pose.pitch, pose.roll).T)[:, 2] >= FACING
+        h, w = texture.shape[:2]
+        laid, cover = lay_back(frame, model.uv, self.triangles, project(vertices, pose)[0], facing, (w, h))
+        crops: dict[str, list[np.ndarray]] = {}
+        covers: dict[str, list[np.ndarray]] = {}
+        for g, bs in self.boxes.items():
+            covers[g] = [cover[y : y + bh, x : x + bw] == 255 for x, y, bw, bh in bs]
+            crops[g] = [
+                np.where(c[:, :, None], laid[y : y + bh, x : x + bw], texture[y : y + bh, x : x + bw])
+                for c, (x, y, bw, bh) in zip(covers[g], bs)
+            ]
+        return crops, covers, _interior(frame, vertices, pose, model, self.strip_uv, self.strip)
 
 
 def build_samples(video: str | Path, actor: Actor, decoded: list[DecodedFrame], budget: int = BUDGET) -> Samples | None:
@@ -211,47 +253,22 @@ def build_samples(video: str | Path, actor: Actor, decoded: list[DecodedFrame], 
         The library (the eyes first, then the mouth, each given the bytes the other leaves);
         None when no sample fits or the clip's shapes never leave the key frame's.
     """
-    puppet = Puppet(actor, Deformer(actor.model).feature_sizes(), model_iod(actor.model), mask_only=True)
-    boxes = sample_boxes(actor)
-    mouth = mouth_knots(actor.model.groups, puppet.deformer.knots)
-    model = actor.model
-    assert model.uv is not None  # an actor's model has texture coordinates
-    tri = np.asarray(model.triangles)
-    v = model.vertices
-    normals = np.cross(v[tri[:, 1]] - v[tri[:, 0]], v[tri[:, 2]] - v[tri[:, 0]])
-    normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
-    h, w = actor.texture.shape[:2]
+    regions = _Regions(actor)
     usable = [i for i, f in enumerate(decoded) if f.face and not f.concealed]
     keep = set(usable[:: max(1, -(-len(usable) // CANDIDATES))])
-    crops: dict[str, list[list[np.ndarray]]] = {g: [] for g in boxes}
-    keys: dict[str, list[np.ndarray]] = {g: [] for g in boxes}
+    crops: dict[str, list[list[np.ndarray]]] = {g: [] for g in regions.boxes}
+    keys: dict[str, list[np.ndarray]] = {g: [] for g in regions.boxes}
     frames: list[int] = []
     interiors: list[np.ndarray | None] = []
-    strip_uv, strip = interior_strip(model)
-    if {frozenset(t) for t in strip.tolist()} & {frozenset(t) for t in tri.tolist()}:
-        strip = strip[:0]  # a capped mouth (fit.actor.mouth_cap): its own texture shows the opening
-    upper, lower = model.groups["mouth_inner_upper"], model.groups["mouth_inner_lower"]
     with VideoReader(video) as reader:
         for i, (frame, f) in enumerate(zip(progress(reader, len(decoded), "samples"), decoded)):
             if i not in keep:
                 continue
-            vertices, pose = puppet.vertices(f.offsets, look=f.look), puppet.pose(f.pose)
-            facing = (normals @ rotation_matrix(pose.yaw, pose.pitch, pose.roll).T)[:, 2] >= FACING
-            laid, cover = lay_back(frame, model.uv, tri, project(vertices, pose)[0], facing, (w, h))
-            for g, bs in boxes.items():
-                crops[g].append(
-                    [
-                        np.where(
-                            cover[y : y + bh, x : x + bw, None] == 255,
-                            laid[y : y + bh, x : x + bw],
-                            actor.texture[y : y + bh, x : x + bw],
-                        )
-                        for x, y, bw, bh in bs
-                    ]
-                )
-            interiors.append(_interior(frame, vertices, pose, model, strip_uv, strip, upper, lower))
-            keys["eyes"].append(weigh_eyes(f.look.vector()))
-            keys["mouth"].append(np.asarray(f.offsets)[mouth].ravel())
+            laid, _, interior = regions.laid(frame, f)
+            for g in regions.boxes:
+                crops[g].append(laid[g])
+                keys[g].append(regions.key(g, f))
+            interiors.append(interior)
             frames.append(i)
     if not frames:
         return None
@@ -259,7 +276,7 @@ def build_samples(video: str | Path, actor: Actor, decoded: list[DecodedFrame], 
     for g in ("eyes", "mouth"):
         group, size = choose_group(
             g,
-            boxes[g],
+            regions.boxes[g],
             crops[g],
             np.array(keys[g]),
             np.array(frames, np.int64),
@@ -272,3 +289,79 @@ def build_samples(video: str | Path, actor: Actor, decoded: list[DecodedFrame], 
             groups.append(group)
             left -= size
     return Samples(tuple(groups)) if groups else None
+
+
+def _error(
+    crops: list[np.ndarray],
+    covers: list[np.ndarray],
+    images: list[np.ndarray],
+    interior: np.ndarray | None,
+    drawn: np.ndarray | None,
+) -> float:
+    """Mean squared difference (levels², over RGB) between a frame's laid-back boxes and a
+    candidate's where the frame covers them, and between the frame's interior and the candidate's
+    (``drawn``) where the frame has one."""
+    total, count = 0.0, 0
+    for crop, cover, image in zip(crops, covers, images):
+        d = crop[cover].astype(np.float32) - image[cover]
+        total, count = total + float((d * d).sum()), count + d.size
+    if interior is not None and drawn is not None:
+        d = interior.astype(np.float32) - drawn
+        total, count = total + float((d * d).sum()), count + d.size
+    return total / count if count else 0.0
+
+
+def choose_samples(video: str | Path, actor: Actor, decoded: list[DecodedFrame]) -> list[tuple[int | None, ...]]:
+    """The sample each frame draws, per group, chosen by what the frame shows: the candidate
+    (each sample, and the key frame's own: the texture with the irises moved, a drawn interior)
+    whose boxes, laid back as for the library, differ least from the frame's, and for the mouth its
+    interior too (a drawn one compared as :data:`~facemime.shared_constants.CAVITY`'s colour). A
+    frame keeps its predecessor's sample unless another's error is smaller by :data:`SWITCH`.
+
+    Parameters
+    ----------
+    video
+        The video the stream was made from.
+    actor
+        The actor as the receiver holds it, with its sample library.
+    decoded
+        The stream's frames as the receiver decodes them, in order.
+
+    Returns
+    -------
+    list of tuple of (int or None)
+        Per frame, per group of :data:`~facemime.types.samples.GROUPS`, the sample's index (None:
+        the key frame's own); frames without a face keep their predecessor's.
+    """
+    assert actor.samples is not None
+    regions, painter = _Regions(actor), LookPainter(actor)
+    cavity = np.full((INTERIOR_SIZE[1], INTERIOR_SIZE[0], 3), CAVITY, np.float32)
+    previous: dict[str, int | None] = dict.fromkeys(GROUPS)
+    out: list[tuple[int | None, ...]] = []
+    with VideoReader(video) as reader:
+        for frame, f in zip(progress(reader, len(decoded), "sample choice"), decoded):
+            if f.face and not f.concealed:
+                crops, covers, interior = regions.laid(frame, f)
+                for group in actor.samples.groups:
+                    base = painter.texture(f.look) if group.name == "eyes" else actor.texture
+                    own = [base[y : y + h, x : x + w] for x, y, w, h in group.boxes]
+                    inside = group.interiors or [None] * len(group.images)
+                    mouth = group.name == "mouth"
+                    errors = [_error(crops[group.name], covers[group.name], own, interior if mouth else None, cavity)]
+                    errors += [
+                        _error(
+                            crops[group.name],
+                            covers[group.name],
+                            images,
+                            interior if mouth else None,
+                            cavity if i is None else i.astype(np.float32),
+                        )
+                        for images, i in zip(group.images, inside)
+                    ]
+                    best, kept = int(np.argmin(errors)), previous[group.name]
+                    stay = 0 if kept is None else kept + 1
+                    previous[group.name] = (
+                        kept if errors[stay] <= (1.0 + SWITCH) * errors[best] else (None if best == 0 else best - 1)
+                    )
+            out.append(tuple(previous[g] for g in GROUPS))
+    return out

@@ -24,10 +24,12 @@ from facemime.codec.params import (
     look_from_extras,
     pose_from_vector,
     pose_vector,
+    samples_from_extras,
     topology_id,
 )
 from facemime.errors import FacemimeError, InvalidInputError
 from facemime.io.actor_file import actor_bytes, actor_id
+from facemime.shared_constants import SAMPLE_KINDS, SAMPLE_STEP
 from facemime.types.actor import Actor
 from facemime.types.contours import FEATURES
 from facemime.types.look import Look
@@ -150,13 +152,14 @@ def _lost_bits(lost: Sequence[str]) -> int:
 @dataclass
 class EncodedFrame:
     """What the receiver will decode for a frame: its pose, (K, 2) offsets (model units) and
-    look (neutral when the stream carries none), and the bytes this frame completed (a packet,
-    or nothing)."""
+    look (neutral when the stream carries none), the samples chosen (None when the stream carries
+    no choice), and the bytes this frame completed (a packet, or nothing)."""
 
     pose: Pose
     offsets: np.ndarray
     data: bytes
     look: Look = field(default_factory=Look)
+    samples: tuple[int | None, ...] | None = None
 
 
 class MotionEncoder:
@@ -185,6 +188,9 @@ class MotionEncoder:
     look
         Whether the stream carries each frame's :class:`~facemime.types.look.Look` (format
         version 2); without it the stream is version 1 and the receiver decodes a neutral look.
+    samples
+        Whether the stream carries each frame's choice of the actor's mouth and eye samples
+        (extra kinds :data:`~facemime.shared_constants.SAMPLE_KINDS`, format version 2).
     actor_data
         The carried actor's file bytes when already made
         (:func:`~facemime.io.actor_file.actor_bytes` with a WebP texture: a live sender makes
@@ -203,11 +209,12 @@ class MotionEncoder:
         reference: Pose | None = None,
         look: bool = False,
         actor_data: bytes | None = None,
+        samples: bool = False,
     ):
-        self.settings, self.basis, self.look = settings, basis, bool(look)
+        self.settings, self.basis, self.look, self.samples = settings, basis, bool(look), bool(samples)
         m = len(basis.raw)
-        steps = settings.steps(m, self.look)
-        extras = list(LOOK_KINDS) if self.look else []
+        steps = settings.steps(m, self.look) + ([SAMPLE_STEP] * len(SAMPLE_KINDS) if self.samples else [])
+        extras = (list(LOOK_KINDS) if self.look else []) + (list(SAMPLE_KINDS) if self.samples else [])
         ref = pose_vector(reference or actor.pose)
         references = [int(round(v / s)) for v, s in zip(ref, steps)] + [0] * (m + len(extras))
         if classes is not None and len(classes) != len(steps):
@@ -250,7 +257,13 @@ class MotionEncoder:
         return self._core.header_chunk()
 
     def push(
-        self, face: bool, lost: Sequence[str], pose: Pose, offsets: np.ndarray, look: Look | None = None
+        self,
+        face: bool,
+        lost: Sequence[str],
+        pose: Pose,
+        offsets: np.ndarray,
+        look: Look | None = None,
+        samples: Sequence[int | None] | None = None,
     ) -> EncodedFrame:
         """Adds a frame.
 
@@ -268,6 +281,10 @@ class MotionEncoder:
         look
             The frame's look; None: neutral. Only an encoder made with ``look=True`` sends one
             that is not neutral.
+        samples
+            Per sample group (eyes, mouth), the index of the sample the receiver draws (None:
+            the key frame's own); None: none. Only an encoder made with ``samples=True`` sends
+            them.
 
         Returns
         -------
@@ -280,16 +297,25 @@ class MotionEncoder:
         if not self.look and np.any(look_values != 0):
             raise InvalidInputError("this encoder's stream carries no look: make it with look=True to send one")
         m = len(self.basis.raw)
+        chosen = [0.0 if k is None else float(k + 1) for k in samples or [None] * len(SAMPLE_KINDS)]
+        if len(chosen) != len(SAMPLE_KINDS) or any(c < 0 for c in chosen):
+            raise InvalidInputError(f"samples are {len(SAMPLE_KINDS)} indices ≥ 0 or None, got {samples}")
+        if not self.samples and any(chosen):
+            raise InvalidInputError("this encoder's stream carries no sample choice: make it with samples=True")
         values = np.concatenate(
-            [pose_vector(pose), self.basis.coefficients(offsets)] + ([look_values] if self.look else [])
+            [pose_vector(pose), self.basis.coefficients(offsets)]
+            + ([look_values] if self.look else [])
+            + ([np.array(chosen)] if self.samples else [])
         )
         recon, packet = self._core.push(bool(face), _lost_bits(lost), values)
         coded = recon[POSE_PARAMETERS + m :]
+        kinds = (LOOK_KINDS if self.look else ()) + (tuple(SAMPLE_KINDS) if self.samples else ())
         return EncodedFrame(
             pose_from_vector(recon[:POSE_PARAMETERS]),
             self.basis.offsets(recon[POSE_PARAMETERS : POSE_PARAMETERS + m]),
             packet or b"",
-            look_from_extras(LOOK_KINDS, coded) if self.look else Look(),
+            look_from_extras(kinds, coded) if self.look else Look(),
+            samples_from_extras(kinds, coded),
         )
 
     def request_intra(self) -> None:

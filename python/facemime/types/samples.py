@@ -20,9 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from facemime.errors import InvalidInputError
-
-#: The groups a library may hold, in the order they are painted.
-GROUPS = ("eyes", "mouth")
+from facemime.shared_constants import SAMPLE_GROUPS as GROUPS  # the groups a library may hold, in painting order
 
 
 @dataclass(frozen=True, eq=False)
