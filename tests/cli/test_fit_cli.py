@@ -138,3 +138,22 @@ def test_bad_input_gives_one_line(tmp_path, capsys, monkeypatch, astronaut, setu
         assert (tmp_path / "a.actor").read_text() == "keep me"
     else:
         assert not (tmp_path / "a.actor").exists() and not (tmp_path / "a.preview.png").exists()
+
+
+def test_fit_keeps_samples_of_the_persons_own_mouth_and_eyes_from_a_clip(tmp_path, capsys, shared):
+    video = shared / "video" / "lp_d0.mp4"
+    out = tmp_path / "d0.actor"
+    code, _, err = run(capsys, "fit", str(video), "--samples-from", str(video), "--out", str(out))
+    assert code == 0, err
+    samples = load_actor(out).samples
+    assert samples is not None and [g.name for g in samples.groups] == ["eyes", "mouth"]
+    plain = tmp_path / "plain.actor"
+    assert run(capsys, "fit", str(video), "--out", str(plain))[0] == 0
+    assert load_actor(plain).samples is None
+
+
+def test_fit_with_a_missing_clip_for_samples_says_so_in_one_line_and_writes_nothing(tmp_path, capsys, astronaut):
+    out = tmp_path / "a.actor"
+    code, _, err = run(capsys, "fit", str(astronaut), "--samples-from", str(tmp_path / "gone.mp4"), "--out", str(out))
+    assert code == 1 and "gone.mp4" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists() and not (tmp_path / "a.preview.png").exists()

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from facemime.codec.samples import library_from_clip
 from facemime.errors import InvalidInputError, NoFaceError
 from facemime.fit.actor import fit_actor
 from facemime.fit.preview import preview_sheet
@@ -30,7 +31,12 @@ class FitRun:
 
 
 def fit_file(
-    source: str | Path, out: str | Path, frame: int = 0, points_file: str | Path | None = None, force: bool = False
+    source: str | Path,
+    out: str | Path,
+    frame: int = 0,
+    points_file: str | Path | None = None,
+    force: bool = False,
+    samples_from: str | Path | None = None,
 ) -> FitRun:
     """Fit an actor to a photo and write its actor file and preview, both or neither.
 
@@ -49,6 +55,10 @@ def fit_file(
         finding them (needed where no face is found); None finds them.
     force
         Write over existing ``out`` and preview files.
+    samples_from
+        A clip of the same person (first frame frontal and neutral, like the photo) to take a
+        library of the person's own mouth and eyes from (:func:`~facemime.codec.samples.library_from_clip`):
+        the actor shows them wherever it is drawn; None: none.
 
     Returns
     -------
@@ -60,7 +70,7 @@ def fit_file(
     if out.suffix.lower() != ".actor":
         raise InvalidInputError(f"the actor file name must end in .actor, got {out.name!r}")
     preview = out.with_suffix(".preview.png")
-    with Outputs([out, preview], force, inputs=[source, points_file]) as outputs:
+    with Outputs([out, preview], force, inputs=[source, points_file, samples_from]) as outputs:
         photo = read_photo(source, frame)
         points = read_points(points_file, (photo.shape[1], photo.shape[0])) if points_file is not None else None
         t0 = time.perf_counter()
@@ -71,6 +81,13 @@ def fit_file(
                 f"{e}; mark the face by hand and pass the points with --points POINTS.json (format facemime.points/1)"
             ) from None
         seconds = time.perf_counter() - t0
+        if samples_from is not None:
+            library = library_from_clip(samples_from, actor)
+            if library is None:
+                warnings.append(
+                    f"{samples_from}: the face's mouth and eyes never change there, so no samples were kept"
+                )
+            actor = replace(actor, samples=library)
         write_bytes(outputs.stage(out), actor_bytes(actor))
         write_image(outputs.stage(preview), preview_sheet(actor, photo))
     return FitRun(actor, [out, preview], warnings, seconds, residual)

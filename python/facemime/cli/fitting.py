@@ -45,14 +45,23 @@ def model_preview(model: Path | None, out_file: Path, force: bool) -> None:
     type=click.Path(path_type=Path),
     help="facemime.points/1 JSON with reference points marked by hand (default: found automatically).",
 )
+@click.option(
+    "--samples-from",
+    "samples_from",
+    type=click.Path(path_type=Path),
+    help="A video of the same person (first frame frontal and neutral): keep samples of their own mouth "
+    "and eyes in the actor, drawn instead of a painted mouth interior and moved irises.",
+)
 @out_option("NAME.actor to write; the preview goes to NAME.preview.png.")
 @force_option
-def fit(source: Path, frame: int, points_file: Path | None, out_file: Path, force: bool) -> None:
+def fit(
+    source: Path, frame: int, points_file: Path | None, samples_from: Path | None, out_file: Path, force: bool
+) -> None:
     """Fit the generic head to the frontal face in IMAGE_OR_VIDEO: reference points, elastic
     adjustment, texture; write the actor file and a preview PNG."""
     from facemime.app.fit import fit_file
 
-    run = fit_file(source, out_file, frame, points_file, force)
+    run = fit_file(source, out_file, frame, points_file, force, samples_from)
     for w in run.warnings:
         click.echo(f"facemime: warning: {w}", err=True)
     for f in run.files:

@@ -24,7 +24,10 @@ from facemime.animate.eyes import LookPainter
 from facemime.animate.samples import INTERIOR_SIZE, interior_strip, mouth_knots, weigh_eyes
 from facemime.animate.synth import Puppet
 from facemime.codec.appearance import FACING, lay_back
-from facemime.codec.decoder import DecodedFrame
+from facemime.codec.clip import analyse, encode_clip
+from facemime.codec.decoder import DecodedFrame, MotionDecoder
+from facemime.codec.params import Basis
+from facemime.codec.stream import Settings
 from facemime.io.samples_file import SAMPLE_QUALITY
 from facemime.io.video import VideoReader
 from facemime.progress import track as progress
@@ -190,7 +193,13 @@ def _interior(
 
 class _Regions:
     """Lays frames back onto an actor's texture through the geometry the receiver draws, and cuts
-    out the sample groups' boxes and the mouth's interior."""
+    out the sample groups' boxes and the mouth's interior.
+
+    Parameters
+    ----------
+    actor
+        The actor as the receiver holds it.
+    """
 
     def __init__(self, actor: Actor):
         self.actor = actor
@@ -208,14 +217,45 @@ class _Regions:
             self.strip = self.strip[:0]  # a capped mouth (fit.actor.mouth_cap): its own texture shows the opening
 
     def key(self, group: str, f: DecodedFrame) -> np.ndarray:
-        """A decoded frame's key in a group, weighed for distances."""
+        """A decoded frame's key in a group.
+
+        Parameters
+        ----------
+        group
+            ``eyes`` or ``mouth``.
+        f
+            The decoded frame.
+
+        Returns
+        -------
+        (D,) float64 array
+            Its look weighed for distances (:func:`~facemime.animate.samples.weigh_eyes`), or its
+            lip knots' offsets flattened, model units.
+        """
         return weigh_eyes(f.look.vector()) if group == "eyes" else np.asarray(f.offsets)[self.mouth].ravel()
 
     def laid(
         self, frame: np.ndarray, f: DecodedFrame
     ) -> tuple[dict[str, list[np.ndarray]], dict[str, list[np.ndarray]], np.ndarray | None]:
-        """A frame's boxes per group (texels no facing triangle covers keep the texture's), their
-        coverage masks, and its interior (:func:`_interior`)."""
+        """A frame laid back onto the texture, cut into the groups' boxes.
+
+        Parameters
+        ----------
+        frame
+            (H, W, 3) uint8 RGB: the real frame.
+        f
+            Its motion as the receiver decodes it.
+
+        Returns
+        -------
+        crops : dict of str -> list of (h, w, 3) uint8 arrays
+            Per group, the frame in each box (texels no facing triangle covers keep the
+            texture's).
+        covers : dict of str -> list of (h, w) bool arrays
+            Per group and box, the texels the frame covers.
+        interior : (40, 96, 3) uint8 array or None
+            Its mouth's opening (:func:`_interior`).
+        """
         model, texture = self.actor.model, self.actor.texture
         assert model.uv is not None
         vertices, pose = self.puppet.vertices(f.offsets, look=f.look), self.puppet.pose(f.pose)
@@ -365,3 +405,30 @@ def choose_samples(video: str | Path, actor: Actor, decoded: list[DecodedFrame])
                     )
             out.append(tuple(previous[g] for g in GROUPS))
     return out
+
+
+def library_from_clip(video: str | Path, actor: Actor) -> Samples | None:
+    """A sample library for an actor from a clip of the same person (``fit --samples-from``): the
+    clip analysed with the actor placed on its face and coded as ``encode --actor`` codes it, the
+    library taken from what a receiver holding the actor decodes (:func:`build_samples`).
+
+    Parameters
+    ----------
+    video
+        The clip, the person's face roughly frontal on its first frame and, like the actor's
+        photo, neutral there.
+    actor
+        The actor, fitted on a photo of the same person.
+
+    Returns
+    -------
+    Samples or None
+        The library; None when the clip's shapes never leave its first frame's.
+    """
+    clip = analyse(video, actor)
+    faces = [m.offsets for m in clip.motion if m.face]
+    settings = Settings()
+    basis = Basis.learn(np.array(faces).reshape(len(faces), -1, 2), settings.basis_size)
+    header, _, packets = encode_clip(clip, settings, False, basis)
+    decoder = MotionDecoder(actor)
+    return build_samples(video, actor, decoder.push(header + b"".join(packets)) + decoder.finish())

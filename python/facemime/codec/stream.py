@@ -188,13 +188,13 @@ class MotionEncoder:
     look
         Whether the stream carries each frame's :class:`~facemime.types.look.Look` (format
         version 2); without it the stream is version 1 and the receiver decodes a neutral look.
-    samples
-        Whether the stream carries each frame's choice of the actor's mouth and eye samples
-        (extra kinds :data:`~facemime.shared_constants.SAMPLE_KINDS`, format version 2).
     actor_data
         The carried actor's file bytes when already made
         (:func:`~facemime.io.actor_file.actor_bytes` with a WebP texture: a live sender makes
         them before its stream starts, as they take a few hundred milliseconds); None: made here.
+    samples
+        Whether the stream carries each frame's choice of the actor's mouth and eye samples
+        (extra kinds :data:`~facemime.shared_constants.SAMPLE_KINDS`, format version 2).
     """
 
     def __init__(
