@@ -14,6 +14,13 @@ export const LOOK_NAMES = [
 ] as const;
 /** Entries of a basis vector are sent ×BASIS_ONE as int16. */
 export const BASIS_ONE = 32767;
+/** The extra parameters' kinds that choose the actor's mouth and eye samples per frame, in the order
+ * of the sample groups (eyes, mouth): the value is the index of the sample drawn plus one, 0 for
+ * none (the key frame's own). */
+export const SAMPLE_KINDS = [7, 8] as const;
+/** Their quantiser step: a sample index is 8 steps, so that the encoder's hysteresis (at most 4
+ * steps) never holds a change of sample back. */
+export const SAMPLE_STEP = 0.125;
 /** The eight contour groups whose vertices are the knots, in the bitstream's order (each curve
  * image-left to image-right, one vertex per knot). */
 export const CONTOUR_GROUPS = [
@@ -36,6 +43,11 @@ export const REACH = 0.45;
  * width as closed: the tracked inner lips of a closed mouth lie a pixel or two apart, and the dark
  * line that gap drew cost up to 8 dB in the mouth region. */
 export const SEAL = 0.05;
+/** The actor's samples of its own mouth and eyes: the sample groups, in the order they are painted. */
+export const SAMPLE_GROUPS = ["eyes", "mouth"] as const;
+/** The weight of the iris shifts (eye widths) against the lid closures (shares of the opening) in
+ * the distance between two looks that chooses an eye sample. */
+export const IRIS_WEIGHT = 5.0;
 /** The colour (RGB) behind a face drawn without its scene. */
 export const BACKGROUND = [38, 40, 46] as const;
 /** Tint of the synthesised picture in frames without a face. */

@@ -474,7 +474,67 @@
     return files;
   }
 
+  // src/shared_constants.ts
+  var POSE_FIELDS = ["yaw", "pitch", "roll", "scale", "tx", "ty"];
+  var LOOK_NAMES = [
+    "eye_right_closure",
+    "eye_left_closure",
+    "iris_right_u",
+    "iris_right_v",
+    "iris_left_u",
+    "iris_left_v"
+  ];
+  var BASIS_ONE = 32767;
+  var SAMPLE_KINDS = [7, 8];
+  var CONTOUR_GROUPS = [
+    "mouth_outer_upper",
+    "mouth_outer_lower",
+    "mouth_inner_upper",
+    "mouth_inner_lower",
+    "brow_left_upper",
+    "brow_left_lower",
+    "brow_right_upper",
+    "brow_right_lower"
+  ];
+  var SOFTEN = 0.02;
+  var REACH = 0.45;
+  var SEAL = 0.05;
+  var SAMPLE_GROUPS = ["eyes", "mouth"];
+  var IRIS_WEIGHT = 5;
+  var BACKGROUND = [38, 40, 46];
+  var NO_FACE_DIM = 0.45;
+  var CAVITY = [52, 18, 22];
+  var TEETH = [185, 165, 150];
+  var GAPS = [150, 140, 128];
+  var UPPER_TEETH = 0.11;
+  var LOWER_TEETH = 0.07;
+  var TEETH_SPAN = 0.72;
+  var UPPER_SHARE = 0.6;
+  var LOWER_SHARE = 0.4;
+  var TEETH_FROM = 0.04;
+  var TEETH_SPREAD = [0.9, 1.05];
+  var UPPER_MIN = 0.5;
+  var SHIFT = 4;
+  var EYES = ["eye_right", "eye_left"];
+  var DENSITY = 20;
+  var SPAN_U = [-0.7, 0.7];
+  var SPAN_V = [-0.55, 0.55];
+  var IRIS_RADIUS = 0.21;
+  var LID_EDGE = 0.04;
+  var IRIS_U = 0.32;
+  var IRIS_V = [-0.2, 0.2];
+  var UPPER_LID = [1, 2, 3];
+  var LOWER_LID = [7, 6, 5];
+  var PASTE_STILL = 0.25;
+  var IRIS_REACH = 1.15;
+  var RINGS = [[1.2, 1], [1.7, 0]];
+  var EDGE_MARGIN = 0.04;
+  var BORDER_STEPS = 9;
+  var SLOW = 1;
+
   // src/render/actor.ts
+  var MAX_SAMPLES = 64;
+  var MAX_BOXES = 4;
   var MAX_MEMBER = 64 << 20;
   async function decodeImage(bytes, type) {
     const bitmap = await createImageBitmap(
@@ -528,7 +588,60 @@
     const texture = await picture("texture");
     if (!texture) throw new Error("the actor has no texture");
     const scene = doc.scene ? await picture("scene") : null;
-    return { model, pose: doc.pose, source: doc.source, texture, scene };
+    const samples = files["samples.json"] ? await readSamples(files, texture) : null;
+    return { model, pose: doc.pose, source: doc.source, texture, scene, samples };
+  }
+  async function readSamples(files, texture) {
+    const bad = (why) => {
+      throw new Error(`the actor's samples.json is malformed (${why})`);
+    };
+    let doc;
+    try {
+      doc = JSON.parse(new TextDecoder().decode(files["samples.json"]));
+    } catch (e) {
+      return bad(e.message);
+    }
+    if (doc?.format !== "facemime.samples/1" || !Array.isArray(doc.groups)) bad("not a facemime.samples/1 document");
+    const groups = [];
+    for (const g of doc.groups) {
+      const { name, boxes, samples } = g ?? {};
+      if (!SAMPLE_GROUPS.includes(name)) bad(`a group is one of ${SAMPLE_GROUPS.join(", ")}, got ${JSON.stringify(name)}`);
+      if (groups.some((h) => h.name === name)) bad(`group ${name} appears twice`);
+      if (!Array.isArray(boxes) || boxes.length < 1 || boxes.length > MAX_BOXES || boxes.some((b) => !Array.isArray(b) || b.length !== 4 || b.some((v2) => !Number.isInteger(v2) || v2 < 0) || b[2] < 1 || b[3] < 1 || b[0] + b[2] > texture.width || b[1] + b[3] > texture.height)) {
+        bad(`group ${name}: boxes must be 1-${MAX_BOXES} rows of x, y, width, height inside the texture`);
+      }
+      if (!Array.isArray(samples) || samples.length < 1 || samples.length > MAX_SAMPLES) bad(`group ${name}: a group holds 1-${MAX_SAMPLES} samples`);
+      const entries = samples;
+      const keys = entries.map((e) => {
+        const key = e?.key;
+        if (!Array.isArray(key) || key.some((v2) => typeof v2 !== "number" || !Number.isFinite(v2))) return bad(`group ${name}: a sample's key is not a list of finite numbers`);
+        return Float64Array.from(key);
+      });
+      if (keys.some((k) => k.length !== keys[0].length) || name === "eyes" && keys[0].length !== 6) bad(`group ${name}: keys of unequal or wrong length`);
+      const frames = entries.map((e) => Number.isInteger(e?.frame) ? e.frame : bad(`group ${name}: a sample's frame is not an integer`));
+      const rects = boxes;
+      const inside = entries.map((e) => e?.interior === true);
+      const image = async (s, b) => {
+        for (const [ext, type] of [["png", "image/png"], ["webp", "image/webp"]]) {
+          const bytes = files[`samples/${name}/${s}_${b}.${ext}`];
+          if (!bytes) continue;
+          try {
+            return await decodeImage(bytes, type);
+          } catch {
+            return bad(`sample image samples/${name}/${s}_${b}.${ext} does not decode`);
+          }
+        }
+        return bad(`sample ${s} of group ${name} has no image of ${b === "interior" ? "its interior" : `box ${b}`}`);
+      };
+      const images = await Promise.all(entries.map((_, s) => Promise.all(rects.map(async ([, , w, h], b) => {
+        const got = await image(s, b);
+        if (got.width !== w || got.height !== h) bad(`sample image samples/${name}/${s}_${b} is not its box's size`);
+        return got;
+      }))));
+      const interiors = inside.some((i2) => i2) ? await Promise.all(inside.map((i2, s) => i2 ? image(s, "interior") : null)) : null;
+      groups.push({ name, boxes: rects, keys, frames, images, interiors });
+    }
+    return groups;
   }
 
   // src/render/appearance.ts
@@ -543,20 +656,23 @@
     }
   }
   function applyUpdate(texture, u4) {
-    const tw = texture.width, th = texture.height, w = u4.image.width, h = u4.image.height;
-    if (u4.x >= tw || u4.y >= th) return false;
-    const fadeLeft = u4.x > 0, fadeTop = u4.y > 0, fadeRight = u4.x + w < tw, fadeBottom = u4.y + h < th;
-    for (let j = 0; j < h && u4.y + j < th; j++) {
-      for (let i2 = 0; i2 < w && u4.x + i2 < tw; i2++) {
+    return pasteFaded(texture, u4.image, u4.x, u4.y);
+  }
+  function pasteFaded(texture, image, x2, y) {
+    const tw = texture.width, th = texture.height, w = image.width, h = image.height;
+    if (x2 >= tw || y >= th) return false;
+    const fadeLeft = x2 > 0, fadeTop = y > 0, fadeRight = x2 + w < tw, fadeBottom = y + h < th;
+    for (let j = 0; j < h && y + j < th; j++) {
+      for (let i2 = 0; i2 < w && x2 + i2 < tw; i2++) {
         let d = Infinity;
         if (fadeLeft) d = Math.min(d, i2);
         if (fadeRight) d = Math.min(d, w - 1 - i2);
         if (fadeTop) d = Math.min(d, j);
         if (fadeBottom) d = Math.min(d, h - 1 - j);
         const k = Math.min(8, d + 1);
-        const s = 4 * (j * w + i2), t = 4 * ((u4.y + j) * tw + u4.x + i2);
+        const s = 4 * (j * w + i2), t = 4 * ((y + j) * tw + x2 + i2);
         for (let c = 0; c < 3; c++) {
-          texture.rgba[t + c] = Math.floor((k * u4.image.rgba[s + c] + (8 - k) * texture.rgba[t + c] + 4) / 8);
+          texture.rgba[t + c] = Math.floor((k * image.rgba[s + c] + (8 - k) * texture.rgba[t + c] + 4) / 8);
         }
       }
     }
@@ -719,61 +835,6 @@ void main() {
       return out;
     }
   };
-
-  // src/shared_constants.ts
-  var POSE_FIELDS = ["yaw", "pitch", "roll", "scale", "tx", "ty"];
-  var LOOK_NAMES = [
-    "eye_right_closure",
-    "eye_left_closure",
-    "iris_right_u",
-    "iris_right_v",
-    "iris_left_u",
-    "iris_left_v"
-  ];
-  var BASIS_ONE = 32767;
-  var CONTOUR_GROUPS = [
-    "mouth_outer_upper",
-    "mouth_outer_lower",
-    "mouth_inner_upper",
-    "mouth_inner_lower",
-    "brow_left_upper",
-    "brow_left_lower",
-    "brow_right_upper",
-    "brow_right_lower"
-  ];
-  var SOFTEN = 0.02;
-  var REACH = 0.45;
-  var SEAL = 0.05;
-  var BACKGROUND = [38, 40, 46];
-  var NO_FACE_DIM = 0.45;
-  var CAVITY = [52, 18, 22];
-  var TEETH = [185, 165, 150];
-  var GAPS = [150, 140, 128];
-  var UPPER_TEETH = 0.11;
-  var LOWER_TEETH = 0.07;
-  var TEETH_SPAN = 0.72;
-  var UPPER_SHARE = 0.6;
-  var LOWER_SHARE = 0.4;
-  var TEETH_FROM = 0.04;
-  var TEETH_SPREAD = [0.9, 1.05];
-  var UPPER_MIN = 0.5;
-  var SHIFT = 4;
-  var EYES = ["eye_right", "eye_left"];
-  var DENSITY = 20;
-  var SPAN_U = [-0.7, 0.7];
-  var SPAN_V = [-0.55, 0.55];
-  var IRIS_RADIUS = 0.21;
-  var LID_EDGE = 0.04;
-  var IRIS_U = 0.32;
-  var IRIS_V = [-0.2, 0.2];
-  var UPPER_LID = [1, 2, 3];
-  var LOWER_LID = [7, 6, 5];
-  var PASTE_STILL = 0.25;
-  var IRIS_REACH = 1.15;
-  var RINGS = [[1.2, 1], [1.7, 0]];
-  var EDGE_MARGIN = 0.04;
-  var BORDER_STEPS = 9;
-  var SLOW = 1;
 
   // src/render/geometry.ts
   function rotation(yaw, pitch, roll) {
@@ -1979,6 +2040,134 @@ void main() {
     return { x0, y0, width: w, height: h, rgba };
   }
 
+  // src/render/samples.ts
+  var MOUTH_GROUPS = ["mouth_outer_upper", "mouth_outer_lower", "mouth_inner_upper", "mouth_inner_lower"];
+  function interiorUv(model) {
+    const uv = new Float64Array(model.vertices.length / 3 * 2);
+    const upper = model.groups.mouth_inner_upper ?? [], lower = model.groups.mouth_inner_lower ?? [];
+    for (const [curve, v2] of [[upper, 0], [lower, 1]]) {
+      const step = 1 / (curve.length - 1);
+      curve.forEach((vertex, i2) => {
+        uv[2 * vertex] = curve.length > 1 && i2 === curve.length - 1 ? 1 : i2 * step || 0;
+        uv[2 * vertex + 1] = v2;
+      });
+    }
+    for (const vertex of upper) if (lower.includes(vertex)) uv[2 * vertex + 1] = 0.5;
+    return uv;
+  }
+  function lipStrip(model) {
+    const upper = model.groups.mouth_inner_upper ?? [], lower = model.groups.mouth_inner_lower ?? [];
+    if (upper.length !== lower.length) return new Uint32Array(0);
+    const out = [];
+    for (let i2 = 0; i2 + 1 < upper.length; i2++) {
+      const [a, b, c, d] = [upper[i2], upper[i2 + 1], lower[i2 + 1], lower[i2]];
+      for (const t of [[a, b, c], [a, c, d]]) if (new Set(t).size === 3) out.push(...t);
+    }
+    return Uint32Array.from(out);
+  }
+  function roundHalfEven(x2) {
+    const f = Math.floor(x2), d = x2 - f;
+    return d < 0.5 ? f : d > 0.5 ? f + 1 : f % 2 === 0 ? f : f + 1;
+  }
+  function sentSamples(kinds, values, first) {
+    const extras = Array.from(kinds);
+    if (!extras.some((k) => SAMPLE_KINDS.includes(k))) return null;
+    return SAMPLE_KINDS.map((kind) => {
+      const j = extras.indexOf(kind);
+      const k = roundHalfEven(j < 0 ? 0 : values[first + j]);
+      return k < 1 ? null : k - 1;
+    });
+  }
+  function weighEyes(key) {
+    return Float64Array.from(key, (v2, j) => v2 * (j < 2 ? 1 : IRIS_WEIGHT));
+  }
+  function pairwiseSum(x2, start, n) {
+    if (n < 8) {
+      let s = -0;
+      for (let i2 = 0; i2 < n; i2++) s += x2[start + i2];
+      return s;
+    }
+    if (n <= 128) {
+      const r = [0, 1, 2, 3, 4, 5, 6, 7].map((i3) => x2[start + i3]);
+      let i2 = 8;
+      for (; i2 < n - n % 8; i2 += 8) for (let j = 0; j < 8; j++) r[j] += x2[start + i2 + j];
+      let s = r[0] + r[1] + (r[2] + r[3]) + (r[4] + r[5] + (r[6] + r[7]));
+      for (; i2 < n; i2++) s += x2[start + i2];
+      return s;
+    }
+    let n2 = Math.floor(n / 2);
+    n2 -= n2 % 8;
+    return pairwiseSum(x2, start, n2) + pairwiseSum(x2, start + n2, n - n2);
+  }
+  function nearest(keys, key) {
+    const sq = new Float64Array(key.length);
+    let best = -1, bestD = Infinity;
+    keys.forEach((k, s) => {
+      for (let j = 0; j < key.length; j++) sq[j] = (k[j] - key[j]) * (k[j] - key[j]);
+      const d = Math.sqrt(pairwiseSum(sq, 0, key.length));
+      if (best < 0 || d < bestD) {
+        best = s;
+        bestD = d;
+      }
+    });
+    let norm2 = 0;
+    for (let j = 0; j < key.length; j++) norm2 += key[j] * key[j];
+    return best < 0 || Math.sqrt(norm2) <= bestD ? null : best;
+  }
+  var SamplePainter = class {
+    /** `knots`: the model's knots' vertex indices (Deformer.knots). */
+    constructor(groups, model, knots) {
+      this.groups = groups;
+      this.work = null;
+      this.keys = groups.map((g) => g.name === "eyes" ? g.keys.map(weighEyes) : g.keys);
+      const lips = new Set(MOUTH_GROUPS.flatMap((name) => model.groups[name] ?? []));
+      this.mouth = knots.flatMap((v2, k) => lips.has(v2) ? [2 * k, 2 * k + 1] : []);
+    }
+    /** Each group's sample for a frame (in the groups' order; null: nothing pasted): the stream's
+     * ``sent`` choice (per group of SAMPLE_GROUPS, sentSamples; an index beyond a group's samples
+     * draws none), or, where the stream sends none, the sample nearest the frame's shape: `offsets`
+     * the knots' (x, y) offsets flattened, the actor's model units; `look` the frame's look vector
+     * (closures, then iris u, v of each eye). */
+    choose(offsets, look, sent = null) {
+      if (sent) {
+        return this.groups.map((g) => {
+          const k = sent[SAMPLE_GROUPS.indexOf(g.name)] ?? null;
+          return k !== null && k < g.keys.length ? k : null;
+        });
+      }
+      const frame = {
+        eyes: weighEyes(look),
+        mouth: Float64Array.from(this.mouth, (r) => offsets[r])
+      };
+      return this.groups.map((g, i2) => {
+        const key = frame[g.name];
+        return this.keys[i2][0].length === key.length ? nearest(this.keys[i2], key) : null;
+      });
+    }
+    /** The chosen mouth sample's interior image (interiorUv), and the sample's index; null where
+     * no mouth sample is chosen or it has none. */
+    interior(chosen) {
+      const i2 = this.groups.findIndex((g) => g.name === "mouth"), k = i2 < 0 ? null : chosen[i2];
+      const image = k === null ? null : this.groups[i2].interiors?.[k] ?? null;
+      return image && k !== null ? { sample: k, image } : null;
+    }
+    /** `texture` with the chosen samples pasted (a working copy reused between calls), or
+     * `texture` itself when none is chosen. */
+    paint(texture, chosen) {
+      if (chosen.every((k) => k === null)) return texture;
+      if (!this.work || this.work.width !== texture.width || this.work.height !== texture.height) {
+        this.work = { width: texture.width, height: texture.height, rgba: texture.rgba.slice() };
+      } else {
+        this.work.rgba.set(texture.rgba);
+      }
+      this.groups.forEach((g, i2) => {
+        const k = chosen[i2];
+        if (k !== null) g.boxes.forEach(([x2, y], b) => pasteFaded(this.work, g.images[k][b], x2, y));
+      });
+      return this.work;
+    }
+  };
+
   // node_modules/robust-predicates/esm/util.js
   var epsilon = 11102230246251565e-32;
   var splitter = 134217729;
@@ -2843,6 +3032,12 @@ void main() {
       this.renderer = renderer2;
       this.actor = actor;
       this.header = header;
+      /** The texture the look painted last (LookPainter.texture), the samples pasted into it. */
+      this.looked = null;
+      /** The samples chosen in the texture uploaded last (SamplePainter.choose, joined). */
+      this.pasted = "";
+      /** The mouth samples' interiors uploaded so far, by sample index. */
+      this.interiors = /* @__PURE__ */ new Map();
       const m = actor.model;
       this.deformer = new Deformer(m);
       if (header.basisLength !== 2 * this.deformer.knots.length) {
@@ -2853,6 +3048,9 @@ void main() {
       this.restWidth = mouthWidth(m, m.vertices);
       this.textureLayer = renderer2.upload(actor.texture);
       this.painter = new LookPainter(actor.texture, m);
+      this.samples = actor.samples ? new SamplePainter(actor.samples, m, this.deformer.knots) : null;
+      this.interiorUv = interiorUv(m);
+      this.strip = lipStrip(m);
       if (actor.scene) {
         const { width, height } = actor.source;
         const outline = m.groups.face_outline;
@@ -2890,9 +3088,14 @@ void main() {
       const [w, h] = this.size;
       const pick = (name) => Float64Array.from(m.groups[name].flatMap((i2) => [points[2 * i2], points[2 * i2 + 1]]));
       const spread = mouthWidth(m, vertices) / Math.max(this.restWidth, 1e-9);
-      const patch = mouthPatch(pick("mouth_inner_upper"), pick("mouth_inner_lower"), teethUncovered(spread), [w, h]);
-      const texture = this.painter.texture(look.iris);
-      if (texture) this.textureLayer = this.renderer.upload(texture, this.textureLayer);
+      const chosen = this.samples?.choose(
+        offsets,
+        [...look.closure, ...look.iris[0], ...look.iris[1]],
+        sentSamples(this.header.extras, v2, 6 + coefficients)
+      ) ?? [];
+      const interior = this.samples?.interior(chosen) ?? null;
+      const patch = interior ? null : mouthPatch(pick("mouth_inner_upper"), pick("mouth_inner_lower"), teethUncovered(spread), [w, h]);
+      this.uploadTexture(chosen, look.iris);
       const r = this.renderer;
       r.begin(w, h, BACKGROUND, view);
       if (this.scene && this.sceneLayer && this.sceneUv) {
@@ -2910,9 +3113,32 @@ void main() {
         r.mesh(this.sceneLayer, at, this.sceneUv, Uint32Array.from(slow), false, false);
         r.mesh(this.sceneLayer, at, this.sceneUv, Uint32Array.from(fast), true, false);
       }
-      if (patch) r.mouthPatch(patch);
+      if (interior) {
+        let layer = this.interiors.get(interior.sample);
+        if (!layer) this.interiors.set(interior.sample, layer = r.upload(interior.image));
+        r.mesh(layer, points, this.interiorUv, paintersOrder(points, depth, this.strip, false), true, false);
+      } else if (patch) {
+        r.mouthPatch(patch);
+      }
       r.mesh(this.textureLayer, points, m.uv, paintersOrder(points, depth, m.triangles), true, false);
       if (!motion.face) r.dim(NO_FACE_DIM, w, h);
+    }
+    /** Uploads the frame's texture when it differs from the last uploaded: the look's irises
+     * painted (LookPainter.texture), then the ``chosen`` samples pasted (SamplePainter.choose;
+     * facemime.animate.synth.Puppet.render, the stream's own actor: offsets in its model units, no
+     * gain). */
+    uploadTexture(chosen, iris) {
+      const painted = this.painter.texture(iris);
+      if (painted) this.looked = painted;
+      const looked = this.looked;
+      if (!this.samples) {
+        if (painted) this.textureLayer = this.renderer.upload(painted, this.textureLayer);
+        return;
+      }
+      const pasted = chosen.join(",");
+      if (!painted && pasted === this.pasted) return;
+      this.pasted = pasted;
+      this.textureLayer = this.renderer.upload(this.samples.paint(looked, chosen), this.textureLayer);
     }
     look(v2, first) {
       const at = (name) => {
@@ -2925,12 +3151,12 @@ void main() {
       };
     }
   };
-  function paintersOrder(points, depth, triangles) {
+  function paintersOrder(points, depth, triangles, cull = true) {
     const order = [];
     for (let f = 0; f < triangles.length / 3; f++) {
       const a = triangles[3 * f], b = triangles[3 * f + 1], c = triangles[3 * f + 2];
       const area2 = (points[2 * b] - points[2 * a]) * (points[2 * c + 1] - points[2 * a + 1]) - (points[2 * b + 1] - points[2 * a + 1]) * (points[2 * c] - points[2 * a]);
-      if (area2 < 0) order.push([(depth[a] + depth[b] + depth[c]) / 3, f]);
+      if (cull ? area2 < 0 : area2 !== 0) order.push([(depth[a] + depth[b] + depth[c]) / 3, f]);
     }
     order.sort((x2, y) => x2[0] - y[0]);
     const out = new Uint32Array(order.length * 3);

@@ -1,12 +1,16 @@
 /**
  * The actor a stream carries (``facemime.actor/1``, docs/bitstream.md "Actor"): a ZIP archive of
  * ``actor.json`` (the head model, its pose on the source picture, the source's size), the
- * texture and, when it has one, the scene (the source picture the face is drawn in).
+ * texture and, when it has one, the scene (the source picture the face is drawn in), and, when it
+ * has one, its sample library of its own mouth and eyes (``samples.json``,
+ * ``samples/<group>/<sample>_<box>.webp`` and a mouth sample's ``<sample>_interior.webp``,
+ * facemime.io.samples_file).
  *
  * Images are RGBA, row-major from the top-left pixel.
  */
 import { unzipSync } from 'fflate';
 import type { Model, Pose } from './geometry';
+import { SAMPLE_GROUPS } from '../shared_constants';
 
 export interface Picture { width: number; height: number; rgba: Uint8Array }
 
@@ -16,7 +20,28 @@ export interface Actor {
   source: { width: number; height: number };
   texture: Picture;
   scene: Picture | null;
+  /** The sample library's groups, in the file's order; null: the actor has none. */
+  samples: SampleGroup[] | null;
 }
+
+/** One group of an actor's samples (facemime.types.samples.SampleGroup). */
+export interface SampleGroup {
+  name: (typeof SAMPLE_GROUPS)[number];
+  /** Each rectangle's [x, y, width, height] in the texture, texels. */
+  boxes: [number, number, number, number][];
+  /** Per sample, its shape as stored: the look vector (eyes) or the mouth knots' offsets. */
+  keys: Float64Array[];
+  /** Per sample, the frame it was taken from (informative). */
+  frames: number[];
+  /** Per sample, its image of each box (RGBA, the box's size). */
+  images: Picture[][];
+  /** Per sample, the mouth's opening laid out between the inner lips (samples.interiorUv; null:
+   * the sample has none); null: no sample of the group has one. */
+  interiors: (Picture | null)[] | null;
+}
+
+/** At most this many samples and boxes a group (facemime.io.samples_file). */
+const MAX_SAMPLES = 64, MAX_BOXES = 4;
 
 /** Largest member accepted, bytes (as the Python reader). */
 const MAX_MEMBER = 64 << 20;
@@ -75,5 +100,62 @@ export async function readActor(data: Uint8Array): Promise<Actor> {
   const texture = await picture('texture');
   if (!texture) throw new Error('the actor has no texture');
   const scene = doc.scene ? await picture('scene') : null;
-  return { model, pose: doc.pose as Pose, source: doc.source, texture, scene };
+  const samples = files['samples.json'] ? await readSamples(files, texture) : null;
+  return { model, pose: doc.pose as Pose, source: doc.source, texture, scene, samples };
+}
+
+/** An actor's sample library from its members (facemime.io.samples_file.samples_from_members,
+ * with facemime.types.samples' checks); throws an Error with a one-line reason when malformed. */
+async function readSamples(files: Record<string, Uint8Array>, texture: Picture): Promise<SampleGroup[]> {
+  const bad = (why: string): never => { throw new Error(`the actor's samples.json is malformed (${why})`); };
+  let doc;
+  try {
+    doc = JSON.parse(new TextDecoder().decode(files['samples.json']));
+  } catch (e) {
+    return bad((e as Error).message);
+  }
+  if (doc?.format !== 'facemime.samples/1' || !Array.isArray(doc.groups)) bad('not a facemime.samples/1 document');
+  const groups: SampleGroup[] = [];
+  for (const g of doc.groups as unknown[]) {
+    const { name, boxes, samples } = (g ?? {}) as { name: unknown; boxes: unknown; samples: unknown };
+    if (!SAMPLE_GROUPS.includes(name as SampleGroup['name'])) bad(`a group is one of ${SAMPLE_GROUPS.join(', ')}, got ${JSON.stringify(name)}`);
+    if (groups.some((h) => h.name === name)) bad(`group ${name} appears twice`);
+    if (!Array.isArray(boxes) || boxes.length < 1 || boxes.length > MAX_BOXES
+      || boxes.some((b) => !Array.isArray(b) || b.length !== 4 || b.some((v) => !Number.isInteger(v) || v < 0) || b[2] < 1 || b[3] < 1
+        || b[0] + b[2] > texture.width || b[1] + b[3] > texture.height)) {
+      bad(`group ${name}: boxes must be 1-${MAX_BOXES} rows of x, y, width, height inside the texture`);
+    }
+    if (!Array.isArray(samples) || samples.length < 1 || samples.length > MAX_SAMPLES) bad(`group ${name}: a group holds 1-${MAX_SAMPLES} samples`);
+    const entries = samples as { frame: unknown; key: unknown; interior?: unknown }[];
+    const keys = entries.map((e) => {
+      const key = e?.key;
+      if (!Array.isArray(key) || key.some((v) => typeof v !== 'number' || !Number.isFinite(v))) return bad(`group ${name}: a sample's key is not a list of finite numbers`);
+      return Float64Array.from(key as number[]);
+    });
+    if (keys.some((k) => k.length !== keys[0].length) || (name === 'eyes' && keys[0].length !== 6)) bad(`group ${name}: keys of unequal or wrong length`);
+    const frames = entries.map((e) => (Number.isInteger(e?.frame) ? (e.frame as number) : bad(`group ${name}: a sample's frame is not an integer`)));
+    const rects = boxes as [number, number, number, number][];
+    const inside = entries.map((e) => e?.interior === true);
+    // one sample's image of box `b` (its index, or 'interior'), PNG or WebP
+    const image = async (s: number, b: number | 'interior'): Promise<Picture> => {
+      for (const [ext, type] of [['png', 'image/png'], ['webp', 'image/webp']]) {
+        const bytes = files[`samples/${name}/${s}_${b}.${ext}`];
+        if (!bytes) continue;
+        try {
+          return await decodeImage(bytes, type);
+        } catch {
+          return bad(`sample image samples/${name}/${s}_${b}.${ext} does not decode`);
+        }
+      }
+      return bad(`sample ${s} of group ${name} has no image of ${b === 'interior' ? 'its interior' : `box ${b}`}`);
+    };
+    const images = await Promise.all(entries.map((_, s) => Promise.all(rects.map(async ([, , w, h], b) => {
+      const got = await image(s, b);
+      if (got.width !== w || got.height !== h) bad(`sample image samples/${name}/${s}_${b} is not its box's size`);
+      return got;
+    }))));
+    const interiors = inside.some((i) => i) ? await Promise.all(inside.map((i, s) => (i ? image(s, 'interior') : null))) : null;
+    groups.push({ name: name as SampleGroup['name'], boxes: rects, keys, frames, images, interiors });
+  }
+  return groups;
 }

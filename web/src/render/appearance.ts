@@ -1,7 +1,7 @@
 /**
  * Appearance updates (docs/bitstream.md, "Appearance"): a WebP image pasted into a rectangle of
  * the actor's texture from frame F on, its fading edges blended over 8 texels with the integer
- * rule of the specification.
+ * rule of the specification (pasteFaded, which the actor's mouth and eye samples share).
  */
 import { decodeImage, type Picture } from './actor';
 
@@ -23,20 +23,29 @@ export async function readUpdate(payload: Uint8Array): Promise<Update | null> {
 /** Applies ``u`` to ``texture`` in place; false (nothing changed) when its rectangle lies wholly
  * outside the texture. */
 export function applyUpdate(texture: Picture, u: Update): boolean {
-  const tw = texture.width, th = texture.height, w = u.image.width, h = u.image.height;
-  if (u.x >= tw || u.y >= th) return false;
-  const fadeLeft = u.x > 0, fadeTop = u.y > 0, fadeRight = u.x + w < tw, fadeBottom = u.y + h < th;
-  for (let j = 0; j < h && u.y + j < th; j++) {
-    for (let i = 0; i < w && u.x + i < tw; i++) {
+  return pasteFaded(texture, u.image, u.x, u.y);
+}
+
+/** Pastes ``image`` into ``texture`` in place with its top-left texel at (x, y), its edges faded
+ * into the texture over 8 texels (facemime.render.paste.paste_faded): a texel at distance d from
+ * the nearest edge that is not on the texture's border weighs k / 8, k = min(8, d + 1), and
+ * becomes (k u + (8 - k) t + 4) // 8; texels beyond the texture are ignored. False (nothing
+ * changed) when the image lies wholly outside the texture. */
+export function pasteFaded(texture: Picture, image: Picture, x: number, y: number): boolean {
+  const tw = texture.width, th = texture.height, w = image.width, h = image.height;
+  if (x >= tw || y >= th) return false;
+  const fadeLeft = x > 0, fadeTop = y > 0, fadeRight = x + w < tw, fadeBottom = y + h < th;
+  for (let j = 0; j < h && y + j < th; j++) {
+    for (let i = 0; i < w && x + i < tw; i++) {
       let d = Infinity;
       if (fadeLeft) d = Math.min(d, i);
       if (fadeRight) d = Math.min(d, w - 1 - i);
       if (fadeTop) d = Math.min(d, j);
       if (fadeBottom) d = Math.min(d, h - 1 - j);
       const k = Math.min(8, d + 1);
-      const s = 4 * (j * w + i), t = 4 * ((u.y + j) * tw + u.x + i);
+      const s = 4 * (j * w + i), t = 4 * ((y + j) * tw + x + i);
       for (let c = 0; c < 3; c++) {
-        texture.rgba[t + c] = Math.floor((k * u.image.rgba[s + c] + (8 - k) * texture.rgba[t + c] + 4) / 8);
+        texture.rgba[t + c] = Math.floor((k * image.rgba[s + c] + (8 - k) * texture.rgba[t + c] + 4) / 8);
       }
     }
   }

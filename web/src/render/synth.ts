@@ -1,9 +1,12 @@
 /**
  * A stream's frames drawn on its actor, as ``facemime decode`` draws them
  * (facemime.animate.synth.Puppet driven by the actor's own motion): the knot offsets deform the
- * head, the look closes the lids and moves the irises, the pose places it, and the picture is the
- * actor's scene warped to follow the face (or the face alone on a dark background when the
- * actor has no scene). A frame without a face shows the last face, dimmed.
+ * head, the look closes the lids and moves the irises, the actor's own mouth and eye samples the
+ * stream chose (or, in a stream that sends no choice, those nearest the frame's shape) are pasted
+ * into the texture, the mouth's opening is drawn from the chosen mouth sample's interior where it
+ * has one (else painted: cavity and teeth), the pose places it, and the picture is the actor's
+ * scene warped to follow the face (or the face alone on a dark background when the actor has no
+ * scene). A frame without a face shows the last face, dimmed.
  */
 import type { Header } from '../stream';
 import type { Actor, Picture } from './actor';
@@ -11,6 +14,7 @@ import { closeLids, Deformer, mouthWidth, poseFromValues, project, shownPose, ty
 import { LookPainter } from './eyes';
 import { Renderer, type Layer } from './gl';
 import { mouthPatch, teethUncovered } from './mouth';
+import { interiorUv, lipStrip, SamplePainter, sentSamples } from './samples';
 import { SceneMesh } from './scene';
 import { BACKGROUND, BASIS_ONE, LOOK_NAMES, NO_FACE_DIM, SEAL, SLOW } from '../shared_constants';
 
@@ -25,6 +29,17 @@ export class Synthesizer {
   private readonly sceneUv: Float32Array | null;
   private textureLayer: Layer;
   private painter: LookPainter;
+  private readonly samples: SamplePainter | null;
+  /** The texture the look painted last (LookPainter.texture), the samples pasted into it. */
+  private looked: Picture | null = null;
+  /** The samples chosen in the texture uploaded last (SamplePainter.choose, joined). */
+  private pasted = '';
+  /** The mouth interiors' texture coordinates per vertex (interiorUv) and the strip between the
+   * inner lips they are drawn on (lipStrip). */
+  private readonly interiorUv: Float64Array;
+  private readonly strip: Uint32Array;
+  /** The mouth samples' interiors uploaded so far, by sample index. */
+  private readonly interiors = new Map<number, Layer>();
   private readonly key: Pose;
   private readonly basis: Float64Array;
   private readonly restWidth: number;
@@ -40,6 +55,9 @@ export class Synthesizer {
     this.restWidth = mouthWidth(m, m.vertices);
     this.textureLayer = renderer.upload(actor.texture);
     this.painter = new LookPainter(actor.texture, m);
+    this.samples = actor.samples ? new SamplePainter(actor.samples, m, this.deformer.knots) : null;
+    this.interiorUv = interiorUv(m);
+    this.strip = lipStrip(m);
     if (actor.scene) {
       const { width, height } = actor.source;
       const outline = m.groups.face_outline;
@@ -80,9 +98,11 @@ export class Synthesizer {
     const [w, h] = this.size;
     const pick = (name: string) => Float64Array.from(m.groups[name].flatMap((i) => [points[2 * i], points[2 * i + 1]]));
     const spread = mouthWidth(m, vertices) / Math.max(this.restWidth, 1e-9);
-    const patch = mouthPatch(pick('mouth_inner_upper'), pick('mouth_inner_lower'), teethUncovered(spread), [w, h]);
-    const texture = this.painter.texture(look.iris);
-    if (texture) this.textureLayer = this.renderer.upload(texture, this.textureLayer);
+    const chosen = this.samples?.choose(offsets, [...look.closure, ...look.iris[0], ...look.iris[1]],
+      sentSamples(this.header.extras, v, 6 + coefficients)) ?? [];
+    const interior = this.samples?.interior(chosen) ?? null;
+    const patch = interior ? null : mouthPatch(pick('mouth_inner_upper'), pick('mouth_inner_lower'), teethUncovered(spread), [w, h]);
+    this.uploadTexture(chosen, look.iris);
     const r = this.renderer;
     r.begin(w, h, BACKGROUND, view);
     if (this.scene && this.sceneLayer && this.sceneUv) {
@@ -101,9 +121,34 @@ export class Synthesizer {
       r.mesh(this.sceneLayer, at, this.sceneUv, Uint32Array.from(slow), false, false);
       r.mesh(this.sceneLayer, at, this.sceneUv, Uint32Array.from(fast), true, false);
     }
-    if (patch) r.mouthPatch(patch);
+    if (interior) {
+      // the chosen sample's opening, stretched between the inner lips (both sides drawn)
+      let layer = this.interiors.get(interior.sample);
+      if (!layer) this.interiors.set(interior.sample, (layer = r.upload(interior.image)));
+      r.mesh(layer, points, this.interiorUv, paintersOrder(points, depth, this.strip, false), true, false);
+    } else if (patch) {
+      r.mouthPatch(patch);
+    }
     r.mesh(this.textureLayer, points, m.uv, paintersOrder(points, depth, m.triangles), true, false);
     if (!motion.face) r.dim(NO_FACE_DIM, w, h);
+  }
+
+  /** Uploads the frame's texture when it differs from the last uploaded: the look's irises
+   * painted (LookPainter.texture), then the ``chosen`` samples pasted (SamplePainter.choose;
+   * facemime.animate.synth.Puppet.render, the stream's own actor: offsets in its model units, no
+   * gain). */
+  private uploadTexture(chosen: (number | null)[], iris: [number, number][]): void {
+    const painted = this.painter.texture(iris);
+    if (painted) this.looked = painted;
+    const looked = this.looked as Picture;
+    if (!this.samples) {
+      if (painted) this.textureLayer = this.renderer.upload(painted, this.textureLayer);
+      return;
+    }
+    const pasted = chosen.join(',');
+    if (!painted && pasted === this.pasted) return;
+    this.pasted = pasted;
+    this.textureLayer = this.renderer.upload(this.samples.paint(looked, chosen), this.textureLayer);
   }
 
   private look(v: ArrayLike<number>, first: number): { closure: [number, number]; iris: [number, number][] } {
@@ -118,15 +163,16 @@ export class Synthesizer {
   }
 }
 
-/** The front-facing triangles (counter-clockwise in the image, y down) far to near by mean
- * depth, a stable sort (facemime.render.raster's painter order). */
-export function paintersOrder(points: Float64Array, depth: Float64Array, triangles: Uint32Array): Uint32Array {
+/** The front-facing triangles (counter-clockwise in the image, y down; with ``cull`` false, all
+ * but those of zero area) far to near by mean depth, a stable sort (facemime.render.raster's
+ * painter order). */
+export function paintersOrder(points: Float64Array, depth: Float64Array, triangles: Uint32Array, cull = true): Uint32Array {
   const order: [number, number][] = [];
   for (let f = 0; f < triangles.length / 3; f++) {
     const a = triangles[3 * f], b = triangles[3 * f + 1], c = triangles[3 * f + 2];
     const area2 = (points[2 * b] - points[2 * a]) * (points[2 * c + 1] - points[2 * a + 1])
       - (points[2 * b + 1] - points[2 * a + 1]) * (points[2 * c] - points[2 * a]);
-    if (area2 < 0) order.push([(depth[a] + depth[b] + depth[c]) / 3, f]);
+    if (cull ? area2 < 0 : area2 !== 0) order.push([(depth[a] + depth[b] + depth[c]) / 3, f]);
   }
   order.sort((x, y) => x[0] - y[0]);
   const out = new Uint32Array(order.length * 3);
