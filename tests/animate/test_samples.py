@@ -40,19 +40,20 @@ def _painter(texture_shape=(40, 60)):
 def test_a_closed_eye_look_pastes_the_closed_eye_sample_and_nothing_outside_its_boxes():
     painter = _painter()
     texture = np.full((40, 60, 3), 100, np.uint8)
-    out, interior = painter.paint(texture, np.zeros((3, 2)), Look(closure=[0.9, 1.0]))
+    out, interior = painter.paint(texture, painter.choose(np.zeros((3, 2)), Look(closure=[0.9, 1.0])))
     assert interior is None  # no mouth samples
     assert out is not texture and (texture == 100).all()  # the texture given is left alone
     assert out[10, 14].tolist() == [200, 200, 200] and out[10, 44].tolist() == [200, 200, 200]  # inside, past the fade
     assert out[30, 30].tolist() == [100, 100, 100]
     assert 100 < out[2, 14, 0] < 200  # the box's edge fades into the texture
-    looked_aside, _ = painter.paint(texture, np.zeros((3, 2)), Look(iris=[[0.09, 0.0], [0.11, 0.0]]))
+    looked_aside, _ = painter.paint(texture, painter.choose(np.zeros((3, 2)), Look(iris=[[0.09, 0.0], [0.11, 0.0]])))
     assert looked_aside[10, 14].tolist() == [50, 50, 50]
 
 
 def test_the_key_frames_look_draws_the_texture_as_it_is():
     texture = np.full((40, 60, 3), 100, np.uint8)
-    out, interior = _painter().paint(texture, np.zeros((3, 2)), Look())
+    painter = _painter()
+    out, interior = painter.paint(texture, painter.choose(np.zeros((3, 2)), Look()))
     assert out is texture and interior is None
 
 
@@ -83,3 +84,10 @@ def test_an_open_mouth_shows_the_samples_interior_between_the_lips_instead_of_dr
     assert is_green.sum() > 100  # the opening shows the sample
     assert not ((drawn[..., 1] > 200) & (drawn[..., 0] < 60)).any()
     assert (sampled[~is_green] == drawn[~is_green]).mean() > 0.97  # the rest of the face is as drawn
+
+
+def test_a_sent_choice_overrides_the_shapes_and_an_index_beyond_the_samples_draws_none():
+    painter = _painter()
+    assert painter.choose(np.zeros((3, 2)), Look(), (1, None)) == {"eyes": 1, "mouth": None}
+    assert painter.choose(np.zeros((3, 2)), Look(closure=[1.0, 1.0]), (None, None)) == {"eyes": None, "mouth": None}
+    assert painter.choose(np.zeros((3, 2)), Look(), (2, 0)) == {"eyes": None, "mouth": None}  # 2 samples; no mouth

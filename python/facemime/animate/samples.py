@@ -149,36 +149,13 @@ class SamplePainter:
         self._keys = {g.name: weigh_eyes(g.keys) if g.name == "eyes" else g.keys for g in samples.groups}
         self._work: np.ndarray | None = None
 
-    def choose(self, offsets: np.ndarray, look: Look) -> dict[str, int | None]:
-        """Each group's sample for a frame's shape.
+    def choose(
+        self, offsets: np.ndarray, look: Look, sent: tuple[int | None, ...] | None = None
+    ) -> dict[str, int | None]:
+        """Each group's sample for a frame.
 
         Parameters
         ----------
-        offsets
-            (K, 2) float array: the frame's knot offsets in the actor's model units.
-        look
-            The frame's look.
-
-        Returns
-        -------
-        dict of str -> int or None
-            Group name -> the sample pasted (None: the key frame's, nothing pasted).
-        """
-        frame_keys = {"eyes": weigh_eyes(look.vector()), "mouth": np.asarray(offsets, np.float64)[self._mouth].ravel()}
-        return {
-            name: nearest(keys, frame_keys[name]) if keys.shape[1] == len(frame_keys[name]) else None
-            for name, keys in self._keys.items()
-        }
-
-    def paint(
-        self, texture: np.ndarray, offsets: np.ndarray, look: Look, sent: tuple[int | None, ...] | None = None
-    ) -> tuple[np.ndarray, np.ndarray | None]:
-        """The texture with the frame's samples pasted in, and the mouth's interior.
-
-        Parameters
-        ----------
-        texture
-            (H, W, 3) uint8 RGB: the texture the frame is drawn with otherwise (not changed).
         offsets
             (K, 2) float array: the frame's knot offsets in the actor's model units.
         look
@@ -186,7 +163,32 @@ class SamplePainter:
         sent
             The samples the stream chose for the frame, per group of
             :data:`~facemime.types.samples.GROUPS` (None: the key frame's); an index beyond a
-            group's samples draws none. None: chosen here by the shapes (:meth:`choose`).
+            group's samples draws none. None: chosen by the shapes, the :func:`nearest` key.
+
+        Returns
+        -------
+        dict of str -> int or None
+            Group name -> the sample pasted (None: the key frame's, nothing pasted).
+        """
+        if sent is not None:
+            sizes = {g.name: len(g.keys) for g in self.samples.groups}
+            return {n: k if k is not None and k < sizes.get(n, 0) else None for n, k in zip(GROUPS, sent)}
+        frame_keys = {"eyes": weigh_eyes(look.vector()), "mouth": np.asarray(offsets, np.float64)[self._mouth].ravel()}
+        return {
+            name: nearest(keys, frame_keys[name]) if keys.shape[1] == len(frame_keys[name]) else None
+            for name, keys in self._keys.items()
+        }
+
+    def paint(self, texture: np.ndarray, chosen: dict[str, int | None]) -> tuple[np.ndarray, np.ndarray | None]:
+        """The texture with a frame's samples pasted in, and the mouth's interior.
+
+        Parameters
+        ----------
+        texture
+            (H, W, 3) uint8 RGB: the texture the frame is drawn with otherwise (not changed); where
+            the eyes' sample is pasted, its irises need not be moved.
+        chosen
+            Group name -> the sample pasted (:meth:`choose`).
 
         Returns
         -------
@@ -197,11 +199,6 @@ class SamplePainter:
             The chosen mouth sample's interior (:func:`interior_uv`); None where it has none or no
             mouth sample is chosen.
         """
-        if sent is None:
-            chosen = self.choose(offsets, look)
-        else:
-            sizes = {g.name: len(g.keys) for g in self.samples.groups}
-            chosen = {n: k if k is not None and k < sizes.get(n, 0) else None for n, k in zip(GROUPS, sent)}
         mouth, k = self.samples.group("mouth"), chosen.get("mouth")
         interior = None if mouth is None or mouth.interiors is None or k is None else mouth.interiors[k]
         if all(k is None for k in chosen.values()):

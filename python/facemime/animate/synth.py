@@ -461,9 +461,13 @@ class Puppet:
         """
         vertices, pose = self.vertices(offsets, user, look), self.pose(measured, user)
         shown_look = Look(look.closure * user.gain, look.iris * user.gain)
-        texture, inside = self.painter.texture(shown_look), None
-        if self.samples is not None:
-            texture, inside = self.samples.paint(texture, offsets * self._ratio * user.gain, shown_look, samples)
+        if self.samples is None:
+            texture, inside = self.painter.texture(shown_look), None
+        else:
+            chosen = self.samples.choose(offsets * self._ratio * user.gain, shown_look, samples)
+            # the eyes' sample covers the eyes: their irises are not moved under it
+            still = Look(shown_look.closure) if chosen.get("eyes") is not None else shown_look
+            texture, inside = self.samples.paint(self.painter.texture(still), chosen)
         interior = None if inside is None else (inside, *self._strip)
         self.shown = (vertices, pose)
         if self.scene is None:

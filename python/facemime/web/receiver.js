@@ -3095,7 +3095,8 @@ void main() {
       ) ?? [];
       const interior = this.samples?.interior(chosen) ?? null;
       const patch = interior ? null : mouthPatch(pick("mouth_inner_upper"), pick("mouth_inner_lower"), teethUncovered(spread), [w, h]);
-      this.uploadTexture(chosen, look.iris);
+      const eyesChosen = (chosen[SAMPLE_GROUPS.indexOf("eyes")] ?? null) !== null;
+      this.uploadTexture(chosen, eyesChosen ? [[0, 0], [0, 0]] : look.iris);
       const r = this.renderer;
       r.begin(w, h, BACKGROUND, view);
       if (this.scene && this.sceneLayer && this.sceneUv) {

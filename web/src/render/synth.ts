@@ -16,7 +16,7 @@ import { Renderer, type Layer } from './gl';
 import { mouthPatch, teethUncovered } from './mouth';
 import { interiorUv, lipStrip, SamplePainter, sentSamples } from './samples';
 import { SceneMesh } from './scene';
-import { BACKGROUND, BASIS_ONE, LOOK_NAMES, NO_FACE_DIM, SEAL, SLOW } from '../shared_constants';
+import { BACKGROUND, BASIS_ONE, LOOK_NAMES, NO_FACE_DIM, SAMPLE_GROUPS, SEAL, SLOW } from '../shared_constants';
 
 /** One frame's motion, as decoded: the parameter values of the stream (pose, coefficients,
  * extras) and whether it shows a face. */
@@ -102,7 +102,9 @@ export class Synthesizer {
       sentSamples(this.header.extras, v, 6 + coefficients)) ?? [];
     const interior = this.samples?.interior(chosen) ?? null;
     const patch = interior ? null : mouthPatch(pick('mouth_inner_upper'), pick('mouth_inner_lower'), teethUncovered(spread), [w, h]);
-    this.uploadTexture(chosen, look.iris);
+    // the eyes' sample covers the eyes: their irises are not moved under it (Puppet.render)
+    const eyesChosen = (chosen[SAMPLE_GROUPS.indexOf('eyes')] ?? null) !== null;
+    this.uploadTexture(chosen, eyesChosen ? [[0, 0], [0, 0]] : look.iris);
     const r = this.renderer;
     r.begin(w, h, BACKGROUND, view);
     if (this.scene && this.sceneLayer && this.sceneUv) {
