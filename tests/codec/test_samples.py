@@ -4,6 +4,7 @@ frame's shape is the sample's, and stored in actor files compatibly."""
 import zipfile
 from dataclasses import replace
 
+import cv2
 import numpy as np
 import pytest
 
@@ -96,6 +97,8 @@ def _edited(actor, name, data):
         for info in src.infolist():
             if info.filename != name:
                 z.writestr(info, src.read(info))
+        if isinstance(data, np.ndarray):
+            data = cv2.imencode(".png", data)[1].tobytes()
         if data is not None:
             z.writestr(name, data)
     return buf.getvalue()
@@ -106,8 +109,10 @@ def _edited(actor, name, data):
     [
         ("samples.json", b"{not json", "samples.json is not valid JSON"),
         ("samples.json", b'{"format": "facemime.samples/9", "groups": []}', "not a 'facemime.samples/1'"),
-        ("samples/eyes/0_0.png", None, "has no image of box 0"),
-        ("samples/eyes/0_0.png", b"not a picture", "does not decode"),
+        ("samples/eyes/0.png", None, "has no image of box 0"),
+        ("samples/eyes/0.png", b"not a picture", "does not decode"),
+        ("samples/mouth/interior.png", None, "has no image of its interiors"),
+        ("samples/mouth/0.png", np.zeros((7, 5, 3), np.uint8), "does not hold [0-9]+ images"),
     ],
 )
 def test_a_damaged_library_is_refused_in_one_line(coded, name, data, message):

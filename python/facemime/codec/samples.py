@@ -13,6 +13,8 @@ added in that order while the library stays under :data:`BUDGET` bytes as the st
 
 from __future__ import annotations
 
+import json
+import zlib
 from dataclasses import replace
 from pathlib import Path
 
@@ -37,10 +39,11 @@ from facemime.types.head import HeadModel, model_iod, mouth_up, mouth_width
 from facemime.types.pose import Pose, project, rotation_matrix
 from facemime.types.samples import GROUPS, SampleGroup, Samples
 
-#: The library's size at most, bytes of WebP images as the stream carries them (issue 64: 30 kB).
-BUDGET = 28_000
+#: The library's size at most, bytes as the stream carries it: its images (WebP) and its
+#: description (issue 64: 30 kB with the archive's own headers).
+BUDGET = 29_000
 #: Samples a group at most.
-MOST = 16
+MOST = 24
 #: The mouth's box: the outer lips' extent in the texture grown this much about its centre.
 MOUTH_GROW = 1.4
 #: A frame's mouth is open, and its interior kept, where its decoded inner lips stand further
@@ -94,6 +97,22 @@ def _as_carried(image: np.ndarray) -> np.ndarray:
     return cv2.cvtColor(decoded, cv2.COLOR_BGR2RGB)
 
 
+def _atlases(
+    crops: list[list[np.ndarray]], interiors: list[np.ndarray | None] | None, chosen: list[int]
+) -> list[np.ndarray]:
+    """The images an actor file stores for the chosen candidates (:mod:`facemime.io.samples_file`):
+    per box their crops stacked top to bottom, then their interiors stacked, if any."""
+    out = [np.vstack([crops[i][b] for i in chosen]) for b in range(len(crops[chosen[0]]))]
+    inside = [i for i in (interiors[c] for c in chosen) if i is not None] if interiors is not None else []
+    return out + ([np.vstack(inside)] if inside else [])
+
+
+def _described(keys: np.ndarray, frames: np.ndarray) -> int:
+    """About the bytes the samples' entries take in the actor file's ``samples.json``, deflated."""
+    entries = [{"frame": int(f), "key": [round(float(v), 4) for v in k]} for f, k in zip(frames, keys)]
+    return len(zlib.compress(json.dumps(entries, separators=(",", ":")).encode()))
+
+
 def _centres(keys: np.ndarray, most: int) -> list[int]:
     """Up to ``most`` rows of ``keys``, each the farthest from the key frame's (zero) and the
     ones before it, while any is farther than zero."""
@@ -130,7 +149,8 @@ def choose_group(
     frames
         (N,) per candidate, its frame index.
     budget
-        Bytes the group's images may take as the stream carries them.
+        Bytes the group may take in the actor file: its images as the stream carries them and its
+        entries in ``samples.json``.
     interiors
         ``mouth`` only: per candidate, its interior image (None: its mouth was closed); None:
         none.
@@ -141,31 +161,35 @@ def choose_group(
         The samples (keys unweighed: as the actor stores them); None when none fits or the
         clip's shapes never leave the key frame's.
     size : int
-        The bytes its images take.
+        The bytes it takes.
     """
     centres = _centres(keys, MOST)
     if not centres:
         return None, 0
     all_keys = np.vstack([np.zeros(keys.shape[1]), keys[centres]])
     owner = np.argmin(np.linalg.norm(keys[:, None, :] - all_keys[None, :, :], axis=2), axis=1) - 1
-    chosen, images, size = [], [], 0
-    kept: list[np.ndarray | None] = []
+    chosen: list[int] = []
+    size = 0
     for c, centre in enumerate(centres):
         members = np.flatnonzero(owner == c)
         flat = np.array([np.concatenate([b.ravel() for b in crops[i]]) for i in members], np.float32)
         best = int(members[np.argmin(((flat - flat.mean(axis=0)) ** 2).sum(axis=1))]) if len(members) else centre
-        inside = None if interiors is None else interiors[best]
-        cost = sum(len(_webp(b)) for b in crops[best] + ([] if inside is None else [inside]))
-        if size + cost > budget:
+        cost = sum(len(_webp(atlas)) for atlas in _atlases(crops, interiors, chosen + [best]))
+        cost += _described(keys[chosen + [best]], frames[chosen + [best]])
+        if cost > budget:
             break
-        size += cost
         chosen.append(best)
-        images.append([_as_carried(b) for b in crops[best]])
-        kept.append(None if inside is None else _as_carried(inside))
+        size = cost
     if not chosen:
         return None, 0
-    carried = kept if any(k is not None for k in kept) else None
-    return SampleGroup(name, boxes, images, keys[chosen], frames[chosen], carried), size
+    carried = [_as_carried(atlas) for atlas in _atlases(crops, interiors, chosen)]
+    per_box = [np.split(carried[b], len(chosen)) for b in range(len(boxes))]
+    images = [[per_box[b][s] for b in range(len(boxes))] for s in range(len(chosen))]
+    opened = [i for i in chosen if interiors is not None and interiors[i] is not None]
+    inside = iter(np.split(carried[len(boxes)], len(opened)) if opened else [])
+    kept = [None if interiors is None or interiors[i] is None else next(inside) for i in chosen]
+    interiors_kept = kept if any(k is not None for k in kept) else None
+    return SampleGroup(name, boxes, images, keys[chosen], frames[chosen], interiors_kept), size
 
 
 def _interior(

@@ -3,10 +3,12 @@
 - ``samples.json``: ``{"format": "facemime.samples/1", "groups": [{"name": "eyes" | "mouth",
   "boxes": [[x, y, width, height], ...] (texels of the actor's texture), "samples": [{"frame": F,
   "key": [...]}, ...]}, ...]}``;
-- ``samples/<group>/<sample>_<box>.png`` (or ``.webp``, in a stream): each sample's image of
-  each box, RGB, the box's size; for a mouth sample with ``"interior": true``,
-  ``samples/mouth/<sample>_interior.png`` too: the mouth's opening laid out between the inner
-  lips (:func:`facemime.animate.samples.interior_uv`).
+- ``samples/<group>/<box>.png`` (or ``.webp``, in a stream): the samples' images of one box, RGB,
+  stacked top to bottom in the samples' order (sample s in rows s·h to (s + 1)·h − 1, h the box's
+  height): one image per box keeps the file small;
+- ``samples/mouth/interior.png`` (``.webp``): the openings of the mouth samples marked
+  ``"interior": true``, stacked the same way in their order, each the mouth's opening laid out
+  between the inner lips (:func:`facemime.animate.samples.interior_uv`), all of one size.
 
 The member is absent from actors without samples; ``actor.json`` does not mention it, so an
 actor's id (the SHA-256 of ``actor.json``) is the same with or without its samples.
@@ -36,15 +38,13 @@ MAX_BOXES = 4
 INTERIOR = "interior"
 
 
-def image_name(group: str, sample: int, box: int | str, kind: str) -> str:
-    """The member holding one sample's image of one box.
+def image_name(group: str, box: int | str, kind: str) -> str:
+    """The member holding a group's samples of one box.
 
     Parameters
     ----------
     group
         The group's name.
-    sample
-        The sample's index in the group.
     box
         The box's index in the group, or :data:`INTERIOR`.
     kind
@@ -53,9 +53,9 @@ def image_name(group: str, sample: int, box: int | str, kind: str) -> str:
     Returns
     -------
     str
-        ``samples/<group>/<sample>_<box>.<kind>``.
+        ``samples/<group>/<box>.<kind>``.
     """
-    return f"samples/{group}/{sample}_{box}.{kind}"
+    return f"samples/{group}/{box}.{kind}"
 
 
 def samples_members(samples: Samples, kind: str, encode: Callable[[np.ndarray], bytes]) -> dict[str, bytes]:
@@ -82,7 +82,7 @@ def samples_members(samples: Samples, kind: str, encode: Callable[[np.ndarray], 
                 "name": g.name,
                 "boxes": g.boxes.astype(int).tolist(),
                 "samples": [
-                    {"frame": int(f), "key": [round(float(v), 6) for v in k]}
+                    {"frame": int(f), "key": [round(float(v), 4) for v in k]}
                     | ({"interior": True} if g.interiors is not None and g.interiors[i] is not None else {})
                     for i, (f, k) in enumerate(zip(g.frames, g.keys))
                 ],
@@ -92,12 +92,11 @@ def samples_members(samples: Samples, kind: str, encode: Callable[[np.ndarray], 
     }
     out = {SAMPLES_JSON: json.dumps(doc, separators=(",", ":")).encode()}
     for g in samples.groups:
-        for s, images in enumerate(g.images):
-            for b, image in enumerate(images):
-                out[image_name(g.name, s, b, kind)] = encode(image)
-            interior = None if g.interiors is None else g.interiors[s]
-            if interior is not None:
-                out[image_name(g.name, s, INTERIOR, kind)] = encode(interior)
+        for b in range(len(g.boxes)):
+            out[image_name(g.name, b, kind)] = encode(np.vstack([images[b] for images in g.images]))
+        inside = [i for i in g.interiors or [] if i is not None]
+        if inside:
+            out[image_name(g.name, INTERIOR, kind)] = encode(np.vstack(inside))
     return out
 
 
@@ -140,8 +139,10 @@ def samples_from_members(text: bytes, read: Callable[[str], bytes | None], where
             inside = [e.get("interior") is True for e in entries]
         except (KeyError, TypeError, ValueError, OverflowError) as e:
             raise InvalidInputError(f"{where}: malformed sample group in {SAMPLES_JSON} ({e})") from None
-        images = [[_image(read, name, s, b, where) for b in range(len(boxes))] for s in range(len(entries))]
-        interiors = [_image(read, name, s, INTERIOR, where) if i else None for s, i in enumerate(inside)]
+        atlases = [_atlas(read, name, b, len(entries), where) for b in range(len(boxes))]
+        images = [[atlas[s] for atlas in atlases] for s in range(len(entries))]
+        openings = iter(_atlas(read, name, INTERIOR, sum(inside), where) if any(inside) else [])
+        interiors = [next(openings) if i else None for i in inside]
         try:
             groups.append(
                 SampleGroup(name, boxes.astype(np.int64), images, keys, frames, interiors if any(inside) else None)
@@ -154,14 +155,18 @@ def samples_from_members(text: bytes, read: Callable[[str], bytes | None], where
         raise InvalidInputError(f"{where}: {e}") from None
 
 
-def _image(read: Callable[[str], bytes | None], group: str, sample: int, box: int | str, where: str) -> np.ndarray:
-    """One sample image, PNG or WebP, as RGB."""
+def _atlas(read: Callable[[str], bytes | None], group: str, box: int | str, count: int, where: str) -> list[np.ndarray]:
+    """A group's stacked images of one box (or its interiors), PNG or WebP, cut into ``count``
+    RGB images of equal height."""
     for kind in ("png", "webp"):
-        data = read(image_name(group, sample, box, kind))
+        name = image_name(group, box, kind)
+        data = read(name)
         if data is not None:
             image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
             if image is None or image.ndim != 3:
-                raise InvalidInputError(f"{where}: sample image {image_name(group, sample, box, kind)} does not decode")
-            return cv2.cvtColor(image, cv2.COLOR_BGR2RGB)
-    what = "its interior" if box == INTERIOR else f"box {box}"
-    raise InvalidInputError(f"{where}: sample {sample} of group {group!r} has no image of {what}")
+                raise InvalidInputError(f"{where}: sample image {name} does not decode")
+            if image.shape[0] % count:
+                raise InvalidInputError(f"{where}: sample image {name} does not hold {count} images of one height")
+            return np.split(cv2.cvtColor(image, cv2.COLOR_BGR2RGB), count)
+    what = "its interiors" if box == INTERIOR else f"box {box}"
+    raise InvalidInputError(f"{where}: group {group!r} has no image of {what}")

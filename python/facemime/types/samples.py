@@ -23,6 +23,11 @@ from facemime.errors import InvalidInputError
 from facemime.shared_constants import SAMPLE_GROUPS as GROUPS  # the groups a library may hold, in painting order
 
 
+def _rgb(image: object) -> bool:
+    """Whether ``image`` is an (h, w, 3) uint8 array."""
+    return isinstance(image, np.ndarray) and image.dtype == np.uint8 and image.ndim == 3 and image.shape[2] == 3
+
+
 @dataclass(frozen=True, eq=False)
 class SampleGroup:
     """The samples of one group.
@@ -68,12 +73,28 @@ class SampleGroup:
             raise InvalidInputError(f"sample group {self.name!r}: its keys must be finite")
         for sample in self.images:
             if len(sample) != len(boxes) or any(
-                not (isinstance(im, np.ndarray) and im.dtype == np.uint8 and im.shape == (int(h), int(w), 3))
-                for im, (_, _, w, h) in zip(sample, boxes)
+                not (_rgb(im) and im.shape[:2] == (int(h), int(w))) for im, (_, _, w, h) in zip(sample, boxes)
             ):
                 raise InvalidInputError(
                     f"sample group {self.name!r}: each sample needs an RGB image of each box's size"
                 )
+        if self.interiors is not None:
+            if self.name != "mouth" or len(self.interiors) != len(keys):
+                raise InvalidInputError(f"sample group {self.name!r}: interiors are the mouth's, one per sample")
+            inside = [im for im in self.interiors if im is not None]
+            if any(
+                not (
+                    isinstance(im, np.ndarray)
+                    and im.dtype == np.uint8
+                    and im.ndim == 3
+                    and im.shape[2] == 3
+                    and min(im.shape[:2]) >= 1
+                )
+                for im in inside
+            ):
+                raise InvalidInputError("sample group 'mouth': an interior is an (h, w, 3) uint8 RGB image")
+            if len({im.shape for im in inside}) > 1:
+                raise InvalidInputError("sample group 'mouth': its interiors must be of one size")
 
 
 @dataclass(frozen=True, eq=False)

@@ -621,24 +621,37 @@
       const frames = entries.map((e) => Number.isInteger(e?.frame) ? e.frame : bad(`group ${name}: a sample's frame is not an integer`));
       const rects = boxes;
       const inside = entries.map((e) => e?.interior === true);
-      const image = async (s, b) => {
+      const atlas = async (b, count) => {
         for (const [ext, type] of [["png", "image/png"], ["webp", "image/webp"]]) {
-          const bytes = files[`samples/${name}/${s}_${b}.${ext}`];
+          const member = `samples/${name}/${b}.${ext}`;
+          const bytes = files[member];
           if (!bytes) continue;
+          let whole;
           try {
-            return await decodeImage(bytes, type);
+            whole = await decodeImage(bytes, type);
           } catch {
-            return bad(`sample image samples/${name}/${s}_${b}.${ext} does not decode`);
+            return bad(`sample image ${member} does not decode`);
           }
+          if (whole.height % count) bad(`sample image ${member} does not hold ${count} images of one height`);
+          const h = whole.height / count, row = 4 * whole.width;
+          return Array.from({ length: count }, (_, k) => ({
+            width: whole.width,
+            height: h,
+            rgba: whole.rgba.slice(k * h * row, (k + 1) * h * row)
+          }));
         }
-        return bad(`sample ${s} of group ${name} has no image of ${b === "interior" ? "its interior" : `box ${b}`}`);
+        return bad(`group ${name} has no image of ${b === "interior" ? "its interiors" : `box ${b}`}`);
       };
-      const images = await Promise.all(entries.map((_, s) => Promise.all(rects.map(async ([, , w, h], b) => {
-        const got = await image(s, b);
-        if (got.width !== w || got.height !== h) bad(`sample image samples/${name}/${s}_${b} is not its box's size`);
-        return got;
-      }))));
-      const interiors = inside.some((i2) => i2) ? await Promise.all(inside.map((i2, s) => i2 ? image(s, "interior") : null)) : null;
+      const perBox = await Promise.all(rects.map(async ([, , w, h], b) => {
+        const cut = await atlas(b, entries.length);
+        if (cut[0].width !== w || cut[0].height !== h) bad(`sample image samples/${name}/${b} is not its box's size`);
+        return cut;
+      }));
+      const images = entries.map((_, s) => perBox.map((cut) => cut[s]));
+      const opened = inside.filter((i2) => i2).length;
+      const openings = opened ? await atlas("interior", opened) : [];
+      let next = 0;
+      const interiors = opened ? inside.map((i2) => i2 ? openings[next++] : null) : null;
       groups.push({ name, boxes: rects, keys, frames, images, interiors });
     }
     return groups;

@@ -2,9 +2,9 @@
  * The actor a stream carries (``facemime.actor/1``, docs/bitstream.md "Actor"): a ZIP archive of
  * ``actor.json`` (the head model, its pose on the source picture, the source's size), the
  * texture and, when it has one, the scene (the source picture the face is drawn in), and, when it
- * has one, its sample library of its own mouth and eyes (``samples.json``,
- * ``samples/<group>/<sample>_<box>.webp`` and a mouth sample's ``<sample>_interior.webp``,
- * facemime.io.samples_file).
+ * has one, its sample library of its own mouth and eyes (``samples.json``, per group and box
+ * ``samples/<group>/<box>.webp`` holding the samples stacked top to bottom, and the mouth's
+ * openings stacked in ``samples/mouth/interior.webp``; facemime.io.samples_file).
  *
  * Images are RGBA, row-major from the top-left pixel.
  */
@@ -136,25 +136,37 @@ async function readSamples(files: Record<string, Uint8Array>, texture: Picture):
     const frames = entries.map((e) => (Number.isInteger(e?.frame) ? (e.frame as number) : bad(`group ${name}: a sample's frame is not an integer`)));
     const rects = boxes as [number, number, number, number][];
     const inside = entries.map((e) => e?.interior === true);
-    // one sample's image of box `b` (its index, or 'interior'), PNG or WebP
-    const image = async (s: number, b: number | 'interior'): Promise<Picture> => {
+    // a group's images of box `b` (its index, or 'interior'), PNG or WebP, stacked top to bottom:
+    // cut into `count` of equal height
+    const atlas = async (b: number | 'interior', count: number): Promise<Picture[]> => {
       for (const [ext, type] of [['png', 'image/png'], ['webp', 'image/webp']]) {
-        const bytes = files[`samples/${name}/${s}_${b}.${ext}`];
+        const member = `samples/${name}/${b}.${ext}`;
+        const bytes = files[member];
         if (!bytes) continue;
+        let whole: Picture;
         try {
-          return await decodeImage(bytes, type);
+          whole = await decodeImage(bytes, type);
         } catch {
-          return bad(`sample image samples/${name}/${s}_${b}.${ext} does not decode`);
+          return bad(`sample image ${member} does not decode`);
         }
+        if (whole.height % count) bad(`sample image ${member} does not hold ${count} images of one height`);
+        const h = whole.height / count, row = 4 * whole.width;
+        return Array.from({ length: count }, (_, k) => ({
+          width: whole.width, height: h, rgba: whole.rgba.slice(k * h * row, (k + 1) * h * row),
+        }));
       }
-      return bad(`sample ${s} of group ${name} has no image of ${b === 'interior' ? 'its interior' : `box ${b}`}`);
+      return bad(`group ${name} has no image of ${b === 'interior' ? 'its interiors' : `box ${b}`}`);
     };
-    const images = await Promise.all(entries.map((_, s) => Promise.all(rects.map(async ([, , w, h], b) => {
-      const got = await image(s, b);
-      if (got.width !== w || got.height !== h) bad(`sample image samples/${name}/${s}_${b} is not its box's size`);
-      return got;
-    }))));
-    const interiors = inside.some((i) => i) ? await Promise.all(inside.map((i, s) => (i ? image(s, 'interior') : null))) : null;
+    const perBox = await Promise.all(rects.map(async ([, , w, h], b) => {
+      const cut = await atlas(b, entries.length);
+      if (cut[0].width !== w || cut[0].height !== h) bad(`sample image samples/${name}/${b} is not its box's size`);
+      return cut;
+    }));
+    const images = entries.map((_, s) => perBox.map((cut) => cut[s]));
+    const opened = inside.filter((i) => i).length;
+    const openings = opened ? await atlas('interior', opened) : [];
+    let next = 0;
+    const interiors = opened ? inside.map((i) => (i ? openings[next++] : null)) : null;
     groups.push({ name: name as SampleGroup['name'], boxes: rects, keys, frames, images, interiors });
   }
   return groups;
