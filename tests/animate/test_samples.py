@@ -58,12 +58,13 @@ def test_the_key_frames_look_draws_the_texture_as_it_is():
 
 
 def test_a_group_needs_an_image_of_each_box_and_six_values_for_an_eye_key():
-    with pytest.raises(InvalidInputError, match="image of each box"):
-        SampleGroup("eyes", np.array([[0, 0, 4, 4]]), [[np.zeros((3, 4, 3), np.uint8)]], np.zeros((1, 6)), np.zeros(1))
+    box, one = np.array([[0, 0, 4, 4]]), np.zeros(1, int)
+    with pytest.raises(InvalidInputError, match="RGB image of each box"):
+        SampleGroup("eyes", box, [[np.zeros((3, 4, 3), np.uint8)]], np.zeros((1, 6)), one)
     with pytest.raises(InvalidInputError, match="6 values"):
-        SampleGroup("eyes", np.array([[0, 0, 4, 4]]), [[np.zeros((4, 4, 3), np.uint8)]], np.zeros((1, 5)), np.zeros(1))
+        SampleGroup("eyes", box, [[np.zeros((4, 4, 3), np.uint8)]], np.zeros((1, 5)), one)
     with pytest.raises(InvalidInputError, match="one of"):
-        SampleGroup("nose", np.array([[0, 0, 4, 4]]), [[np.zeros((4, 4, 3), np.uint8)]], np.zeros((1, 6)), np.zeros(1))
+        SampleGroup("nose", box, [[np.zeros((4, 4, 3), np.uint8)]], np.zeros((1, 6)), one)
 
 
 def test_an_open_mouth_shows_the_samples_interior_between_the_lips_instead_of_drawn_teeth():
@@ -91,3 +92,33 @@ def test_a_sent_choice_overrides_the_shapes_and_an_index_beyond_the_samples_draw
     assert painter.choose(np.zeros((3, 2)), Look(), (1, None)) == {"eyes": 1, "mouth": None}
     assert painter.choose(np.zeros((3, 2)), Look(closure=[1.0, 1.0]), (None, None)) == {"eyes": None, "mouth": None}
     assert painter.choose(np.zeros((3, 2)), Look(), (2, 0)) == {"eyes": None, "mouth": None}  # 2 samples; no mouth
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"boxes": [["a", 0, 4, 4]]}, "boxes must be"),
+        ({"boxes": np.array([[2**62, 0, 4, 4]])}, "boxes must be"),
+        ({"keys": np.array([["x"] * 6])}, "keys must be rows of real numbers"),
+        ({"keys": np.full((1, 6), 1e300)}, "finite, within"),
+        ({"frames": None}, "one key, one frame"),
+        ({"images": None}, "one key, one frame"),
+        ({"interiors": [np.zeros((40, 96, 3), np.uint8)]}, "interiors are the mouth's"),
+    ],
+)
+def test_a_malformed_group_is_refused_with_the_libraries_own_error(change, message):
+    args = {
+        "name": "eyes",
+        "boxes": np.array([[0, 0, 4, 4]]),
+        "images": [[np.zeros((4, 4, 3), np.uint8)]],
+        "keys": np.zeros((1, 6)),
+        "frames": np.zeros(1, int),
+    } | change
+    with pytest.raises(InvalidInputError, match=message):
+        SampleGroup(**args)
+
+
+def test_a_library_is_a_tuple_of_groups():
+    for groups in (None, (1, 2), "eyes"):
+        with pytest.raises(InvalidInputError, match="tuple of sample groups"):
+            Samples(groups)

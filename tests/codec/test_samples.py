@@ -110,9 +110,10 @@ def _edited(actor, name, data):
         ("samples.json", b"{not json", "samples.json is not valid JSON"),
         ("samples.json", b'{"format": "facemime.samples/9", "groups": []}', "not a 'facemime.samples/1'"),
         ("samples/eyes/0.png", None, "has no image of box 0"),
-        ("samples/eyes/0.png", b"not a picture", "does not decode"),
+        ("samples/eyes/0.png", b"not a picture", "is not a PNG image"),
+        ("samples/eyes/0.png", b"", "is not a PNG image"),
         ("samples/mouth/interior.png", None, "has no image of its interiors"),
-        ("samples/mouth/0.png", np.zeros((7, 5, 3), np.uint8), "does not hold [0-9]+ images"),
+        ("samples/mouth/0.png", np.zeros((7, 5, 3), np.uint8), "is 5x7, not [0-9]+ images of"),
     ],
 )
 def test_a_damaged_library_is_refused_in_one_line(coded, name, data, message):

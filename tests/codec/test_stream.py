@@ -349,13 +349,13 @@ def test_two_streams_one_after_the_other_decode_each_with_its_own_header(clip, w
     assert len(dec.info.basis.raw) == Settings(quality=2).basis_size
 
 
-def test_sample_choices_round_trip_exactly_whatever_the_hysteresis(clip):
+def test_sample_choices_round_trip_exactly(clip):
     rng = np.random.default_rng(3)
     given = [
         tuple(None if k < 0 else int(k) for k in rng.integers(-1, 16, 2)) if i % 7 else (None, None)
         for i in range(len(clip.motion))
     ]
-    for hysteresis in (0.0, 4.0):  # the core's widest: a change of one sample is still sent
+    for hysteresis in (0.0, 0.49):  # under half a step: a change of one sample is always sent
         enc = MotionEncoder(
             clip.actor,
             clip.fps,
@@ -383,3 +383,9 @@ def test_a_stream_without_sample_choices_decodes_none_and_an_encoder_without_the
     recon = [enc.push(m.face, m.lost, m.pose, m.offsets, None, (None, None)) for m in clip.motion]
     frames = MotionDecoder(clip.actor).push(enc.header + b"".join(r.data for r in recon) + enc.finish())
     assert frames and all(f.samples is None for f in frames)
+
+
+def test_an_encoder_whose_hysteresis_would_hold_a_sample_choice_back_refuses_to_send_them(clip):
+    basis = Basis.learn(np.array([m.offsets for m in clip.motion]), 8)
+    with pytest.raises(InvalidInputError, match=r"hysteresis under 0\.5"):
+        MotionEncoder(clip.actor, clip.fps, clip.size, basis, Settings(hysteresis=0.5), False, samples=True)

@@ -18,9 +18,9 @@ export const BASIS_ONE = 32767;
  * of the sample groups (eyes, mouth): the value is the index of the sample drawn plus one, 0 for
  * none (the key frame's own). */
 export const SAMPLE_KINDS = [7, 8] as const;
-/** Their quantiser step: a sample index is 8 steps, so that the encoder's hysteresis (at most 4
- * steps) never holds a change of sample back. */
-export const SAMPLE_STEP = 0.125;
+/** Their quantiser step: a sample index is one step (an encoder that sends them keeps its hysteresis
+ * under half a step, so that no change of sample is held back). */
+export const SAMPLE_STEP = 1.0;
 /** The eight contour groups whose vertices are the knots, in the bitstream's order (each curve
  * image-left to image-right, one vertex per knot). */
 export const CONTOUR_GROUPS = [
@@ -45,6 +45,9 @@ export const REACH = 0.45;
 export const SEAL = 0.05;
 /** The actor's samples of its own mouth and eyes: the sample groups, in the order they are painted. */
 export const SAMPLE_GROUPS = ["eyes", "mouth"] as const;
+/** A mouth sample's interior image: (width, height), texels; the upper inner lip along its top edge,
+ * the lower along its bottom, corner to corner. */
+export const INTERIOR_SIZE = [96, 40] as const;
 /** The weight of the iris shifts (eye widths) against the lid closures (shares of the opening) in
  * the distance between two looks that chooses an eye sample. */
 export const IRIS_WEIGHT = 5.0;

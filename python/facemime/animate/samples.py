@@ -25,12 +25,7 @@ from facemime.render.paste import paste_faded
 from facemime.shared_constants import IRIS_WEIGHT, LOOK_NAMES
 from facemime.types.head import HeadModel, lip_strip
 from facemime.types.look import Look
-from facemime.types.samples import GROUPS, Samples
-
-#: The interior image's (width, height), texels.
-INTERIOR_SIZE = (96, 40)
-#: The head model's groups whose knots key the mouth's samples.
-MOUTH_GROUPS = ("mouth_outer_upper", "mouth_outer_lower", "mouth_inner_upper", "mouth_inner_lower")
+from facemime.types.samples import GROUPS, MOUTH_GROUPS, Samples
 
 
 def interior_uv(model: HeadModel) -> np.ndarray:

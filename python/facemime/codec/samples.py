@@ -23,7 +23,7 @@ import numpy as np
 
 from facemime.animate.deform import Deformer
 from facemime.animate.eyes import LookPainter
-from facemime.animate.samples import INTERIOR_SIZE, interior_strip, mouth_knots, weigh_eyes
+from facemime.animate.samples import interior_strip, mouth_knots, weigh_eyes
 from facemime.animate.synth import Puppet
 from facemime.codec.appearance import FACING, lay_back
 from facemime.codec.clip import analyse, encode_clip
@@ -33,7 +33,7 @@ from facemime.codec.stream import Settings
 from facemime.io.samples_file import SAMPLE_QUALITY
 from facemime.io.video import VideoReader
 from facemime.progress import track as progress
-from facemime.shared_constants import CAVITY, SEAL
+from facemime.shared_constants import CAVITY, INTERIOR_SIZE, SEAL
 from facemime.types.actor import Actor
 from facemime.types.head import HeadModel, model_iod, mouth_up, mouth_width
 from facemime.types.pose import Pose, project, rotation_matrix

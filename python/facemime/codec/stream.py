@@ -194,7 +194,8 @@ class MotionEncoder:
         them before its stream starts, as they take a few hundred milliseconds); None: made here.
     samples
         Whether the stream carries each frame's choice of the actor's mouth and eye samples
-        (extra kinds :data:`~facemime.shared_constants.SAMPLE_KINDS`, format version 2).
+        (extra kinds :data:`~facemime.shared_constants.SAMPLE_KINDS`, format version 2; an index
+        is one step, so ``settings.hysteresis`` must be under 0.5).
     """
 
     def __init__(
@@ -213,6 +214,10 @@ class MotionEncoder:
     ):
         self.settings, self.basis, self.look, self.samples = settings, basis, bool(look), bool(samples)
         m = len(basis.raw)
+        if self.samples and settings.hysteresis >= 0.5:
+            raise InvalidInputError(
+                f"sample choices are sent with a hysteresis under 0.5 steps, got {settings.hysteresis:g}"
+            )
         steps = settings.steps(m, self.look) + ([SAMPLE_STEP] * len(SAMPLE_KINDS) if self.samples else [])
         extras = (list(LOOK_KINDS) if self.look else []) + (list(SAMPLE_KINDS) if self.samples else [])
         ref = pose_vector(reference or actor.pose)

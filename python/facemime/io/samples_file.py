@@ -23,17 +23,15 @@ import cv2
 import numpy as np
 
 from facemime.errors import InvalidInputError
-from facemime.limits import parse_json
-from facemime.types.samples import SampleGroup, Samples
+from facemime.limits import image_size, parse_json
+from facemime.shared_constants import INTERIOR_SIZE
+from facemime.types.samples import GROUPS, MAX_BOXES, MAX_SAMPLES, MAX_TEXELS, SampleGroup, Samples
 
 SAMPLES_FORMAT = "facemime.samples/1"
 #: The library's description member.
 SAMPLES_JSON = "samples.json"
 #: WebP quality of the samples' images in a stream (the library's size is chosen at it).
 SAMPLE_QUALITY = 70
-#: At most this many samples a group, and boxes a group.
-MAX_SAMPLES = 64
-MAX_BOXES = 4
 #: Names a mouth sample's interior image in place of a box's index.
 INTERIOR = "interior"
 
@@ -127,25 +125,41 @@ def samples_from_members(text: bytes, read: Callable[[str], bytes | None], where
     groups = []
     for g in doc["groups"]:
         try:
-            name = str(g["name"])
-            boxes = np.asarray(g["boxes"])
-            entries = g["samples"]
-            if boxes.dtype.kind not in "iu" or boxes.ndim != 2 or not 1 <= len(boxes) <= MAX_BOXES:
-                raise ValueError(f"boxes must be 1-{MAX_BOXES} rows of 4 integers")
+            name, boxes, entries = g["name"], g["boxes"], g["samples"]
+            if name not in GROUPS:
+                raise ValueError(f"a group is one of {', '.join(GROUPS)}, got {name!r}")
+            if not (
+                isinstance(boxes, list)
+                and 1 <= len(boxes) <= MAX_BOXES
+                and all(isinstance(b, list) and len(b) == 4 and all(_integer(v, 1 << 16) for v in b) for b in boxes)
+            ):
+                raise ValueError(f"boxes must be 1-{MAX_BOXES} rows of 4 integers 0-65536")
             if not isinstance(entries, list) or not 1 <= len(entries) <= MAX_SAMPLES:
                 raise ValueError(f"a group holds 1-{MAX_SAMPLES} samples")
+            if len(entries) * sum(w * h for _, _, w, h in boxes) > MAX_TEXELS:
+                raise ValueError(f"its images would hold more than {MAX_TEXELS} texels")
+            if not all(isinstance(e, dict) and _integer(e.get("frame"), 1 << 31) for e in entries):
+                raise ValueError("each sample needs its frame, an integer ≥ 0")
+            if not all(isinstance(e.get("key"), list) and all(_real(v) for v in e["key"]) for e in entries):
+                raise ValueError("each sample needs its key, a list of numbers")
+            if not all(isinstance(e.get("interior", False), bool) for e in entries):
+                raise ValueError("a sample's interior is true or false")
             keys = np.array([np.asarray(e["key"], np.float64) for e in entries])
-            frames = np.array([int(e["frame"]) for e in entries], np.int64)
+            frames = np.array([e["frame"] for e in entries], np.int64)
             inside = [e.get("interior") is True for e in entries]
         except (KeyError, TypeError, ValueError, OverflowError) as e:
             raise InvalidInputError(f"{where}: malformed sample group in {SAMPLES_JSON} ({e})") from None
-        atlases = [_atlas(read, name, b, len(entries), where) for b in range(len(boxes))]
+        atlases = [_atlas(read, name, b, (w, h), len(entries), where) for b, (_, _, w, h) in enumerate(boxes)]
         images = [[atlas[s] for atlas in atlases] for s in range(len(entries))]
-        openings = iter(_atlas(read, name, INTERIOR, sum(inside), where) if any(inside) else [])
+        openings = iter(
+            _atlas(read, name, INTERIOR, (INTERIOR_SIZE[0], INTERIOR_SIZE[1]), sum(inside), where)
+            if any(inside)
+            else []
+        )
         interiors = [next(openings) if i else None for i in inside]
         try:
             groups.append(
-                SampleGroup(name, boxes.astype(np.int64), images, keys, frames, interiors if any(inside) else None)
+                SampleGroup(name, np.array(boxes, np.int64), images, keys, frames, interiors if any(inside) else None)
             )
         except InvalidInputError as e:
             raise InvalidInputError(f"{where}: {e}") from None
@@ -155,18 +169,37 @@ def samples_from_members(text: bytes, read: Callable[[str], bytes | None], where
         raise InvalidInputError(f"{where}: {e}") from None
 
 
-def _atlas(read: Callable[[str], bytes | None], group: str, box: int | str, count: int, where: str) -> list[np.ndarray]:
+def _integer(value: object, most: int) -> bool:
+    """Whether a JSON value is an integer from 0 to ``most`` (not a boolean)."""
+    return isinstance(value, int) and not isinstance(value, bool) and 0 <= value <= most
+
+
+def _real(value: object) -> bool:
+    """Whether a JSON value is a number (not a boolean)."""
+    return isinstance(value, int | float) and not isinstance(value, bool)
+
+
+def _atlas(
+    read: Callable[[str], bytes | None], group: str, box: int | str, size: tuple[int, int], count: int, where: str
+) -> list[np.ndarray]:
     """A group's stacked images of one box (or its interiors), PNG or WebP, cut into ``count``
-    RGB images of equal height."""
+    RGB images of ``size`` (width, height); its header's size is checked before it is decoded."""
+    w, h = size
     for kind in ("png", "webp"):
         name = image_name(group, box, kind)
         data = read(name)
-        if data is not None:
-            image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
-            if image is None or image.ndim != 3:
-                raise InvalidInputError(f"{where}: sample image {name} does not decode")
-            if image.shape[0] % count:
-                raise InvalidInputError(f"{where}: sample image {name} does not hold {count} images of one height")
-            return np.split(cv2.cvtColor(image, cv2.COLOR_BGR2RGB), count)
+        if data is None:
+            continue
+        declared = image_size(data) if data else None
+        if declared is None:
+            raise InvalidInputError(f"{where}: sample image {name} is not a {kind.upper()} image")
+        if declared != (w, h * count):
+            raise InvalidInputError(
+                f"{where}: sample image {name} is {declared[0]}x{declared[1]}, not {count} images of {w}x{h}"
+            )
+        image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
+        if image is None or image.shape[:2] != (h * count, w):
+            raise InvalidInputError(f"{where}: sample image {name} does not decode")
+        return np.split(cv2.cvtColor(image, cv2.COLOR_BGR2RGB), count)
     what = "its interiors" if box == INTERIOR else f"box {box}"
     raise InvalidInputError(f"{where}: group {group!r} has no image of {what}")

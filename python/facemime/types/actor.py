@@ -16,7 +16,7 @@ from facemime.errors import InvalidInputError
 from facemime.types.head import HeadModel
 from facemime.types.points import ReferencePoints
 from facemime.types.pose import Pose
-from facemime.types.samples import Samples
+from facemime.types.samples import MOUTH_GROUPS, Samples
 
 
 @dataclass(frozen=True, eq=False)
@@ -75,6 +75,13 @@ class Actor:
             raise InvalidInputError("actor model needs texture coordinates (uv)")
         if self.samples is not None:
             h, w = self.texture.shape[:2]
+            lips = len(np.unique(np.concatenate([self.model.groups[n] for n in MOUTH_GROUPS])))
             for g in self.samples.groups:
-                if ((g.boxes[:, 0] + g.boxes[:, 2]) > w).any() or ((g.boxes[:, 1] + g.boxes[:, 3]) > h).any():
+                x, y, bw, bh = g.boxes.T
+                if ((x >= w) | (bw > w - x) | (y >= h) | (bh > h - y)).any():
                     raise InvalidInputError(f"sample group {g.name!r} has a box outside the {w}x{h} texture")
+                if g.name == "mouth" and g.keys.shape[1] != 2 * lips:
+                    raise InvalidInputError(
+                        f"sample group 'mouth': its keys must hold the {lips} lip knots' (x, y), "
+                        f"got {g.keys.shape[1]} values"
+                    )

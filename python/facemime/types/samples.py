@@ -20,7 +20,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from facemime.errors import InvalidInputError
+from facemime.shared_constants import INTERIOR_SIZE
 from facemime.shared_constants import SAMPLE_GROUPS as GROUPS  # the groups a library may hold, in painting order
+
+#: The head model's groups whose knots key the mouth's samples.
+MOUTH_GROUPS = ("mouth_outer_upper", "mouth_outer_lower", "mouth_inner_upper", "mouth_inner_lower")
+#: A key's values at most, in absolute value (shares, eye widths, model units).
+MAX_KEY = 1e4
+#: Samples a group, and boxes a group, at most; texels of a library's images at most (boxes and
+#: interiors, all samples: 64 MB of RGB).
+MAX_SAMPLES = 64
+MAX_BOXES = 4
+MAX_TEXELS = 1 << 24
 
 
 def _rgb(image: object) -> bool:
@@ -45,10 +56,11 @@ class SampleGroup:
         (x, y) offsets flattened (``mouth``, model units).
     frames : (S,) int64 array
         Per sample, the index of the frame it was taken from (informative).
-    interiors : list of ((h, w, 3) uint8 array or None) or None
+    interiors : list of ((40, 96, 3) uint8 array or None) or None
         ``mouth`` only: per sample, the mouth's opening as its frame showed it, laid out between
-        the inner lips (:func:`facemime.animate.samples.interior_uv`); None for a sample whose
-        mouth was closed. None: no sample has one.
+        the inner lips (:func:`facemime.animate.samples.interior_uv`,
+        :data:`~facemime.shared_constants.INTERIOR_SIZE`); None for a sample whose mouth was
+        closed. None: no sample has one.
     """
 
     name: str
@@ -59,42 +71,63 @@ class SampleGroup:
     interiors: list[np.ndarray | None] | None = None
 
     def __post_init__(self) -> None:
-        if self.name not in GROUPS:
+        try:
+            self._check()
+        except InvalidInputError:
+            raise
+        except (TypeError, ValueError, AttributeError, IndexError) as e:  # arrays of the wrong kind
+            raise InvalidInputError(f"sample group {self.name!r}: malformed ({e})") from None
+
+    def _check(self) -> None:
+        if not isinstance(self.name, str) or self.name not in GROUPS:
             raise InvalidInputError(f"a sample group is one of {', '.join(GROUPS)}, got {self.name!r}")
         boxes = np.asarray(self.boxes)
-        if boxes.ndim != 2 or boxes.shape[1] != 4 or not len(boxes) or (boxes[:, 2:] < 1).any() or (boxes < 0).any():
-            raise InvalidInputError(f"sample group {self.name!r}: boxes must be rows of x, y, width, height ≥ 0")
-        keys = np.asarray(self.keys, np.float64)
-        if keys.ndim != 2 or len(keys) != len(self.images) or len(self.frames) != len(keys) or not len(keys):
-            raise InvalidInputError(f"sample group {self.name!r}: one key and one frame per sample are needed")
+        if (
+            boxes.dtype.kind not in "iu"
+            or boxes.ndim != 2
+            or boxes.shape[1] != 4
+            or not 1 <= len(boxes) <= MAX_BOXES
+            or (boxes[:, 2:] < 1).any()
+            or (boxes < 0).any()
+            or (boxes > 1 << 16).any()
+        ):
+            raise InvalidInputError(
+                f"sample group {self.name!r}: boxes must be 1-{MAX_BOXES} rows of integer x, y, width, height ≥ 0"
+            )
+        object.__setattr__(self, "boxes", boxes.astype(np.int64))
+        keys = np.asarray(self.keys)
+        if keys.dtype.kind not in "iuf" or keys.ndim != 2:
+            raise InvalidInputError(f"sample group {self.name!r}: keys must be rows of real numbers")
+        object.__setattr__(self, "keys", keys := keys.astype(np.float64))
+        frames = np.asarray(self.frames)
+        if frames.dtype.kind not in "iu" or frames.shape != (len(keys),) or not isinstance(self.images, list):
+            raise InvalidInputError(f"sample group {self.name!r}: one key, one frame and one image list per sample")
+        object.__setattr__(self, "frames", frames.astype(np.int64))
+        if len(self.images) != len(keys) or not 1 <= len(keys) <= MAX_SAMPLES:
+            raise InvalidInputError(
+                f"sample group {self.name!r}: 1-{MAX_SAMPLES} samples, each with its key and images"
+            )
         if self.name == "eyes" and keys.shape[1] != 6:
             raise InvalidInputError(f"sample group 'eyes': its keys are looks of 6 values, got {keys.shape[1]}")
-        if not np.isfinite(keys).all():
-            raise InvalidInputError(f"sample group {self.name!r}: its keys must be finite")
+        if not np.isfinite(keys).all() or (np.abs(keys) > MAX_KEY).any():
+            raise InvalidInputError(f"sample group {self.name!r}: its keys must be finite, within ±{MAX_KEY:g}")
+        if len(keys) * int((boxes[:, 2] * boxes[:, 3]).sum()) > MAX_TEXELS:
+            raise InvalidInputError(f"sample group {self.name!r}: more than {MAX_TEXELS} texels of images")
         for sample in self.images:
-            if len(sample) != len(boxes) or any(
-                not (_rgb(im) and im.shape[:2] == (int(h), int(w))) for im, (_, _, w, h) in zip(sample, boxes)
+            if (
+                not isinstance(sample, list | tuple)
+                or len(sample) != len(boxes)
+                or any(not (_rgb(im) and im.shape[:2] == (int(h), int(w))) for im, (_, _, w, h) in zip(sample, boxes))
             ):
                 raise InvalidInputError(
                     f"sample group {self.name!r}: each sample needs an RGB image of each box's size"
                 )
         if self.interiors is not None:
-            if self.name != "mouth" or len(self.interiors) != len(keys):
+            if self.name != "mouth" or not isinstance(self.interiors, list) or len(self.interiors) != len(keys):
                 raise InvalidInputError(f"sample group {self.name!r}: interiors are the mouth's, one per sample")
-            inside = [im for im in self.interiors if im is not None]
-            if any(
-                not (
-                    isinstance(im, np.ndarray)
-                    and im.dtype == np.uint8
-                    and im.ndim == 3
-                    and im.shape[2] == 3
-                    and min(im.shape[:2]) >= 1
-                )
-                for im in inside
-            ):
-                raise InvalidInputError("sample group 'mouth': an interior is an (h, w, 3) uint8 RGB image")
-            if len({im.shape for im in inside}) > 1:
-                raise InvalidInputError("sample group 'mouth': its interiors must be of one size")
+            w, h = INTERIOR_SIZE
+            if any(im is not None and not (_rgb(im) and im.shape[:2] == (h, w)) for im in self.interiors):
+                raise InvalidInputError(f"sample group 'mouth': an interior is a {w} x {h} RGB image")
 
 
 @dataclass(frozen=True, eq=False)
@@ -104,6 +137,8 @@ class Samples:
     groups: tuple[SampleGroup, ...]
 
     def __post_init__(self) -> None:
+        if not isinstance(self.groups, tuple) or not all(isinstance(g, SampleGroup) for g in self.groups):
+            raise InvalidInputError("a sample library is a tuple of sample groups")
         names = [g.name for g in self.groups]
         if len(set(names)) != len(names):
             raise InvalidInputError(f"a sample library holds each group once, got {', '.join(names)}")

@@ -500,6 +500,7 @@
   var REACH = 0.45;
   var SEAL = 0.05;
   var SAMPLE_GROUPS = ["eyes", "mouth"];
+  var INTERIOR_SIZE = [96, 40];
   var IRIS_WEIGHT = 5;
   var BACKGROUND = [38, 40, 46];
   var NO_FACE_DIM = 0.45;
@@ -535,6 +536,8 @@
   // src/render/actor.ts
   var MAX_SAMPLES = 64;
   var MAX_BOXES = 4;
+  var MAX_KEY = 1e4;
+  var MAX_TEXELS = 1 << 24;
   var MAX_MEMBER = 64 << 20;
   async function decodeImage(bytes, type) {
     const bitmap = await createImageBitmap(
@@ -588,10 +591,10 @@
     const texture = await picture("texture");
     if (!texture) throw new Error("the actor has no texture");
     const scene = doc.scene ? await picture("scene") : null;
-    const samples = files["samples.json"] ? await readSamples(files, texture) : null;
+    const samples = files["samples.json"] ? await readSamples(files, texture, model) : null;
     return { model, pose: doc.pose, source: doc.source, texture, scene, samples };
   }
-  async function readSamples(files, texture) {
+  async function readSamples(files, texture, model) {
     const bad = (why) => {
       throw new Error(`the actor's samples.json is malformed (${why})`);
     };
@@ -614,10 +617,14 @@
       const entries = samples;
       const keys = entries.map((e) => {
         const key = e?.key;
-        if (!Array.isArray(key) || key.some((v2) => typeof v2 !== "number" || !Number.isFinite(v2))) return bad(`group ${name}: a sample's key is not a list of finite numbers`);
+        if (!Array.isArray(key) || key.some((v2) => typeof v2 !== "number" || !Number.isFinite(v2) || Math.abs(v2) > MAX_KEY)) return bad(`group ${name}: a sample's key is not a list of finite numbers within ±${MAX_KEY}`);
         return Float64Array.from(key);
       });
-      if (keys.some((k) => k.length !== keys[0].length) || name === "eyes" && keys[0].length !== 6) bad(`group ${name}: keys of unequal or wrong length`);
+      const lips = new Set(["mouth_outer_upper", "mouth_outer_lower", "mouth_inner_upper", "mouth_inner_lower"].flatMap((g2) => [...model.groups[g2]])).size;
+      if (keys.some((k) => k.length !== (name === "eyes" ? 6 : 2 * lips))) bad(`group ${name}: keys of the wrong length`);
+      const rectsAll = boxes;
+      if (entries.length * rectsAll.reduce((t, [, , w, h]) => t + w * h, 0) > MAX_TEXELS) bad(`group ${name}: more than ${MAX_TEXELS} texels of images`);
+      if (entries.some((e) => e?.interior !== void 0 && typeof e.interior !== "boolean")) bad(`group ${name}: a sample's interior is true or false`);
       const frames = entries.map((e) => Number.isInteger(e?.frame) ? e.frame : bad(`group ${name}: a sample's frame is not an integer`));
       const rects = boxes;
       const inside = entries.map((e) => e?.interior === true);
@@ -650,6 +657,9 @@
       const images = entries.map((_, s) => perBox.map((cut) => cut[s]));
       const opened = inside.filter((i2) => i2).length;
       const openings = opened ? await atlas("interior", opened) : [];
+      if (opened && (openings[0].width !== INTERIOR_SIZE[0] || openings[0].height !== INTERIOR_SIZE[1])) {
+        bad(`group ${name}: an interior is a ${INTERIOR_SIZE[0]} x ${INTERIOR_SIZE[1]} image`);
+      }
       let next = 0;
       const interiors = opened ? inside.map((i2) => i2 ? openings[next++] : null) : null;
       groups.push({ name, boxes: rects, keys, frames, images, interiors });

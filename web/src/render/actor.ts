@@ -10,7 +10,7 @@
  */
 import { unzipSync } from 'fflate';
 import type { Model, Pose } from './geometry';
-import { SAMPLE_GROUPS } from '../shared_constants';
+import { INTERIOR_SIZE, SAMPLE_GROUPS } from '../shared_constants';
 
 export interface Picture { width: number; height: number; rgba: Uint8Array }
 
@@ -41,7 +41,7 @@ export interface SampleGroup {
 }
 
 /** At most this many samples and boxes a group (facemime.io.samples_file). */
-const MAX_SAMPLES = 64, MAX_BOXES = 4;
+const MAX_SAMPLES = 64, MAX_BOXES = 4, MAX_KEY = 1e4, MAX_TEXELS = 1 << 24;
 
 /** Largest member accepted, bytes (as the Python reader). */
 const MAX_MEMBER = 64 << 20;
@@ -100,13 +100,13 @@ export async function readActor(data: Uint8Array): Promise<Actor> {
   const texture = await picture('texture');
   if (!texture) throw new Error('the actor has no texture');
   const scene = doc.scene ? await picture('scene') : null;
-  const samples = files['samples.json'] ? await readSamples(files, texture) : null;
+  const samples = files['samples.json'] ? await readSamples(files, texture, model) : null;
   return { model, pose: doc.pose as Pose, source: doc.source, texture, scene, samples };
 }
 
 /** An actor's sample library from its members (facemime.io.samples_file.samples_from_members,
  * with facemime.types.samples' checks); throws an Error with a one-line reason when malformed. */
-async function readSamples(files: Record<string, Uint8Array>, texture: Picture): Promise<SampleGroup[]> {
+async function readSamples(files: Record<string, Uint8Array>, texture: Picture, model: Model): Promise<SampleGroup[]> {
   const bad = (why: string): never => { throw new Error(`the actor's samples.json is malformed (${why})`); };
   let doc;
   try {
@@ -129,10 +129,14 @@ async function readSamples(files: Record<string, Uint8Array>, texture: Picture):
     const entries = samples as { frame: unknown; key: unknown; interior?: unknown }[];
     const keys = entries.map((e) => {
       const key = e?.key;
-      if (!Array.isArray(key) || key.some((v) => typeof v !== 'number' || !Number.isFinite(v))) return bad(`group ${name}: a sample's key is not a list of finite numbers`);
+      if (!Array.isArray(key) || key.some((v) => typeof v !== 'number' || !Number.isFinite(v) || Math.abs(v) > MAX_KEY)) return bad(`group ${name}: a sample's key is not a list of finite numbers within ±${MAX_KEY}`);
       return Float64Array.from(key as number[]);
     });
-    if (keys.some((k) => k.length !== keys[0].length) || (name === 'eyes' && keys[0].length !== 6)) bad(`group ${name}: keys of unequal or wrong length`);
+    const lips = new Set(['mouth_outer_upper', 'mouth_outer_lower', 'mouth_inner_upper', 'mouth_inner_lower'].flatMap((g) => [...model.groups[g]])).size;
+    if (keys.some((k) => k.length !== (name === 'eyes' ? 6 : 2 * lips))) bad(`group ${name}: keys of the wrong length`);
+    const rectsAll = boxes as [number, number, number, number][];
+    if (entries.length * rectsAll.reduce((t, [, , w, h]) => t + w * h, 0) > MAX_TEXELS) bad(`group ${name}: more than ${MAX_TEXELS} texels of images`);
+    if (entries.some((e) => e?.interior !== undefined && typeof e.interior !== 'boolean')) bad(`group ${name}: a sample's interior is true or false`);
     const frames = entries.map((e) => (Number.isInteger(e?.frame) ? (e.frame as number) : bad(`group ${name}: a sample's frame is not an integer`)));
     const rects = boxes as [number, number, number, number][];
     const inside = entries.map((e) => e?.interior === true);
@@ -165,6 +169,9 @@ async function readSamples(files: Record<string, Uint8Array>, texture: Picture):
     const images = entries.map((_, s) => perBox.map((cut) => cut[s]));
     const opened = inside.filter((i) => i).length;
     const openings = opened ? await atlas('interior', opened) : [];
+    if (opened && (openings[0].width !== INTERIOR_SIZE[0] || openings[0].height !== INTERIOR_SIZE[1])) {
+      bad(`group ${name}: an interior is a ${INTERIOR_SIZE[0]} x ${INTERIOR_SIZE[1]} image`);
+    }
     let next = 0;
     const interiors = opened ? inside.map((i) => (i ? openings[next++] : null)) : null;
     groups.push({ name: name as SampleGroup['name'], boxes: rects, keys, frames, images, interiors });
