@@ -18,6 +18,7 @@ from facemime.codec.clip import (
     MAX_COEFFICIENTS,
     MAX_CONCEALED_RATIO,
     SUFFIX,
+    Clip,
     analyse,
     encode_clip,
     member_bytes,
@@ -137,20 +138,7 @@ def encode_video(
     basis = Basis.learn(np.array(faces).reshape(len(faces), -1, 2), MAX_COEFFICIENTS)
     warnings = list(clip.warnings)
     duration = len(clip.motion) / clip.fps
-    if rate is None:
-        chosen = settings
-        header, actor_chunk, packets = encode_clip(clip, settings, carry, basis)
-    else:
-        for quality in reversed(range(len(LADDER))):
-            chosen = replace(settings, quality=quality)
-            header, actor_chunk, packets = encode_clip(clip, chosen, carry, basis)
-            if sum(map(len, packets)) * 8 / 1000 / duration <= rate:
-                break
-        else:
-            warnings.append(
-                f"the coarsest quality needs {sum(map(len, packets)) * 8 / 1000 / duration:.2f} kbit/s, "
-                f"more than the {rate:g} asked for"
-            )
+    chosen, (header, actor_chunk, packets), short = _at_rate(clip, settings, carry, basis, rate, duration)
     if samples and carry and not from_track:
         decoder = MotionDecoder()
         decoded = decoder.push(header + actor_chunk + b"".join(packets)) + decoder.finish()
@@ -159,7 +147,11 @@ def encode_video(
         if library is not None:
             choices = choose_samples(video, replace(decoder.actor, samples=library), decoded)
             clip = replace(clip, actor=replace(clip.actor, samples=library))
-            header, actor_chunk, packets = encode_clip(clip, chosen, carry, basis, choices)
+            # the choices take some of the rate: the quality is chosen again with them
+            chosen, (header, actor_chunk, packets), short = _at_rate(
+                clip, settings, carry, basis, rate, duration, choices
+            )
+    warnings += short
     motion_bytes, updates, sent = sum(map(len, packets)), 0, 0
     if appearance > 0:
         chunks, sender = with_appearance(video, clip, header, actor_chunk, packets, chosen, appearance)
@@ -181,6 +173,29 @@ def encode_video(
         updates,
         member_bytes(actor_chunk, "samples"),
     )
+
+
+def _at_rate(
+    clip: Clip,
+    settings: Settings,
+    carry: bool,
+    basis: Basis,
+    rate: float | None,
+    duration: float,
+    choices: list[tuple[int | None, ...]] | None = None,
+) -> tuple[Settings, tuple[bytes, bytes, list[bytes]], list[str]]:
+    """The clip coded at ``settings`` or, given a ``rate`` (kbit/s of packets), at the finest
+    quality whose packets fit it; the settings used, the stream's parts, and a warning when even
+    the coarsest does not fit."""
+    if rate is None:
+        return settings, encode_clip(clip, settings, carry, basis, choices), []
+    for quality in reversed(range(len(LADDER))):
+        chosen = replace(settings, quality=quality)
+        parts = encode_clip(clip, chosen, carry, basis, choices)
+        needed = sum(map(len, parts[2])) * 8 / 1000 / duration
+        if needed <= rate:
+            return chosen, parts, []
+    return chosen, parts, [f"the coarsest quality needs {needed:.2f} kbit/s, more than the {rate:g} asked for"]
 
 
 @dataclass
