@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from facemime.io.image_bytes import decode_rgb
 from facemime.render.paste import BLEND, paste_faded
 from facemime.render.raster import render_mesh_into
 from facemime.shared_constants import EYES
@@ -104,10 +105,8 @@ def parse(payload: bytes) -> Update | None:
     if len(payload) <= HEAD.size:
         return None
     frame, x, y = HEAD.unpack_from(payload)
-    image = cv2.imdecode(np.frombuffer(payload, np.uint8, offset=HEAD.size), cv2.IMREAD_COLOR)
-    if image is None or image.ndim != 3 or image.shape[2] != 3:
-        return None
-    return Update(frame, x, y, cv2.cvtColor(image, cv2.COLOR_BGR2RGB))
+    image = decode_rgb(payload[HEAD.size :])
+    return None if image is None else Update(frame, x, y, image)
 
 
 def paste(texture: np.ndarray, update: Update) -> bool:

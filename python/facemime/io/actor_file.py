@@ -35,6 +35,7 @@ import numpy as np
 
 from facemime.errors import FacemimeError, InputFileError, InvalidInputError, ModelFormatError
 from facemime.io.head_file import head_document, head_from_document
+from facemime.io.image_bytes import decode_rgb
 from facemime.io.outputs import OutputFileError, check_outputs, write_bytes
 from facemime.io.samples_file import SAMPLE_QUALITY, SAMPLES_JSON, samples_from_members, samples_members
 from facemime.limits import image_size, limit, parse_json, pose_in_range
@@ -331,9 +332,9 @@ def _texture(data: bytes, member: str, meta: object, where: str, what: str = "te
     w, h = size
     if not (1 <= w <= MAX_TEXTURE_SIDE and 1 <= h <= MAX_TEXTURE_SIDE):
         raise ActorFileError(f"{where}: {what} is {w}x{h}; at most {MAX_TEXTURE_SIDE} pixels a side are allowed")
-    img = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
+    img = decode_rgb(data)
     if img is None or img.shape[:2] != (h, w):
         raise ActorFileError(f"{where}: {member} is corrupt")
     if not isinstance(meta, dict) or [meta.get("width"), meta.get("height")] != [img.shape[1], img.shape[0]]:
         raise ActorFileError(f"{where}: {what} is {img.shape[1]}x{img.shape[0]}, but actor.json says {meta}")
-    return np.ascontiguousarray(cv2.cvtColor(img, cv2.COLOR_BGR2RGB))
+    return img

@@ -19,10 +19,10 @@ from __future__ import annotations
 import json
 from collections.abc import Callable
 
-import cv2
 import numpy as np
 
 from facemime.errors import InvalidInputError
+from facemime.io.image_bytes import decode_rgb
 from facemime.limits import image_size, parse_json
 from facemime.shared_constants import INTERIOR_SIZE
 from facemime.types.samples import GROUPS, MAX_BOXES, MAX_SAMPLES, MAX_TEXELS, SampleGroup, Samples
@@ -197,9 +197,9 @@ def _atlas(
             raise InvalidInputError(
                 f"{where}: sample image {name} is {declared[0]}x{declared[1]}, not {count} images of {w}x{h}"
             )
-        image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
+        image = decode_rgb(data)
         if image is None or image.shape[:2] != (h * count, w):
             raise InvalidInputError(f"{where}: sample image {name} does not decode")
-        return np.split(cv2.cvtColor(image, cv2.COLOR_BGR2RGB), count)
+        return np.split(image, count)
     what = "its interiors" if box == INTERIOR else f"box {box}"
     raise InvalidInputError(f"{where}: group {group!r} has no image of {what}")
