@@ -109,6 +109,19 @@ def _edited(actor, name, data):
     [
         ("samples.json", b"{not json", "samples.json is not valid JSON"),
         ("samples.json", b'{"format": "facemime.samples/9", "groups": []}', "not a 'facemime.samples/1'"),
+        ("samples.json", b'{"format": "facemime.samples/1", "groups": [null]}', "an object with its name"),
+        (
+            "samples.json",
+            b'{"format": "facemime.samples/1", "groups": [{"name": "eyes", "boxes": [[0, 0, 4, 4]],'
+            b' "samples": [{"frame": 0, "key": [0, 0, 0, 0, 0, 0]}, {"frame": 1, "key": [0]}]}]}',
+            "keys differ in length",
+        ),
+        (
+            "samples.json",
+            b'{"format": "facemime.samples/1", "groups": [{"name": "eyes", "boxes": [[0, 0, 0, 4]],'
+            b' "samples": [{"frame": 0, "key": [0, 0, 0, 0, 0, 0]}]}]}',
+            "width and height",
+        ),
         ("samples/eyes/0.png", None, "has no image of box 0"),
         ("samples/eyes/0.png", b"not a picture", "is not a PNG image"),
         ("samples/eyes/0.png", b"", "is not a PNG image"),

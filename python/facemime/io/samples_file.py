@@ -125,6 +125,8 @@ def samples_from_members(text: bytes, read: Callable[[str], bytes | None], where
     groups = []
     for g in doc["groups"]:
         try:
+            if not isinstance(g, dict) or not {"name", "boxes", "samples"} <= g.keys():
+                raise ValueError("a group is an object with its name, boxes and samples")
             name, boxes, entries = g["name"], g["boxes"], g["samples"]
             if name not in GROUPS:
                 raise ValueError(f"a group is one of {', '.join(GROUPS)}, got {name!r}")
@@ -132,8 +134,9 @@ def samples_from_members(text: bytes, read: Callable[[str], bytes | None], where
                 isinstance(boxes, list)
                 and 1 <= len(boxes) <= MAX_BOXES
                 and all(isinstance(b, list) and len(b) == 4 and all(_integer(v, 1 << 16) for v in b) for b in boxes)
+                and all(w >= 1 and h >= 1 for _, _, w, h in boxes)
             ):
-                raise ValueError(f"boxes must be 1-{MAX_BOXES} rows of 4 integers 0-65536")
+                raise ValueError(f"boxes must be 1-{MAX_BOXES} rows of 4 integers 0-65536, width and height ≥ 1")
             if not isinstance(entries, list) or not 1 <= len(entries) <= MAX_SAMPLES:
                 raise ValueError(f"a group holds 1-{MAX_SAMPLES} samples")
             if len(entries) * sum(w * h for _, _, w, h in boxes) > MAX_TEXELS:
@@ -142,8 +145,12 @@ def samples_from_members(text: bytes, read: Callable[[str], bytes | None], where
                 raise ValueError("each sample needs its frame, an integer ≥ 0")
             if not all(isinstance(e.get("key"), list) and all(_real(v) for v in e["key"]) for e in entries):
                 raise ValueError("each sample needs its key, a list of numbers")
+            if len({len(e["key"]) for e in entries}) > 1:
+                raise ValueError("the samples' keys differ in length")
             if not all(isinstance(e.get("interior", False), bool) for e in entries):
                 raise ValueError("a sample's interior is true or false")
+            if name != "mouth" and any(e.get("interior") for e in entries):
+                raise ValueError("only mouth samples hold an interior")
             keys = np.array([np.asarray(e["key"], np.float64) for e in entries])
             frames = np.array([e["frame"] for e in entries], np.int64)
             inside = [e.get("interior") is True for e in entries]
