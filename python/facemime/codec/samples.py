@@ -53,6 +53,9 @@ OPEN = 2 * SEAL
 #: A frame keeps its predecessor's sample unless another's error is this share smaller (fewer
 #: switches: fewer bits, and no flicker between samples that fit about as well).
 SWITCH = 0.25
+#: Texels (Gaussian sigma) over which a laid-back frame fades into the texture where its facing
+#: triangles end.
+FEATHER = 2.0
 #: Frames laid back at most (evenly spread over the clip): bounds the memory the choice takes.
 CANDIDATES = 600
 
@@ -192,6 +195,11 @@ def choose_group(
     return SampleGroup(name, boxes, images, keys[chosen], frames[chosen], interiors_kept), size
 
 
+def _blend(base: np.ndarray, over: np.ndarray, weight: np.ndarray) -> np.ndarray:
+    """``base`` + ``weight`` · (``over`` − ``base``), rounded: uint8 RGB images, (h, w, 1) weights 0-1."""
+    return np.clip(base + weight * (over.astype(np.float32) - base) + 0.5, 0, 255).astype(np.uint8)
+
+
 def _interior(
     frame: np.ndarray, vertices: np.ndarray, pose: Pose, model: HeadModel, strip_uv: np.ndarray, strip: np.ndarray
 ) -> np.ndarray | None:
@@ -232,13 +240,15 @@ class _Regions:
         self.mouth = mouth_knots(actor.model.groups, self.puppet.deformer.knots)
         model = actor.model
         assert model.uv is not None  # an actor's model has texture coordinates
+        self.strip_uv, self.strip = interior_strip(model)
+        strip = {frozenset(t) for t in self.strip.tolist()}
+        cap = np.array([frozenset(t) in strip for t in model.triangles.tolist()], bool)
+        if cap.any():  # a capped mouth (fit.actor.mouth_cap) shows the photo's own opening, as it is
+            self.strip = self.strip[:0]
         self.triangles = tri = np.asarray(model.triangles)
         v = model.vertices
         normals = np.cross(v[tri[:, 1]] - v[tri[:, 0]], v[tri[:, 2]] - v[tri[:, 0]])
         self.normals = normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
-        self.strip_uv, self.strip = interior_strip(model)
-        if {frozenset(t) for t in self.strip.tolist()} & {frozenset(t) for t in tri.tolist()}:
-            self.strip = self.strip[:0]  # a capped mouth (fit.actor.mouth_cap): its own texture shows the opening
 
     def key(self, group: str, f: DecodedFrame) -> np.ndarray:
         """A decoded frame's key in a group.
@@ -288,11 +298,15 @@ class _Regions:
         laid, cover = lay_back(frame, model.uv, self.triangles, project(vertices, pose)[0], facing, (w, h))
         crops: dict[str, list[np.ndarray]] = {}
         covers: dict[str, list[np.ndarray]] = {}
+        covered = (cover == 255).astype(np.float32)
+        # where the frame's facing triangles end (the far cheek of a turned head), it fades into the
+        # texture over a few texels instead of leaving a seam
+        weight = (cv2.GaussianBlur(covered, (0, 0), FEATHER) * covered)[:, :, None]
         for g, bs in self.boxes.items():
             covers[g] = [cover[y : y + bh, x : x + bw] == 255 for x, y, bw, bh in bs]
             crops[g] = [
-                np.where(c[:, :, None], laid[y : y + bh, x : x + bw], texture[y : y + bh, x : x + bw])
-                for c, (x, y, bw, bh) in zip(covers[g], bs)
+                _blend(texture[y : y + bh, x : x + bw], laid[y : y + bh, x : x + bw], weight[y : y + bh, x : x + bw])
+                for x, y, bw, bh in bs
             ]
         return crops, covers, _interior(frame, vertices, pose, model, self.strip_uv, self.strip)
 
