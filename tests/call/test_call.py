@@ -136,7 +136,9 @@ def test_a_client_gets_hello_header_actor_then_frames_and_packets_that_decode(li
     arrived = [a for t in texts for a in t["arrived"]]
     gaps = [b - a for a, b in itertools.pairwise(arrived)]
     assert 30 < sum(gaps) / len(gaps) < 50  # the video's pace: 40 ms a frame
-    assert abs(arrived[-1] - time.time() * 1000) < 1000  # ms since the epoch, this machine's clock
+    # ms since the epoch on this machine's clock (not seconds, not a monotonic clock): within 10 s of now even
+    # on a loaded machine, where the sender can fall a second behind (latency is benchmarks/call.py's)
+    assert abs(arrived[-1] - time.time() * 1000) < 10_000
     decoder = MotionDecoder(from_start=False)
     frames = decoder.push(header + actor + b"".join(packets)) + decoder.finish()
     decoded = [f for f in frames if not f.concealed]
