@@ -369,24 +369,25 @@ def build_samples(video: str | Path, actor: Actor, decoded: list[DecodedFrame], 
     return Samples(tuple(groups)) if groups else None
 
 
-def _error(
-    crops: list[np.ndarray],
-    covers: list[np.ndarray],
-    images: list[np.ndarray],
-    interior: np.ndarray | None,
-    drawn: np.ndarray | None,
-) -> float:
-    """Mean squared difference (levels², over RGB) between a frame's laid-back boxes and a
-    candidate's where the frame covers them, and between the frame's interior and the candidate's
-    (``drawn``) where the frame has one."""
-    total, count = 0.0, 0
-    for crop, cover, image in zip(crops, covers, images):
-        d = crop[cover].astype(np.float32) - image[cover]
-        total, count = total + float((d * d).sum()), count + d.size
-    if interior is not None and drawn is not None:
-        d = interior.astype(np.float32) - drawn
-        total, count = total + float((d * d).sum()), count + d.size
-    return total / count if count else 0.0
+def _errors(
+    candidates: np.ndarray,
+    frame: np.ndarray,
+    covered: np.ndarray,
+    openings: np.ndarray | None = None,
+    opening: np.ndarray | None = None,
+) -> np.ndarray:
+    """Each candidate's mean squared difference (levels², over RGB) from a frame: over the texels
+    of its boxes the frame covers, and over the interior where the frame has one.
+
+    ``candidates`` (C, P) float32: each candidate's boxes flattened; ``frame`` (P,) the frame's,
+    ``covered`` (P,) 1 where it covers them; ``openings`` (C, Q) each candidate's interior
+    flattened, ``opening`` (Q,) the frame's (None: none)."""
+    total = ((candidates - frame) ** 2) @ covered
+    count = float(covered.sum())
+    if openings is not None and opening is not None:
+        total = total + ((openings - opening) ** 2).sum(axis=1)
+        count += opening.size
+    return total / count if count else np.zeros(len(candidates))
 
 
 def choose_samples(video: str | Path, actor: Actor, decoded: list[DecodedFrame]) -> list[tuple[int | None, ...]]:
@@ -413,7 +414,15 @@ def choose_samples(video: str | Path, actor: Actor, decoded: list[DecodedFrame])
     """
     assert actor.samples is not None
     regions, painter = _Regions(actor), LookPainter(actor)
-    cavity = np.full((INTERIOR_SIZE[1], INTERIOR_SIZE[0], 3), CAVITY, np.float32)
+    cavity = np.tile(np.array(CAVITY, np.float32), INTERIOR_SIZE[0] * INTERIOR_SIZE[1])  # a drawn interior, flattened
+    flat = lambda images: np.concatenate([im.ravel() for im in images]).astype(np.float32)  # noqa: E731
+    samples = {g.name: np.array([flat(images) for images in g.images]) for g in actor.samples.groups}
+    # the mouth's candidates' interiors: a drawn one (the key frame's, a sample without) as the cavity
+    openings = {
+        g.name: np.array([cavity] + [cavity if i is None else flat([i]) for i in g.interiors or [None] * len(g.images)])
+        for g in actor.samples.groups
+        if g.name == "mouth"
+    }
     previous: dict[str, int | None] = dict.fromkeys(GROUPS)
     out: list[tuple[int | None, ...]] = []
     with VideoReader(video) as reader:
@@ -422,20 +431,15 @@ def choose_samples(video: str | Path, actor: Actor, decoded: list[DecodedFrame])
                 crops, covers, interior = regions.laid(frame, f)
                 for group in actor.samples.groups:
                     base = painter.texture(f.look) if group.name == "eyes" else actor.texture
-                    own = [base[y : y + h, x : x + w] for x, y, w, h in group.boxes]
-                    inside = group.interiors or [None] * len(group.images)
-                    mouth = group.name == "mouth"
-                    errors = [_error(crops[group.name], covers[group.name], own, interior if mouth else None, cavity)]
-                    errors += [
-                        _error(
-                            crops[group.name],
-                            covers[group.name],
-                            images,
-                            interior if mouth else None,
-                            cavity if i is None else i.astype(np.float32),
-                        )
-                        for images, i in zip(group.images, inside)
-                    ]
+                    own = flat([base[y : y + h, x : x + w] for x, y, w, h in group.boxes])
+                    covered = np.concatenate([np.repeat(c.ravel(), 3) for c in covers[group.name]]).astype(np.float32)
+                    errors = _errors(
+                        np.vstack([own[None], samples[group.name]]),
+                        flat(crops[group.name]),
+                        covered,
+                        openings.get(group.name),
+                        None if interior is None else flat([interior]),
+                    )
                     best, kept = int(np.argmin(errors)), previous[group.name]
                     stay = 0 if kept is None else kept + 1
                     previous[group.name] = (
