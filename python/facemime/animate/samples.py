@@ -1,5 +1,8 @@
-"""The actor's own mouth and eyes in the synthesis: per frame, each sample group's sample whose
-shape is nearest the frame's is pasted into the texture (:mod:`facemime.types.samples`).
+"""The actor's own mouth and eyes in the synthesis: per frame, each sample group's sample is
+pasted into the texture (:mod:`facemime.types.samples`): the one the stream chose
+(``docs/bitstream.md``, "Sample choices"), or, without a choice, the one whose shape is nearest
+the frame's. Under an eye sample the irises are not moved (:meth:`Puppet.render
+<facemime.animate.synth.Puppet.render>`).
 
 The nearest sample: the smallest Euclidean distance between keys, the look's iris shifts weighed
 :data:`IRIS_WEIGHT` times its lid closures (an iris shift of a tenth of the eye's width looks as

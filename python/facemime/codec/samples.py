@@ -3,12 +3,15 @@ library chosen from the clip that is coded, sent once inside the stream's actor 
 
 Each frame with a face is laid back onto the texture through the geometry the receiver draws
 (:func:`~facemime.codec.appearance.lay_back`, the stream decoded here), and each group's boxes are
-cut out of it (texels no facing triangle covers keep the texture's), keyed by the frame's decoded
-shape (:mod:`facemime.animate.samples`). The library covers the shapes seen: per group, the
-frames' keys are chosen farthest first from the key frame's and from each other's (k-centre), the
-frames are put with the nearest chosen key (the key frame's own among them), and each chosen
-sample is the frame of its cluster whose boxes look most like the cluster's mean. Samples are
-added in that order while the library stays under :data:`BUDGET` bytes as the stream carries it.
+cut out of it (texels no facing triangle covers keep the texture's, faded in over
+:data:`FEATHER` texels), keyed by the frame's decoded shape (:mod:`facemime.animate.samples`); an
+open mouth's opening is laid out on its interior image too. The library covers the shapes seen
+(:func:`build_samples`): per group, the frames' keys are chosen farthest first from the key
+frame's and from each other's (k-centre), the frames are put with the nearest chosen key (the key
+frame's own among them), and each chosen sample is the frame of its cluster whose boxes look most
+like the cluster's mean. Samples are added in that order while the library stays under
+:data:`BUDGET` bytes as the stream carries it. Then each frame's sample is chosen by what the
+frame shows (:func:`choose_samples`) and sent with it (``docs/bitstream.md``, "Sample choices").
 """
 
 from __future__ import annotations
