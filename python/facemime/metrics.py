@@ -162,3 +162,39 @@ def pooled_summary(per_video: Sequence[np.ndarray]) -> dict[str, float]:
     for key, q in (("median", 0.5), ("p90", 0.9)):
         out[key] = float(values[order][np.searchsorted(cum, q)])
     return out
+
+
+#: Face Mesh points of each eye in a reference (the subject's right first): the corners (image-left
+#: one first), the upper and lower lids' middles, the iris's centre (478-point refined landmarks).
+EYE_POINTS = ((33, 133, 159, 145, 468), (362, 263, 386, 374, 473))
+
+
+def reference_eyes(landmarks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The eyes of a Face Mesh reference, per frame, relative to its first frame.
+
+    Parameters
+    ----------
+    landmarks
+        (T, 478, 2+) float array: refined Face Mesh landmarks (the shared data's), (x, y) pixels
+        first.
+
+    Returns
+    -------
+    opening : (T, 2) float64 array
+        Per eye (the subject's right first), the distance between the lids' middles over the eye's
+        width (corner to corner), over the first frame's.
+    iris : (T, 2, 2) float64 array
+        Per eye, the iris centre's (u, v) shift from its first-frame place relative to the eye's
+        corners, eye widths: u along the eye towards its image-right corner, v across it, down.
+    """
+    p = np.asarray(landmarks, np.float64)[:, :, :2]
+    opening, iris = np.zeros((len(p), 2)), np.zeros((len(p), 2, 2))
+    for eye, (a, b, up, low, centre) in enumerate(EYE_POINTS):
+        width = np.linalg.norm(p[:, b] - p[:, a], axis=1)
+        along = (p[:, b] - p[:, a]) / width[:, None]
+        across = np.stack([-along[:, 1], along[:, 0]], axis=1)
+        rel = p[:, centre] - (p[:, a] + p[:, b]) / 2
+        o = np.linalg.norm(p[:, up] - p[:, low], axis=1) / width
+        opening[:, eye] = o / o[0]
+        iris[:, eye] = np.stack([(rel * along).sum(1), (rel * across).sum(1)], axis=1) / width[:, None]
+    return opening, iris - iris[:1]

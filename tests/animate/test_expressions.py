@@ -52,11 +52,14 @@ def test_each_control_moves_only_its_region(head, expressions):
             assert not (moved & mouth).any(), name
             assert np.abs(field[~above]).max() == 0.0, name  # nothing below the eyes
         # the subject's left is +x: a left control moves no knot beyond the middle on the right
-        # (mouthLeft and mouthRight move the whole mouth that way)
-        if name.endswith("Left") and name != "mouthLeft":
+        # (mouthLeft and mouthRight move the whole mouth that way, jawLeft and jawRight the lower lip)
+        if name.endswith("Left") and name not in ("mouthLeft", "jawLeft"):
             assert not (moved & (x < -1.0)).any(), name
-        if name.endswith("Right") and name != "mouthRight":
+        if name.endswith("Right") and name not in ("mouthRight", "jawRight"):
             assert not (moved & (x > 1.0)).any(), name
+        if name.startswith("jaw") and name != "jawOpen":  # sideways, towards its side: +x the subject's left
+            sign = 1.0 if name.endswith("Left") else -1.0
+            assert (sign * pattern[moved, 0] > 0).all() and not pattern[:, 1].any(), name
     # the fields are the synthesis's own deformation of the patterns
     k = NAMES.index("jawOpen")
     assert np.allclose(expressions.fields[k, :, :2], d.weights @ expressions.patterns[k])
@@ -73,11 +76,12 @@ def test_each_control_moves_only_its_region(head, expressions):
 
 
 def performance(t: int = 100, seed: int = 3) -> np.ndarray:
-    """Weights (T, E) that change smoothly, 0.8 at most, mouthLeft and mouthRight never both."""
+    """Weights (T, E) that change smoothly, 0.8 at most, the mouth and the jaw never sideways both
+    ways."""
     time = np.linspace(0, 4, t)[:, None]
     rng = np.random.default_rng(seed)
     w = np.clip(np.sin(rng.uniform(0.3, 2, len(NAMES)) * time + rng.uniform(0, 6, len(NAMES))), 0, 1) * 0.8
-    w[:, NAMES.index("mouthRight")] = 0.0
+    w[:, [NAMES.index("mouthRight"), NAMES.index("jawRight")]] = 0.0
     return w
 
 

@@ -18,12 +18,13 @@ blurred shake: the rigid points are dropped and found anew) keeps the face and i
 from __future__ import annotations
 
 import time
-from collections.abc import Iterable, Iterator
+from collections.abc import Generator, Iterable
 from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
+from facemime.animate.arkit import landmark_openings
 from facemime.animate.deform import Deformer
 from facemime.animate.head_pose import PoseFollower
 from facemime.errors import NoFaceError
@@ -47,7 +48,9 @@ class FrameMotion:
     repeat the last good frame's); ``pose``: the head pose of the analysis actor; ``offsets``:
     (K, 2) knot offsets, model units; ``redetected``: the face landmark model put the contours
     right on this frame; ``look``: the eyes (:class:`~facemime.types.look.Look`, relative to
-    the first frame's).
+    the first frame's); ``landmark_closure``: (2,) the lids' closures in the head pose's Face Mesh
+    landmarks (1 - each eye's :func:`~facemime.animate.arkit.landmark_openings` over the first
+    frame's; the subject's right eye first), None where the landmark pass measured none.
     """
 
     contours: dict[str, np.ndarray]
@@ -58,6 +61,7 @@ class FrameMotion:
     offsets: np.ndarray
     redetected: bool = False
     look: Look = field(default_factory=Look)
+    landmark_closure: np.ndarray | None = None
 
 
 @dataclass
@@ -119,6 +123,7 @@ class Analysis:
         t0 = time.perf_counter()
         self.pose = PoseFollower(frame, found.face.landmarks, self.actor.model, self.actor.pose, self.tracker, fps)
         self.timings.fit += time.perf_counter() - t0
+        self._key_openings = landmark_openings(self.pose.key_landmarks)
         self.last = FrameMotion(
             contours, dict.fromkeys(FEATURES, 1.0), [], True, self.actor.pose, np.zeros((len(self.deformer.knots), 2))
         )
@@ -155,8 +160,12 @@ class Analysis:
             looking = time.perf_counter() - t2
             self.timings.look += looking
             elsewhere += looking
+            landmarks = self.pose.landmarks
+            lids = (
+                None if landmarks is None else 1.0 - landmark_openings(landmarks) / np.maximum(self._key_openings, 1e-6)
+            )
             self.last = FrameMotion(
-                result.contours, result.confidence, result.lost, True, pose, offsets, result.redetected, look
+                result.contours, result.confidence, result.lost, True, pose, offsets, result.redetected, look, lids
             )
         else:
             self.frames_without_face += 1
@@ -213,7 +222,7 @@ def start_analysis(frame: np.ndarray, video: str, **options: Any) -> Analysis:
 
 def analysed(
     frames: Iterable[np.ndarray], video: str, **options: Any
-) -> Iterator[tuple[np.ndarray, Analysis, FrameMotion]]:
+) -> Generator[tuple[np.ndarray, Analysis, FrameMotion]]:
     """Each frame with the video's :class:`Analysis` and that frame's :class:`FrameMotion`.
 
     The first frame starts the analysis (:func:`start_analysis`: its one message for a first

@@ -68,6 +68,8 @@ NAMES: tuple[str, ...] = (
     "browDownRight",
     "eyeBlinkLeft",
     "eyeBlinkRight",
+    "jawLeft",
+    "jawRight",
 )
 BLINKS = ("eyeBlinkRight", "eyeBlinkLeft")  # in the order of Look.closure (right eye first)
 
@@ -104,6 +106,8 @@ MAGNITUDES: dict[str, float] = {
     "browDownRight": 0.33,
     "eyeBlinkLeft": 1.0,
     "eyeBlinkRight": 1.0,
+    "jawLeft": 0.22,
+    "jawRight": 0.22,
 }
 DESCRIPTIONS: dict[str, str] = {
     "jawOpen": "the jaw opens: the lower lip down (its middle the most, the corners 0.3 of it), the chin follows",
@@ -132,6 +136,8 @@ DESCRIPTIONS: dict[str, str] = {
     "browDownRight": "the subject's right brow lowers (its inner end the most) and draws in",
     "eyeBlinkLeft": "the subject's left upper lid down onto the lower lid (look closure 1)",
     "eyeBlinkRight": "the subject's right upper lid down onto the lower lid (look closure 1)",
+    "jawLeft": "the jaw moves to the subject's left: the lower lip sideways (the corners half of it)",
+    "jawRight": "the jaw moves to the subject's right: the lower lip sideways (the corners half of it)",
 }
 #: Pull towards the previous frame's weights in :meth:`Expressions.solve`, a fraction of the
 #: mean squared pattern norm. On the shared videos it changes the coverage by < 0.0003 IOD (0 ->
@@ -222,6 +228,8 @@ def unit_patterns(model: HeadModel, deformer: Deformer | None = None) -> np.ndar
         out[f"browOuterUp{side}"][brow, 1] = t[brow]
         out[f"browDown{side}"][brow, 1] = -(1.0 - 0.5 * t[brow])
         out[f"browDown{side}"][brow, 0] = -sign * 0.3 * (1.0 - t[brow])  # towards the middle
+        out[f"jaw{side}"][lower, 0] = sign
+        out[f"jaw{side}"][corner, 0] = 0.5 * sign
     out["mouthRollUpper"][role["ou"], 1] = -bump[role["ou"]]
     out["mouthRollLower"][role["ol"], 1] = bump[role["ol"]]
     brows = role["brow_l"] | role["brow_r"]

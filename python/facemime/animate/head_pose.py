@@ -69,6 +69,8 @@ class PoseFollower:
         # frame), not as the fit's (two passes averaged): the two differ by a constant offset
         key = follow_face(frame, landmarks)
         self._landmarks: np.ndarray | None = landmarks if key is None else key
+        self.key_landmarks = self._landmarks
+        self.landmarks: np.ndarray | None = None  # the last update's landmarks: None where it measured none
         self._model = model
         self._landmark_pose = LandmarkPose(self._landmarks, pose, model.vertices, model.triangles)
         self._fps = max(float(fps), 1.0)
@@ -144,7 +146,7 @@ class PoseFollower:
         Pose
             The frame's pose (also :attr:`pose`).
         """
-        measured = True
+        measured, self.landmarks = True, None
         if self._tracker.tracker is not self._follower:  # restarted on a face found anew: new rigid points
             t0 = time.perf_counter()
             self._follower = self._tracker.tracker
@@ -159,7 +161,7 @@ class PoseFollower:
             # points the flow follows, or moved by the head's step without them.
             found = None if self._landmarks is None else follow_face(frame, self._landmarks)
             if found is not None:
-                self._landmarks = found
+                self._landmarks = self.landmarks = found
                 self._flow.follow(self._smooth(self._landmark_pose.measure(found)), self._motion)
             else:
                 measured = self._flow.update(self._motion)

@@ -1,0 +1,274 @@
+"""The 52 ARKit blendshapes of a frame: what avatar software (VSeeFace, Warudo, three-vrm, Unity,
+Unreal) takes from a face tracker, by name.
+
+Every value is 0..1 and relative to the key frame the actor was fitted on (0: as there). Left and
+right are the subject's own, as ARKit's are. They come from three measures:
+
+- the **expression controls** (:mod:`facemime.animate.expressions`): the 27 mouth, jaw, brow and
+  lid controls under their own names; of two controls that move the same knots opposite ways
+  (``mouthLeft``/``mouthRight``, ``jawLeft``/``jawRight``) only their difference shows, so the
+  smaller is taken from both (:data:`OPPOSITES`);
+- the **irises** (:class:`facemime.types.look.Look`'s ``iris``, eye widths): ``eyeLook*``, the
+  shift along the eye over :data:`LOOK_SIDE`, down over :data:`LOOK_DOWN`, up over
+  :data:`LOOK_UP`; the subject's right eye is image-left, so its iris moving image-right looks in
+  (towards the nose), the left eye's looks out;
+- the **blinks**, not the lid closure as it is: ARKit's ``eyeBlink*`` means shut, and a lid that
+  follows the eye looking down closes part of the way (:func:`blinks`).
+
+The names in :data:`UNMEASURED` are not measured by the analysis: they are always 0. The
+contours show no depth (``jawForward``), cheeks, nose wings or tongue, and neither lid's
+narrowing from below (``eyeSquint``) nor widening (``eyeWide``: the eye tracker reads an eye at
+most 10% wider than on the key frame, within its noise on renders of the lids raised). Press,
+dimple and shrug move the lips as roll, stretch and the lower lip's raise do in a contour.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from facemime.animate.expressions import NAMES as CONTROLS
+from facemime.animate.expressions import Expressions
+from facemime.errors import InvalidInputError
+from facemime.types.head import HeadModel
+from facemime.types.look import Look
+
+#: ARKit's 52 blendshape names, in the order of Apple's ``ARFaceAnchor.BlendShapeLocation`` list
+#: (eyes, jaw, mouth, brows, cheeks, nose, tongue): the order of every value vector here.
+NAMES: tuple[str, ...] = (
+    "eyeBlinkLeft",
+    "eyeLookDownLeft",
+    "eyeLookInLeft",
+    "eyeLookOutLeft",
+    "eyeLookUpLeft",
+    "eyeSquintLeft",
+    "eyeWideLeft",
+    "eyeBlinkRight",
+    "eyeLookDownRight",
+    "eyeLookInRight",
+    "eyeLookOutRight",
+    "eyeLookUpRight",
+    "eyeSquintRight",
+    "eyeWideRight",
+    "jawForward",
+    "jawLeft",
+    "jawRight",
+    "jawOpen",
+    "mouthClose",
+    "mouthFunnel",
+    "mouthPucker",
+    "mouthLeft",
+    "mouthRight",
+    "mouthSmileLeft",
+    "mouthSmileRight",
+    "mouthFrownLeft",
+    "mouthFrownRight",
+    "mouthDimpleLeft",
+    "mouthDimpleRight",
+    "mouthStretchLeft",
+    "mouthStretchRight",
+    "mouthRollLower",
+    "mouthRollUpper",
+    "mouthShrugLower",
+    "mouthShrugUpper",
+    "mouthPressLeft",
+    "mouthPressRight",
+    "mouthLowerDownLeft",
+    "mouthLowerDownRight",
+    "mouthUpperUpLeft",
+    "mouthUpperUpRight",
+    "browDownLeft",
+    "browDownRight",
+    "browInnerUp",
+    "browOuterUpLeft",
+    "browOuterUpRight",
+    "cheekPuff",
+    "cheekSquintLeft",
+    "cheekSquintRight",
+    "noseSneerLeft",
+    "noseSneerRight",
+    "tongueOut",
+)
+#: The eyes' look directions: measured, with no morph target on facemime's head (its irises are
+#: painted in the texture).
+LOOKS: tuple[str, ...] = tuple(n for n in NAMES if n.startswith("eyeLook"))
+#: Not measured by the analysis: always 0.
+UNMEASURED: tuple[str, ...] = (
+    "eyeSquintLeft",
+    "eyeSquintRight",
+    "eyeWideLeft",
+    "eyeWideRight",
+    "jawForward",
+    "mouthDimpleLeft",
+    "mouthDimpleRight",
+    "mouthShrugLower",
+    "mouthShrugUpper",
+    "mouthPressLeft",
+    "mouthPressRight",
+    "cheekPuff",
+    "cheekSquintLeft",
+    "cheekSquintRight",
+    "noseSneerLeft",
+    "noseSneerRight",
+    "tongueOut",
+)
+# The iris shifts at a full look, eye widths: the 99th percentiles of the analysis's iris shift
+# over the ten shared videos (3,101 frames). Sideways the median of the videos' own (0.07-0.46;
+# lp_d3's shut eyes hold stray shifts); down and up over all frames pooled (0.22, 0.13).
+#: Iris shift along the eye at ``eyeLookIn``/``eyeLookOut`` = 1, eye widths.
+LOOK_SIDE = 0.30
+#: Iris shift down at ``eyeLookDown`` = 1, eye widths.
+LOOK_DOWN = 0.22
+#: Iris shift up at ``eyeLookUp`` = 1, eye widths.
+LOOK_UP = 0.13
+# Blinks, measured against the Face Mesh references' lid openings on the ten shared videos (shut:
+# under 0.35 of frame 0's opening, 405 eye-frames; open and looking down: over 0.6, the iris 0.04
+# eye widths down, 905): the eye tracker's closure alone reads a lid that follows the eye down as
+# closing, the landmark pass reads a shut lid half shut (its eyes' points are coarse) but is not
+# fooled by a look down. Averaged, the landmarks' scaled by 2.5, and ramped from 0.35 to 0.5:
+# > 0.5 on 88% of the shut eye-frames and < 0.2 on 87% of those looking down, the best of the
+# least of the two over scales 0-3 and ramps 0.2-0.4 to 0.5-0.8 (lp_d3: 240 of 244, 41 of 76;
+# the eye tracker's alone at its best ramp, 0.3-0.7: 231 of 244, 32 of 76).
+#: Closure (the two measures' mean) at which a blink starts (0) and is full (1).
+BLINK_FROM, BLINK_TO = 0.35, 0.5
+#: The landmark pass's closure is multiplied by this before it is averaged with the eye tracker's.
+LANDMARK_SCALE = 2.5
+#: Pairs of controls that move the same knots opposite ways.
+OPPOSITES = (("mouthLeft", "mouthRight"), ("jawLeft", "jawRight"))
+# Face Mesh points of each eye (subject's right first, as Look.closure): the corners, then the
+# upper and lower lids' middles.
+_EYE_POINTS = ((33, 133, 159, 145), (362, 263, 386, 374))
+
+
+def landmark_openings(landmarks: np.ndarray) -> np.ndarray:
+    """Each eye's opening in the Face Mesh landmarks.
+
+    Parameters
+    ----------
+    landmarks
+        (468, 2+) float array: the Face Mesh landmarks, (x, y) pixels first.
+
+    Returns
+    -------
+    (2,) float64 array
+        Per eye (the subject's right first), the distance between its lids' middles over its
+        width (corner to corner).
+    """
+    p = np.asarray(landmarks, np.float64)[:, :2]
+    ends = [(up, low, a, b) for a, b, up, low in _EYE_POINTS]
+    return np.array(
+        [np.linalg.norm(p[u] - p[d]) / max(float(np.linalg.norm(p[b] - p[a])), 1e-9) for u, d, a, b in ends]
+    )
+
+
+def blinks(closure: np.ndarray, landmark_closure: np.ndarray | None = None) -> np.ndarray:
+    """ARKit's ``eyeBlinkRight``/``eyeBlinkLeft`` of a frame's lid closures.
+
+    Parameters
+    ----------
+    closure
+        (2,) float array: the eye tracker's closures (:class:`~facemime.types.look.Look`'s; right
+        eye first).
+    landmark_closure
+        (2,) float array: 1 - the landmarks' :func:`landmark_openings` over the key frame's, or
+        None (or NaN per eye) where not measured: the eye tracker's alone then.
+
+    Returns
+    -------
+    (2,) float64 array
+        Right eye, left eye, 0..1: the closure ramped from :data:`BLINK_FROM` to
+        :data:`BLINK_TO` (averaged first with :data:`LANDMARK_SCALE` times the landmarks' closure
+        where it is measured).
+    """
+    c = np.asarray(closure, np.float64)
+    if landmark_closure is not None:
+        lm = np.asarray(landmark_closure, np.float64)
+        c = np.where(np.isfinite(lm), (c + LANDMARK_SCALE * lm) / 2.0, c)
+    return np.clip((c - BLINK_FROM) / (BLINK_TO - BLINK_FROM), 0.0, 1.0)
+
+
+def looks(iris: np.ndarray) -> dict[str, float]:
+    """The ``eyeLook*`` values of a frame's iris shifts.
+
+    Parameters
+    ----------
+    iris
+        (2, 2) float array: per eye (the subject's right first), the iris's (u, v) shift, eye
+        widths (u image-left to image-right along the eye, v down).
+
+    Returns
+    -------
+    dict of str to float
+        The eight :data:`LOOKS` names, 0..1.
+    """
+    i = np.asarray(iris, np.float64)
+    out = {}
+    for eye, side, inward in ((0, "Right", 1.0), (1, "Left", -1.0)):
+        u, v = i[eye]
+        out[f"eyeLookIn{side}"] = min(max(inward * u / LOOK_SIDE, 0.0), 1.0)
+        out[f"eyeLookOut{side}"] = min(max(-inward * u / LOOK_SIDE, 0.0), 1.0)
+        out[f"eyeLookDown{side}"] = min(max(v / LOOK_DOWN, 0.0), 1.0)
+        out[f"eyeLookUp{side}"] = min(max(-v / LOOK_UP, 0.0), 1.0)
+    return out
+
+
+def arkit_values(controls: np.ndarray, iris: np.ndarray, landmark_closure: np.ndarray | None = None) -> np.ndarray:
+    """A frame's 52 ARKit values.
+
+    Parameters
+    ----------
+    controls
+        (E,) float array: the frame's expression weights in the order of
+        :data:`facemime.animate.expressions.NAMES` (its blinks the eye tracker's closures).
+    iris
+        (2, 2) float array: the frame's iris shifts (:class:`~facemime.types.look.Look`'s).
+    landmark_closure
+        (2,) float array or None: the landmark pass's closures, as :func:`blinks` takes them.
+
+    Returns
+    -------
+    (52,) float64 array
+        0..1 in the order of :data:`NAMES`; :data:`UNMEASURED` are 0.
+    """
+    w = np.asarray(controls, np.float64)
+    if w.shape != (len(CONTROLS),):
+        raise InvalidInputError(f"expression weights must have shape ({len(CONTROLS)},), got {w.shape}")
+    named = dict(zip(CONTROLS, w.tolist()))
+    for a, b in OPPOSITES:
+        both = min(named[a], named[b])
+        named[a], named[b] = named[a] - both, named[b] - both
+    closure = np.array([named["eyeBlinkRight"], named["eyeBlinkLeft"]])
+    named["eyeBlinkRight"], named["eyeBlinkLeft"] = blinks(closure, landmark_closure).tolist()
+    named.update(looks(iris))
+    return np.array([named.get(n, 0.0) for n in NAMES])
+
+
+class ArkitSolver:
+    """The 52 ARKit values of an analysis's frames, one at a time.
+
+    Parameters
+    ----------
+    model
+        The analysed actor's head model (its expression controls are solved from its knots).
+    """
+
+    def __init__(self, model: HeadModel):
+        self._solver = Expressions.of(model).solver()
+
+    def step(self, offsets: np.ndarray, look: Look, landmark_closure: np.ndarray | None = None) -> np.ndarray:
+        """The next frame's values.
+
+        Parameters
+        ----------
+        offsets
+            (K, 2) float array: the frame's knot offsets, model units.
+        look
+            The frame's eyes.
+        landmark_closure
+            (2,) float array or None: the landmark pass's closures (:func:`blinks`).
+
+        Returns
+        -------
+        (52,) float64 array
+            0..1 in the order of :data:`NAMES`.
+        """
+        return arkit_values(self._solver.step(offsets, look.closure), look.iris, landmark_closure)
