@@ -31,6 +31,7 @@ _API = {
     "decode_stream": "facemime.app.coding",
     "export_track": "facemime.app.export",
     "run_batch": "facemime.app.batch",
+    "Live": "facemime.app.live",
     "run_demo": "facemime.app.demo",
     # frame by frame, in memory
     "read_photo": "facemime.io.photo",
@@ -46,6 +47,7 @@ _API = {
     "analysed": "facemime.animate.analysis",
     "Puppet": "facemime.animate.synth",
     "UserMotion": "facemime.animate.synth",
+    "ArkitSolver": "facemime.animate.arkit",
     "Pose": "facemime.types.pose",
     "Look": "facemime.types.look",
     "MotionEncoder": "facemime.codec.stream",

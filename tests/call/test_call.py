@@ -20,9 +20,10 @@ from websockets.sync.client import connect
 
 from cli.test_cli import run
 from facemime.app.call import Call
-from facemime.call.sender import FileSource, Sender, SenderStats
+from facemime.call.sender import Sender, SenderStats
 from facemime.call.server import MAX_MESSAGE
 from facemime.codec.decoder import MotionDecoder
+from facemime.io.live_source import FileSource
 
 HEADER, ACTOR, INTRA, INTER = 1, 2, 3, 4
 PAGE = b"<!doctype html><title>stand-in</title>"

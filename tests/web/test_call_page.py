@@ -11,10 +11,11 @@ import time
 
 import numpy as np
 
-from facemime.call.sender import FileSource, Sender
+from facemime.call.sender import Sender
 from facemime.call.server import Hub, make_server
 from facemime.codec.decoder import MotionDecoder
 from facemime.codec.params import pose_from_vector
+from facemime.io.live_source import FileSource
 from facemime.io.video import VideoReader
 
 INTRA, INTER = 3, 4  # packet kinds

@@ -11,9 +11,10 @@ import threading
 from pathlib import Path
 from typing import BinaryIO
 
-from facemime.call.sender import KEYFRAME, PACKET_FRAMES, RATE, WARMUP, Sender, open_source
+from facemime.call.sender import KEYFRAME, PACKET_FRAMES, RATE, WARMUP, Sender
 from facemime.call.server import GOING_AWAY, PORT, Hub, make_server
 from facemime.errors import InvalidInputError
+from facemime.io.live_source import open_source
 from facemime.io.outputs import OutputFileError, check_outputs, temporary_sibling
 from facemime.types.actor import Actor
 

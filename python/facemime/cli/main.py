@@ -11,7 +11,7 @@ import threading
 
 import click
 
-from facemime.cli import batch, coding, fitting, synthesis  # noqa: F401 (they add their commands)
+from facemime.cli import batch, coding, fitting, live, synthesis  # noqa: F401 (they add their commands)
 from facemime.cli.app import ExitStatus, cli
 from facemime.errors import FacemimeError
 
