@@ -9,6 +9,8 @@ relative to frame 0's) marks frames **shut** (under 0.35) and **open and looking
 - **blinks**: how many shut eye-frames have ``eyeBlink`` > 0.5 and how many looking-down ones
   < 0.2 (issue 66's target on lp_d3), and the median ``eyeBlink`` of each; the counts over all
   the videos last;
+- **jaw**: the largest ``jawOpen`` and its correlation with the reference's chin drop
+  (:func:`facemime.animate.arkit.chin_drop`) and with the gap between its inner lips' middles;
 - **look**: the correlation of ``eyeLookIn - eyeLookOut`` (per eye, signed towards image-right)
   and ``eyeLookDown - eyeLookUp`` with the reference iris's shift;
 - **speed**: ms a frame of the ARKit solve alone, one core.
@@ -32,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from facemime.animate.analysis import analysed
-from facemime.animate.arkit import NAMES, ArkitSolver
+from facemime.animate.arkit import NAMES, ArkitSolver, chin_drop
 from facemime.io.video import VideoReader
 from facemime.metrics import reference_eyes
 
@@ -54,7 +56,7 @@ def main() -> None:
             for _, analysis, motion in analysed(reader, name, fps=reader.fps):
                 solver = solver or ArkitSolver(analysis.actor.model)
                 t0 = time.perf_counter()
-                values.append(solver.step(motion.offsets, motion.look, motion.landmark_closure))
+                values.append(solver.step(motion.offsets, motion.look, motion.landmark_closure, motion.landmark_jaw))
                 seconds += time.perf_counter() - t0
         w = np.array(values)
         ref = np.load(args.data / "video" / f"{name}.landmarks.npz")
@@ -78,6 +80,15 @@ def main() -> None:
             updown = w[:, at[f"eyeLookDown{side}"]] - w[:, at[f"eyeLookUp{side}"]]
             look_u.append(np.corrcoef(across, u[:, eye])[0, 1] if across.std() > 0 else float("nan"))
             look_v.append(np.corrcoef(updown, v[:, eye])[0, 1] if updown.std() > 0 else float("nan"))
+        # the jaw: against the reference's chin drop and the opening between its inner lips
+        lm = ref["landmarks"][:n].astype(np.float64)
+        chin = np.array([chin_drop(f, lm[0]) for f in lm])
+        gap = np.linalg.norm(lm[:, 13, :2] - lm[:, 14, :2], axis=1) / np.linalg.norm(
+            lm[:, 33, :2] - lm[:, 263, :2], axis=1
+        )
+        jaw = w[:, at["jawOpen"]]
+        corr = lambda a, b: round(float(np.corrcoef(a, b)[0, 1]), 3) if a.std() > 0 and b.std() > 0 else None  # noqa: E731
+        row.update(jaw_max=round(float(jaw.max()), 3), jaw_chin_corr=corr(jaw, chin), jaw_gap_corr=corr(jaw, gap))
         med = lambda parts: round(float(np.median(np.concatenate(parts))), 3) if sum(map(len, parts)) else None  # noqa: E731
         row.update(
             shut=f"{shut_ok}/{shut_n}",

@@ -107,16 +107,22 @@ def _clip_values(path):
         solver, out = None, []
         for _, analysis, motion in analysed(reader, path.name, fps=reader.fps):
             solver = solver or ArkitSolver(analysis.actor.model)
-            out.append(solver.step(motion.offsets, motion.look, motion.landmark_closure))
+            out.append(solver.step(motion.offsets, motion.look, motion.landmark_closure, motion.landmark_jaw))
     return {n: np.array(out)[:, k] for k, n in enumerate(NAMES)}
 
 
-def test_blinks_are_told_apart_from_looking_down_on_a_real_clip(shared):
+@pytest.fixture(scope="module")
+def lp_d3(shared):
+    """lp_d3's values, and its reference landmarks."""
+    return _clip_values(shared / "video" / "lp_d3.mp4"), np.load(shared / "video" / "lp_d3.landmarks.npz")["landmarks"]
+
+
+def test_blinks_are_told_apart_from_looking_down_on_a_real_clip(lp_d3):
     """lp_d3 winks, shuts her eyes and looks down; the reference's lids mark the frames: shut
     (opening under 0.35 of frame 0's) and open, looking down (over 0.6, the iris 0.04 eye widths
     down)."""
-    v = _clip_values(shared / "video" / "lp_d3.mp4")
-    opening, iris = reference_eyes(np.load(shared / "video" / "lp_d3.landmarks.npz")["landmarks"])
+    v, landmarks = lp_d3
+    opening, iris = reference_eyes(landmarks)
     shut_values, down_values = [], []
     for eye, side in ((0, "Right"), (1, "Left")):
         blink = v[f"eyeBlink{side}"][: len(opening)]
@@ -128,6 +134,20 @@ def test_blinks_are_told_apart_from_looking_down_on_a_real_clip(shared):
     # (median 0.05)
     assert np.mean(shut > 0.5) > 0.9 and np.median(shut) > 0.9
     assert np.mean(down < 0.2) > 0.5 and np.median(down) < 0.15
+
+
+def test_the_jaw_opens_as_the_reference_mouth_does_on_a_real_clip(lp_d3):
+    """lp_d3 ends on a wide "O": jawOpen, from the landmarks' chin, follows the gap between the
+    reference's inner lips (the lips' solve alone put the opening in mouthLowerDown: jawOpen at
+    most 0.025, correlation -0.02)."""
+    v, landmarks = lp_d3
+    n = min(len(landmarks), len(v["jawOpen"]))
+    p = landmarks[:n, :, :2].astype(np.float64)
+    gap = np.linalg.norm(p[:, 13] - p[:, 14], axis=1) / np.linalg.norm(p[:, 33] - p[:, 263], axis=1)
+    jaw = v["jawOpen"][:n]
+    # measured: correlation 0.94, jawOpen up to 0.56
+    assert np.corrcoef(jaw, gap)[0, 1] > 0.85 and 0.3 < jaw.max() < 0.9
+    assert np.median(jaw[gap < np.percentile(gap, 20)]) < 0.1  # closed, no jaw
 
 
 def test_the_eyes_look_where_the_reference_looks_on_a_real_clip(shared):

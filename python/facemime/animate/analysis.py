@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from facemime.animate.arkit import landmark_openings
+from facemime.animate.arkit import chin_drop, landmark_openings
 from facemime.animate.deform import Deformer
 from facemime.animate.head_pose import PoseFollower
 from facemime.errors import NoFaceError
@@ -50,7 +50,9 @@ class FrameMotion:
     right on this frame; ``look``: the eyes (:class:`~facemime.types.look.Look`, relative to
     the first frame's); ``landmark_closure``: (2,) the lids' closures in the head pose's Face Mesh
     landmarks (1 - each eye's :func:`~facemime.animate.arkit.landmark_openings` over the first
-    frame's; the subject's right eye first), None where the landmark pass measured none.
+    frame's; the subject's right eye first), None where the landmark pass measured none;
+    ``landmark_jaw``: the chin's drop in those landmarks (:func:`~facemime.animate.arkit.chin_drop`,
+    mouth widths), None likewise.
     """
 
     contours: dict[str, np.ndarray]
@@ -62,6 +64,7 @@ class FrameMotion:
     redetected: bool = False
     look: Look = field(default_factory=Look)
     landmark_closure: np.ndarray | None = None
+    landmark_jaw: float | None = None
 
 
 @dataclass
@@ -160,12 +163,12 @@ class Analysis:
             looking = time.perf_counter() - t2
             self.timings.look += looking
             elsewhere += looking
-            landmarks = self.pose.landmarks
-            lids = (
-                None if landmarks is None else 1.0 - landmark_openings(landmarks) / np.maximum(self._key_openings, 1e-6)
-            )
+            landmarks, lids, jaw = self.pose.landmarks, None, None
+            if landmarks is not None:
+                lids = 1.0 - landmark_openings(landmarks) / np.maximum(self._key_openings, 1e-6)
+                jaw = chin_drop(landmarks, self.pose.key_landmarks)
             self.last = FrameMotion(
-                result.contours, result.confidence, result.lost, True, pose, offsets, result.redetected, look, lids
+                result.contours, result.confidence, result.lost, True, pose, offsets, result.redetected, look, lids, jaw
             )
         else:
             self.frames_without_face += 1

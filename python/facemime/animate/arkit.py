@@ -26,8 +26,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from facemime.animate.box_solver import BoxLeastSquares
+from facemime.animate.expressions import MAGNITUDES, Expressions
 from facemime.animate.expressions import NAMES as CONTROLS
-from facemime.animate.expressions import Expressions
 from facemime.errors import InvalidInputError
 from facemime.types.head import HeadModel
 from facemime.types.look import Look
@@ -134,6 +135,8 @@ BLINK_FROM, BLINK_TO = 0.35, 0.5
 LANDMARK_SCALE = 2.5
 #: Pairs of controls that move the same knots opposite ways.
 OPPOSITES = (("mouthLeft", "mouthRight"), ("jawLeft", "jawRight"))
+# Face Mesh points of the nose's bridge and the chin's tip.
+_BRIDGE, _CHIN = 168, 152
 # Face Mesh points of each eye (subject's right first, as Look.closure): the corners, then the
 # upper and lower lids' middles.
 _EYE_POINTS = ((33, 133, 159, 145), (362, 263, 386, 374))
@@ -158,6 +161,34 @@ def landmark_openings(landmarks: np.ndarray) -> np.ndarray:
     return np.array(
         [np.linalg.norm(p[u] - p[d]) / max(float(np.linalg.norm(p[b] - p[a])), 1e-9) for u, d, a, b in ends]
     )
+
+
+def chin_drop(landmarks: np.ndarray, key: np.ndarray) -> float:
+    """How far the chin has dropped from its place on the key frame, in the Face Mesh landmarks.
+
+    The distance from the nose's bridge to the chin, in 3-D (the landmarks' depth included, so a
+    nod does not shorten it) and over the eyes' outer corners' distance (so coming nearer does
+    not lengthen it), against the key frame's.
+
+    Parameters
+    ----------
+    landmarks
+        (468, 3) float array: the frame's Face Mesh landmarks, (x, y) pixels and depth.
+    key
+        (468, 3) float array: the key frame's.
+
+    Returns
+    -------
+    float
+        The drop in units of the key frame's mouth width (corner to corner); negative: raised.
+    """
+
+    def ratios(p: np.ndarray) -> tuple[float, float]:
+        iod = max(float(np.linalg.norm(p[263] - p[33])), 1e-9)
+        return float(np.linalg.norm(p[_CHIN] - p[_BRIDGE])) / iod, float(np.linalg.norm(p[291] - p[61])) / iod
+
+    now, (then, mouth) = ratios(np.asarray(landmarks, np.float64)), ratios(np.asarray(key, np.float64))
+    return (now[0] - then) / max(mouth, 1e-9)
 
 
 def blinks(closure: np.ndarray, landmark_closure: np.ndarray | None = None) -> np.ndarray:
@@ -245,6 +276,12 @@ def arkit_values(controls: np.ndarray, iris: np.ndarray, landmark_closure: np.nd
 class ArkitSolver:
     """The 52 ARKit values of an analysis's frames, one at a time.
 
+    Where the frame's landmarks measured the chin (:func:`chin_drop`), ``jawOpen`` is the chin's
+    drop over the control's magnitude, and the lower lip's motion that the solve had put in
+    ``jawOpen`` and ``mouthLowerDown*`` is solved again for the two ``mouthLowerDown*`` alone
+    once the jaw's share is taken out: the lips' contours alone cannot tell a jaw that opens from
+    a lower lip pulled down (their patterns are nearly one), the chin can.
+
     Parameters
     ----------
     model
@@ -252,9 +289,21 @@ class ArkitSolver:
     """
 
     def __init__(self, model: HeadModel):
-        self._solver = Expressions.of(model).solver()
+        expressions = Expressions.of(model)
+        self._solver = expressions.solver()
+        self._jaw = CONTROLS.index("jawOpen")
+        self._lower = [CONTROLS.index("mouthLowerDownLeft"), CONTROLS.index("mouthLowerDownRight")]
+        self._patterns = expressions.patterns[[self._jaw, *self._lower]].reshape(3, -1)  # (3, 2K)
+        lower = self._patterns[1:]
+        self._lower_gram = lower @ lower.T
 
-    def step(self, offsets: np.ndarray, look: Look, landmark_closure: np.ndarray | None = None) -> np.ndarray:
+    def step(
+        self,
+        offsets: np.ndarray,
+        look: Look,
+        landmark_closure: np.ndarray | None = None,
+        landmark_jaw: float | None = None,
+    ) -> np.ndarray:
         """The next frame's values.
 
         Parameters
@@ -265,10 +314,20 @@ class ArkitSolver:
             The frame's eyes.
         landmark_closure
             (2,) float array or None: the landmark pass's closures (:func:`blinks`).
+        landmark_jaw
+            The landmarks' :func:`chin_drop`, mouth widths, or None where not measured: the jaw
+            then as the lips' solve has it.
 
         Returns
         -------
         (52,) float64 array
             0..1 in the order of :data:`NAMES`.
         """
-        return arkit_values(self._solver.step(offsets, look.closure), look.iris, landmark_closure)
+        w = self._solver.step(offsets, look.closure)
+        if landmark_jaw is not None and np.isfinite(landmark_jaw):
+            jaw = min(max(landmark_jaw / MAGNITUDES["jawOpen"], 0.0), 1.0)
+            mouth = w[[self._jaw, *self._lower]] @ self._patterns  # the lower lip's motion in the three
+            rest = mouth - jaw * self._patterns[0]
+            w[self._jaw] = jaw
+            w[self._lower] = BoxLeastSquares(self._lower_gram, 0.0).step(self._patterns[1:] @ rest)
+        return arkit_values(w, look.iris, landmark_closure)

@@ -68,8 +68,8 @@ class PoseFollower:
         # the reference measured as every later frame's is (one pass on the crop the landmarks
         # frame), not as the fit's (two passes averaged): the two differ by a constant offset
         key = follow_face(frame, landmarks)
-        self._landmarks: np.ndarray | None = landmarks if key is None else key
-        self.key_landmarks = self._landmarks
+        self.key_landmarks: np.ndarray = landmarks if key is None else key
+        self._landmarks: np.ndarray | None = self.key_landmarks
         self.landmarks: np.ndarray | None = None  # the last update's landmarks: None where it measured none
         self._model = model
         self._landmark_pose = LandmarkPose(self._landmarks, pose, model.vertices, model.triangles)

@@ -140,7 +140,7 @@ class Live:
         return self.stats
 
     def _send(self, motion: FrameMotion) -> None:
-        values = self._solver.step(motion.offsets, motion.look, motion.landmark_closure)
+        values = self._solver.step(motion.offsets, motion.look, motion.landmark_closure, motion.landmark_jaw)
         datagram = frame_bundle(
             values,
             unity_quaternion(motion.pose),
