@@ -20,7 +20,6 @@ import cv2
 import numpy as np
 import pytest
 
-from facemime.animate.expressions import Expressions
 from facemime.animate.motion_file import read_motion
 from facemime.animate.synth import Puppet, synthesize
 from facemime.export import glb_bytes, load_performance
@@ -61,7 +60,7 @@ def facemime_frame(track, perf, n):
     _, block, frames = read_motion(track)
     puppet = Puppet(perf.actor, np.asarray(block["feature_sizes"]), block["iod"], None, mask_only=True)
     pose = puppet.pose(Pose(**frames[n]["pose"]))
-    vertices = Expressions.of(perf.actor.model).vertices(perf.weights[n])
+    vertices = perf.actor.model.vertices + np.tensordot(perf.weights[n], perf.fields, axes=1)  # the morph
     picture = synthesize(perf.actor, vertices, pose, perf.size)
     points = project(vertices, pose)[0]
     g = perf.actor.model.groups

@@ -133,13 +133,16 @@ def view(source: Path, actor_file: Path | None, port: int, no_browser: bool, mas
 @actor_option("NAME.actor to carry the performance (default: the generic head, as view plays a track file).")
 @out_option(
     "PERFORMANCE.glb to write: binary glTF 2.0, the textured head, its expression morph targets and "
-    "one animation (weights and head pose) at the track's frame rate."
+    "one animation (weights and head pose) at the track's frame rate; or AVATAR.vrm: the head as a "
+    "VRM 1.0 avatar (humanoid skeleton, an expression per ARKit name) for facemime live --vmc."
 )
 @force_option
 def export(track: Path, actor_file: Path | None, out_file: Path, force: bool) -> None:
     """Export the performance of TRACK.json (from facemime run) as a glTF 2.0 file for Blender,
     three.js, Unity or Unreal: the actor's textured mesh in metres, y up, its named expression
-    controls (ARKit names) as morph targets, and their weights and the head pose per frame."""
+    controls (ARKit names) as morph targets, and their weights and the head pose per frame. An
+    --out ending in .vrm writes the head as a VRM 1.0 avatar instead, for VSeeFace, Warudo or
+    three-vrm."""
     from facemime.app.export import export_track
 
     result = export_track(track, out_file, actor_file, force)

@@ -137,6 +137,26 @@ class Glb:
             entry["max"] = [cast(v) for v in flat.max(axis=0)]
         return self.add("accessors", entry)
 
+    def zeros(self, count: int, width: int) -> int:
+        """An accessor of float32 zeros that stores nothing (glTF reads an accessor without a buffer
+        view as zeros), with its ``min`` and ``max``.
+
+        Parameters
+        ----------
+        count
+            Its number of elements.
+        width
+            Components per element, 1-4.
+
+        Returns
+        -------
+        int
+            The accessor's index.
+        """
+        zero = [0.0] * width
+        entry = {"componentType": COMPONENTS[np.dtype("<f4")], "count": count, "type": TYPES[width]}
+        return self.add("accessors", {**entry, "min": zero, "max": zero})
+
     def bytes(self) -> bytes:
         """The ``.glb`` file of the document built so far.
 
@@ -210,13 +230,18 @@ def accessor_array(doc: dict[str, Any], blob: bytes, index: int) -> np.ndarray:
     Returns
     -------
     (count,) or (count, width) array
-        Read-only view of ``blob`` in the accessor's dtype (float32, uint32, uint16 or uint8);
-        (count,) for ``SCALAR`` accessors, else ``width`` = 2-4 components per row.
+        Read-only view of ``blob`` in the accessor's dtype (float32, uint32, uint16 or uint8), or
+        zeros for an accessor without a buffer view; (count,) for ``SCALAR`` accessors, else
+        ``width`` = 2-4 components per row.
     """
     acc = doc["accessors"][index]
-    view = doc["bufferViews"][acc["bufferView"]]
     dtype = next(d for d, c in COMPONENTS.items() if c == acc["componentType"])
     width = next(n for n, t in TYPES.items() if t == acc["type"])
+    if "bufferView" not in acc:  # zeros (Glb.zeros)
+        zero = np.zeros((acc["count"], width), dtype)
+        zero.flags.writeable = False
+        return zero[:, 0] if width == 1 else zero
+    view = doc["bufferViews"][acc["bufferView"]]
     start = view.get("byteOffset", 0) + acc.get("byteOffset", 0)
     a = np.frombuffer(blob, dtype, acc["count"] * width, start)
     return a if width == 1 else a.reshape(-1, width)

@@ -5,10 +5,17 @@ model's millimetres × 0.001; its axes are glTF's: x to the subject's left, y up
 viewer, the asset's front; triangles counter-clockwise seen from outside, glTF's front faces),
 its texture as an embedded PNG (texture coordinates from the image's top-left, as glTF's are;
 no flip), an unlit material (``KHR_materials_unlit``: the texture as it is, as facemime draws
-it), one morph target per expression control (the displacement at weight 1, in metres, named in
-``mesh.extras.targetNames``, which three.js and Blender read), and one animation with a key per
-track frame at ``index / fps`` seconds: the weights (``path: "weights"``) and the head's pose as
-the node's rotation, translation and scale (:mod:`facemime.export.animation`; linear).
+it), one morph target for each of ARKit's 52 blendshapes (:mod:`facemime.animate.arkit`; the
+displacement at weight 1, in metres, named in ``mesh.extras.targetNames``, which three.js and
+Blender read), and one animation with a key per track frame at ``index / fps`` seconds: the 52
+values (``path: "weights"``) and the head's pose as the node's rotation, translation and scale
+(:mod:`facemime.export.animation`; linear). The head shows the expression controls' 27 (their
+targets are the controls' fields); the eyes' look directions, animated as measured, and the
+names the analysis does not measure (always 0) have targets that move nothing (accessors of
+zeros, which store no bytes), so that the animation keeps every name for retargeting onto an
+avatar that has them. The blinks are ARKit's (:func:`facemime.animate.arkit.blinks`: shut at a
+closure of 0.5), not the lid closure facemime draws, and the jaw is the lips' solve's (the chin the
+live analysis measures is not in a track file).
 
 The pose's pixels are mapped relative to the first frame at the size the head is shown in
 facemime's own picture with ``--mask-only`` (the measured scale times the ratio of the eye
@@ -29,6 +36,8 @@ import cv2
 import numpy as np
 
 from facemime import __version__
+from facemime.animate.arkit import NAMES as ARKIT
+from facemime.animate.arkit import arkit_values
 from facemime.animate.motion_file import read_motion
 from facemime.animate.replay import track_settings
 from facemime.errors import InvalidInputError
@@ -54,13 +63,14 @@ class Performance:
     actor : Actor
         The head, its texture and model (vertices in model units, see :data:`METRES`).
     names : tuple of str
-        The expression controls (morph targets), E of them.
+        The morph targets' names, E of them (ARKit's 52).
     fields : (E, N, 3) float array
-        Each control's vertex displacement at weight 1, model units.
+        Each target's vertex displacement at weight 1, model units (zero for those the head
+        cannot show).
     times : (T,) float array
         Seconds of each frame (``index / fps``).
     weights : (T, E) float array
-        Each frame's control weights, 0..1.
+        Each frame's values, 0..1.
     poses : (T, 6) float array
         Each frame's pose as facemime shows it alone (:data:`POSE_KEYS`; degrees, pixels per model
         unit, pixels).
@@ -91,23 +101,26 @@ class Performance:
         return METRES[unit]
 
 
-def glb_bytes(perf: Performance) -> bytes:
-    """The ``.glb`` file of a performance (see the module docstring).
+def add_face(g: Glb, perf: Performance) -> int:
+    """Store the actor's textured mesh and its morph targets in a glTF document being built (the
+    module docstring describes them): positions and targets in metres, texture coordinates from
+    the image's top-left, the texture as an embedded PNG under an unlit material; the mesh's
+    ``weights`` are the first frame's. Adds ``KHR_materials_unlit`` to ``extensionsUsed``.
 
     Parameters
     ----------
+    g
+        The document being built.
     perf
-        The performance: the actor's mesh, texture and morph targets, and one animation key per
-        frame.
+        The performance: its actor's mesh and texture, its targets' names and fields.
 
     Returns
     -------
-    bytes
-        The binary glTF 2.0 file; positions and morph targets in metres, key times in seconds.
+    int
+        The mesh's index in ``g.doc["meshes"]``.
     """
     m = perf.metres_per_unit
     model = perf.actor.model
-    g = Glb(f"facemime {__version__}")
     n = len(model.vertices)
     index_type = np.uint16 if n < 65535 else np.uint32
     attributes = {
@@ -119,7 +132,12 @@ def glb_bytes(perf: Performance) -> bytes:
     mesh: dict[str, Any] = {"name": "face", "primitives": [primitive]}
     if perf.names:
         primitive["targets"] = [
-            {"POSITION": g.accessor((f * m).astype(np.float32), ARRAY_BUFFER, bounds=True)} for f in perf.fields
+            {
+                "POSITION": g.accessor((f * m).astype(np.float32), ARRAY_BUFFER, bounds=True)
+                if f.any()
+                else g.zeros(n, 3)
+            }
+            for f in perf.fields
         ]
         mesh["weights"] = [float(w) for w in perf.weights[0]]
         mesh["extras"] = {"targetNames": list(perf.names)}
@@ -138,8 +156,60 @@ def glb_bytes(perf: Performance) -> bytes:
         },
     )
     g.doc["extensionsUsed"] = ["KHR_materials_unlit"]
-    translation, rotation, scale = node_keys(perf.poses, m)
-    node = g.add("nodes", {"name": model.name, "mesh": g.add("meshes", mesh), "rotation": rotation[0].tolist()})
+    return g.add("meshes", mesh)
+
+
+def add_animation(g: Glb, perf: Performance, node: int) -> int:
+    """Store the performance as one linear animation of a node (the module docstring): a key per
+    frame at ``perf.times``, the node's translation, rotation and scale
+    (:func:`~facemime.export.animation.node_keys`) and, when the performance has targets, the
+    mesh's weights.
+
+    Parameters
+    ----------
+    g
+        The document being built.
+    perf
+        The performance.
+    node
+        The index of the node animated, the one holding the mesh of :func:`add_face`.
+
+    Returns
+    -------
+    int
+        The animation's index in ``g.doc["animations"]``.
+    """
+    translation, rotation, scale = node_keys(perf.poses, perf.metres_per_unit)
+    times = g.accessor(perf.times.astype(np.float32), bounds=True)
+    channels = [("translation", translation), ("rotation", rotation), ("scale", scale)]
+    if perf.names:
+        channels.append(("weights", perf.weights.reshape(-1)))
+    samplers, targets = [], []
+    for k, (path, values) in enumerate(channels):
+        samplers.append({"input": times, "output": g.accessor(values.astype(np.float32)), "interpolation": "LINEAR"})
+        targets.append({"sampler": k, "target": {"node": node, "path": path}})
+    return g.add("animations", {"name": "performance", "channels": targets, "samplers": samplers})
+
+
+def glb_bytes(perf: Performance) -> bytes:
+    """The ``.glb`` file of a performance (see the module docstring).
+
+    Parameters
+    ----------
+    perf
+        The performance: the actor's mesh, texture and morph targets, and one animation key per
+        frame.
+
+    Returns
+    -------
+    bytes
+        The binary glTF 2.0 file; positions and morph targets in metres, key times in seconds.
+    """
+    m = perf.metres_per_unit
+    g = Glb(f"facemime {__version__}")
+    mesh = add_face(g, perf)
+    rotation = node_keys(perf.poses[:1], m)[1]
+    node = g.add("nodes", {"name": perf.actor.model.name, "mesh": mesh, "rotation": rotation[0].tolist()})
     first = perf.poses[0]
     per_pixel = m / float(first[3])
     g.doc["scenes"] = [
@@ -158,15 +228,7 @@ def glb_bytes(perf: Performance) -> bytes:
         }
     ]
     g.doc["scene"] = 0
-    times = g.accessor(perf.times.astype(np.float32), bounds=True)
-    channels = [("translation", translation), ("rotation", rotation), ("scale", scale)]
-    if perf.names:
-        channels.append(("weights", perf.weights.reshape(-1)))
-    samplers, targets = [], []
-    for k, (path, values) in enumerate(channels):
-        samplers.append({"input": times, "output": g.accessor(values.astype(np.float32)), "interpolation": "LINEAR"})
-        targets.append({"sampler": k, "target": {"node": node, "path": path}})
-    g.add("animations", {"name": "performance", "channels": targets, "samplers": samplers})
+    add_animation(g, perf, node)
     return g.bytes()
 
 
@@ -209,8 +271,9 @@ def load_performance(track: str | Path, actor: Actor | None = None) -> Performan
     Returns
     -------
     Performance
-        The frames' ``weights`` when every frame has them, else solved from their knot offsets
-        and eye closure; key times ``index / fps`` seconds; each pose's scale multiplied by the
+        ARKit's 52 values of the frames' ``weights`` when every frame has them, else of the
+        controls solved from their knot offsets and eye closure (the look directions from their
+        irises); key times ``index / fps`` seconds; each pose's scale multiplied by the
         track's outer eye corner distance over the actor model's (both model units), the size the
         head is shown at alone.
     """
@@ -228,7 +291,6 @@ def load_performance(track: str | Path, actor: Actor | None = None) -> Performan
         ex = Expressions.of(model)
     except (KeyError, IndexError, ValueError) as e:  # a head without the generic head's groups
         raise InvalidInputError(f"actor {model.name!r} is not a facemime head with expression controls ({e})") from None
-    names = tuple(ex.names)
     knots = block.get("knots", ex.deformer.knots.tolist())
     if len(knots) != len(ex.deformer.knots) or not all(
         isinstance(k, int) and 0 <= k < len(model.vertices) for k in knots
@@ -237,13 +299,18 @@ def load_performance(track: str | Path, actor: Actor | None = None) -> Performan
             f"the track's motion has {len(knots)} knots of another head model than actor "
             f"{model.name!r} ({len(ex.deformer.knots)} knots, {len(model.vertices)} vertices)"
         )
-    weights = _file_weights(track, names)
-    if weights is None:  # solved as the actor would play the knots: offsets scaled per feature (Puppet)
+    controls = _file_weights(track, ex.names)
+    if controls is None:  # solved as the actor would play the knots: offsets scaled per feature (Puppet)
         ratio = (ex.deformer.feature_sizes() / sizes)[:, None]
         offsets = np.stack([f["offsets"] for f in frames]) * ratio
         closure = np.stack([f["look"].closure for f in frames])
-        weights = np.asarray(ex.solve(offsets, closure), np.float64)
+        controls = np.asarray(ex.solve(offsets, closure), np.float64)
+    weights = np.array([arkit_values(c, f["look"].iris) for c, f in zip(controls, frames)])
+    fields = np.zeros((len(ARKIT), *ex.fields.shape[1:]))
+    for k, name in enumerate(ARKIT):
+        if name in ex.names:
+            fields[k] = ex.fields[ex.names.index(name)]
     ratio = 1.0 if iod is None else iod / model_iod(model)
     poses = np.array([[f["pose"][k] for k in POSE_KEYS] for f in frames])
     poses[:, 3] *= ratio
-    return Performance(actor, names, np.asarray(ex.fields, np.float64), index / fps, weights, poses, size)
+    return Performance(actor, ARKIT, fields, index / fps, weights, poses, size)
