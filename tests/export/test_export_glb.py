@@ -115,6 +115,11 @@ def test_a_real_track_round_trips_on_a_fitted_actor(real_export):
     looks = [perf.names.index(n) for n in perf.names if n.startswith("eyeLook")]
     assert perf.weights[:, looks].max() > 0.05  # and the eyes look about, animated without a target
     assert not perf.weights[:, [perf.names.index(n) for n in UNMEASURED]].any()
+    # the values are those run wrote, live's own (the jaw from the chin), not the weights' remake
+    frames = json.loads(track.read_text())["frames"]
+    stored = np.array([[f["arkit"].get(n, 0.0) for n in ARKIT] for f in frames])
+    assert np.array_equal(perf.weights, stored)
+    assert all(set(f["arkit"]) <= set(ARKIT) and set(f["weights"]) <= set(ARKIT) for f in frames)
 
 
 def test_stored_weights_are_exported_as_they_are(tmp_path):
@@ -146,6 +151,9 @@ def test_bad_input_is_refused_in_one_line(generic_export, tmp_path, capsys):
     (tmp_path / "bad_weight.json").write_text(
         json.dumps({**doc, "frames": [{**f, "weights": {"jawOpen": 2.0}} for f in doc["frames"]]})
     )
+    (tmp_path / "bad_arkit.json").write_text(
+        json.dumps({**doc, "frames": [{**f, "arkit": {"tongueIn": 0.5}} for f in doc["frames"]]})
+    )
     (tmp_path / "bad.actor").write_bytes(b"PK\3\4 not an actor")
     cases = [
         ((str(track), "--out", str(out)), "already exists; use --force"),
@@ -155,6 +163,7 @@ def test_bad_input_is_refused_in_one_line(generic_export, tmp_path, capsys):
         ((str(tmp_path / "other_head.json"), "--out", str(tmp_path / "a.glb")), "another head model"),
         ((str(tmp_path / "bad_fps.json"), "--out", str(tmp_path / "a.glb")), "'fps' must be"),
         ((str(tmp_path / "bad_weight.json"), "--out", str(tmp_path / "a.glb")), "must be a number in [0, 1]"),
+        ((str(tmp_path / "bad_arkit.json"), "--out", str(tmp_path / "a.glb")), "'arkit' names 'tongueIn'"),
         (
             (str(track), "--actor", str(tmp_path / "bad.actor"), "--out", str(tmp_path / "a.glb")),
             "not a facemime actor",

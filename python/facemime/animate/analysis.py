@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from facemime.animate.arkit import chin_drop, landmark_openings
+from facemime.animate.arkit import jaw_opening, landmark_openings
 from facemime.animate.deform import Deformer
 from facemime.animate.head_pose import PoseFollower
 from facemime.errors import NoFaceError
@@ -51,8 +51,8 @@ class FrameMotion:
     the first frame's); ``landmark_closure``: (2,) the lids' closures in the head pose's Face Mesh
     landmarks (1 - each eye's :func:`~facemime.animate.arkit.landmark_openings` over the first
     frame's; the subject's right eye first), None where the landmark pass measured none;
-    ``landmark_jaw``: the chin's drop in those landmarks (:func:`~facemime.animate.arkit.chin_drop`,
-    mouth widths), None likewise.
+    ``landmark_jaw``: the jaw's opening in those landmarks
+    (:func:`~facemime.animate.arkit.jaw_opening`, mouth widths), None likewise.
     """
 
     contours: dict[str, np.ndarray]
@@ -166,7 +166,7 @@ class Analysis:
             landmarks, lids, jaw = self.pose.landmarks, None, None
             if landmarks is not None:
                 lids = 1.0 - landmark_openings(landmarks) / np.maximum(self._key_openings, 1e-6)
-                jaw = chin_drop(landmarks, self.pose.key_landmarks)
+                jaw = jaw_opening(landmarks, self.pose.key_landmarks)
             self.last = FrameMotion(
                 result.contours, result.confidence, result.lost, True, pose, offsets, result.redetected, look, lids, jaw
             )

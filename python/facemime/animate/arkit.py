@@ -135,8 +135,9 @@ BLINK_FROM, BLINK_TO = 0.35, 0.5
 LANDMARK_SCALE = 2.5
 #: Pairs of controls that move the same knots opposite ways.
 OPPOSITES = (("mouthLeft", "mouthRight"), ("jawLeft", "jawRight"))
-# Face Mesh points of the nose's bridge and the chin's tip.
+# Face Mesh points of the nose's bridge and the chin's tip, and of the inner lips' middles.
 _BRIDGE, _CHIN = 168, 152
+_LIPS = (13, 14)
 # Face Mesh points of each eye (subject's right first, as Look.closure): the corners, then the
 # upper and lower lids' middles.
 _EYE_POINTS = ((33, 133, 159, 145), (362, 263, 386, 374))
@@ -189,6 +190,28 @@ def chin_drop(landmarks: np.ndarray, key: np.ndarray) -> float:
 
     now, (then, mouth) = ratios(np.asarray(landmarks, np.float64)), ratios(np.asarray(key, np.float64))
     return (now[0] - then) / max(mouth, 1e-9)
+
+
+def jaw_opening(landmarks: np.ndarray, key: np.ndarray) -> float:
+    """How far the jaw is open from closed lips, in the Face Mesh landmarks: the chin's drop from
+    the key frame (:func:`chin_drop`) plus the gap the key frame had between the inner lips'
+    middles, so that a key frame with the mouth open does not make that opening the jaw's zero.
+
+    Parameters
+    ----------
+    landmarks
+        (468, 3) float array: the frame's Face Mesh landmarks, (x, y) pixels and depth.
+    key
+        (468, 3) float array: the key frame's.
+
+    Returns
+    -------
+    float
+        Mouth widths of the key frame.
+    """
+    k = np.asarray(key, np.float64)
+    gap = float(np.linalg.norm(k[_LIPS[0]] - k[_LIPS[1]])) / max(float(np.linalg.norm(k[291] - k[61])), 1e-9)
+    return chin_drop(landmarks, key) + gap
 
 
 def blinks(closure: np.ndarray, landmark_closure: np.ndarray | None = None) -> np.ndarray:
@@ -276,8 +299,8 @@ def arkit_values(controls: np.ndarray, iris: np.ndarray, landmark_closure: np.nd
 class ArkitSolver:
     """The 52 ARKit values of an analysis's frames, one at a time.
 
-    Where the frame's landmarks measured the chin (:func:`chin_drop`), ``jawOpen`` is the chin's
-    drop over the control's magnitude, and the lower lip's motion that the solve had put in
+    Where the frame's landmarks measured the chin (:func:`jaw_opening`), ``jawOpen`` is the jaw's
+    opening over the control's magnitude, and the lower lip's motion that the solve had put in
     ``jawOpen`` and ``mouthLowerDown*`` is solved again for the two ``mouthLowerDown*`` alone
     once the jaw's share is taken out: the lips' contours alone cannot tell a jaw that opens from
     a lower lip pulled down (their patterns are nearly one), the chin can.
@@ -296,6 +319,10 @@ class ArkitSolver:
         self._patterns = expressions.patterns[[self._jaw, *self._lower]].reshape(3, -1)  # (3, 2K)
         lower = self._patterns[1:]
         self._lower_gram = lower @ lower.T
+        #: The last frame's expression controls as the lips' solve has them (no jaw from the chin),
+        #: in the order of :data:`facemime.animate.expressions.NAMES`: what a track file's
+        #: ``weights`` hold.
+        self.controls = np.zeros(len(CONTROLS))
 
     def step(
         self,
@@ -315,7 +342,7 @@ class ArkitSolver:
         landmark_closure
             (2,) float array or None: the landmark pass's closures (:func:`blinks`).
         landmark_jaw
-            The landmarks' :func:`chin_drop`, mouth widths, or None where not measured: the jaw
+            The landmarks' :func:`jaw_opening`, mouth widths, or None where not measured: the jaw
             then as the lips' solve has it.
 
         Returns
@@ -324,6 +351,7 @@ class ArkitSolver:
             0..1 in the order of :data:`NAMES`.
         """
         w = self._solver.step(offsets, look.closure)
+        self.controls = w.copy()
         if landmark_jaw is not None and np.isfinite(landmark_jaw):
             jaw = min(max(landmark_jaw / MAGNITUDES["jawOpen"], 0.0), 1.0)
             mouth = w[[self._jaw, *self._lower]] @ self._patterns  # the lower lip's motion in the three

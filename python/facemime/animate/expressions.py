@@ -457,4 +457,22 @@ class FrameSolver:
         dict of str to float
             Name -> weight rounded to 4 decimals, the weights that round to 0 left out.
         """
-        return {n: round(float(x), 4) for n, x in zip(self.expressions.names, weights) if round(float(x), 4) != 0.0}
+        return named_weights(self.expressions.names, weights)
+
+
+def named_weights(names: tuple[str, ...], weights: np.ndarray) -> dict[str, float]:
+    """Weights as a track file's name -> weight object.
+
+    Parameters
+    ----------
+    names
+        The weights' names, in order.
+    weights
+        (E,) float array: the weights, 0..1.
+
+    Returns
+    -------
+    dict of str to float
+        Name -> weight rounded to 4 decimals, the weights that round to 0 left out.
+    """
+    return {n: round(float(x), 4) for n, x in zip(names, weights) if round(float(x), 4) != 0.0}

@@ -22,8 +22,11 @@ from pathlib import Path
 import numpy as np
 
 from facemime.animate.analysis import Analysis, analysed
+from facemime.animate.arkit import NAMES as ARKIT
+from facemime.animate.arkit import ArkitSolver
 from facemime.animate.departure import DEPARTS_AT, departure
-from facemime.animate.expressions import Expressions
+from facemime.animate.expressions import NAMES as CONTROLS
+from facemime.animate.expressions import named_weights
 from facemime.animate.synth import Puppet, UserMotion
 from facemime.errors import InputFileError, InvalidInputError
 from facemime.io.actor_file import load_actor
@@ -157,7 +160,7 @@ class SideBySide:
                 outline = actor.model.groups["face_outline"]
                 canvas = np.empty((h, 2 * w, 3), np.uint8)
                 synth = np.empty((h, w, 3), np.uint8)
-                solver = Expressions.of(actor.model).solver()
+                solver = ArkitSolver(actor.model)
             assert puppet is not None and synth is not None and canvas is not None  # made on the first frame
             t1 = time.perf_counter()
             if puppet.scene is None:
@@ -174,8 +177,10 @@ class SideBySide:
                 "offsets": motion.offsets,
                 "look": motion.look.as_dict(),
             }
-            self.weights.append(solver.step(motion.offsets, motion.look.closure))
-            record["weights"] = solver.named(self.weights[-1])
+            values = solver.step(motion.offsets, motion.look, motion.landmark_closure, motion.landmark_jaw)
+            self.weights.append(solver.controls)
+            record["weights"] = named_weights(CONTROLS, solver.controls)
+            record["arkit"] = named_weights(ARKIT, values)
             if compare and motion.face and puppet.shown is not None:  # shown: set by the render above
                 vertices, shown = puppet.shown
                 share = departure(frame, synth, project(vertices[outline], shown)[0])

@@ -13,9 +13,12 @@ values (``path: "weights"``) and the head's pose as the node's rotation, transla
 targets are the controls' fields); the eyes' look directions, animated as measured, and the
 names the analysis does not measure (always 0) have targets that move nothing (accessors of
 zeros, which store no bytes), so that the animation keeps every name for retargeting onto an
-avatar that has them. The blinks are ARKit's (:func:`facemime.animate.arkit.blinks`: shut at a
-closure of 0.5), not the lid closure facemime draws, and the jaw is the lips' solve's (the chin the
-live analysis measures is not in a track file).
+avatar that has them. The values are the track's ``arkit`` (written by ``facemime run``: what
+``facemime live`` sends, the jaw from the chin and the blinks from both eye measures,
+:class:`facemime.animate.arkit.ArkitSolver`); a track without them (written by hand, or before
+them) has them made from its ``weights`` or offsets and look (:func:`facemime.animate.arkit.arkit_values`:
+the jaw as the lips' solve has it). The blinks are ARKit's (shut at a closure of 0.5), not the lid
+closure facemime draws.
 
 The pose's pixels are mapped relative to the first frame at the size the head is shown in
 facemime's own picture with ``--mask-only`` (the measured scale times the ratio of the eye
@@ -232,25 +235,23 @@ def glb_bytes(perf: Performance) -> bytes:
     return g.bytes()
 
 
-def _file_weights(path: Path, names: tuple[str, ...]) -> np.ndarray | None:
-    """(T, E) weights stored in the track's frames (``weights``: name -> value), in the order of
+def _file_weights(path: Path, names: tuple[str, ...], key: str = "weights") -> np.ndarray | None:
+    """(T, E) weights stored in the track's frames (``key``: name -> value), in the order of
     ``names``, a missing name 0; None when a frame has none."""
     frames = load_document(path, "track", TRACK_FORMAT)["frames"]
-    if not all(isinstance(f, dict) and "weights" in f for f in frames):
+    if not all(isinstance(f, dict) and key in f for f in frames):
         return None
     out = np.zeros((len(frames), len(names)))
     slot = {n: k for k, n in enumerate(names)}
     for t, f in enumerate(frames):
-        w = f["weights"]
+        w = f[key]
         if not isinstance(w, dict):
-            raise ContourFileError(f"{path}: frame entry {t} has malformed 'weights'")
+            raise ContourFileError(f"{path}: frame entry {t} has malformed {key!r}")
         for name, value in w.items():
             if name not in slot:
-                raise ContourFileError(
-                    f"{path}: frame entry {t} weighs {name!r}, not a control of this actor ({', '.join(names)})"
-                )
+                raise ContourFileError(f"{path}: frame entry {t} {key!r} names {name!r}, not one of {', '.join(names)}")
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 1.0:
-                raise ContourFileError(f"{path}: frame entry {t} weight {name!r} must be a number in [0, 1]")
+                raise ContourFileError(f"{path}: frame entry {t} {key!r} value {name!r} must be a number in [0, 1]")
             out[t, slot[name]] = value
     return out
 
@@ -271,11 +272,11 @@ def load_performance(track: str | Path, actor: Actor | None = None) -> Performan
     Returns
     -------
     Performance
-        ARKit's 52 values of the frames' ``weights`` when every frame has them, else of the
-        controls solved from their knot offsets and eye closure (the look directions from their
-        irises); key times ``index / fps`` seconds; each pose's scale multiplied by the
-        track's outer eye corner distance over the actor model's (both model units), the size the
-        head is shown at alone.
+        The frames' ``arkit`` values when every frame has them, else ARKit's 52 of their
+        ``weights`` when every frame has them, else of the controls solved from their knot
+        offsets and eye closure (the look directions from their irises); key times
+        ``index / fps`` seconds; each pose's scale multiplied by the track's outer eye corner
+        distance over the actor model's (both model units), the size the head is shown at alone.
     """
     from facemime.animate.expressions import Expressions
 
@@ -299,13 +300,15 @@ def load_performance(track: str | Path, actor: Actor | None = None) -> Performan
             f"the track's motion has {len(knots)} knots of another head model than actor "
             f"{model.name!r} ({len(ex.deformer.knots)} knots, {len(model.vertices)} vertices)"
         )
-    controls = _file_weights(track, ex.names)
-    if controls is None:  # solved as the actor would play the knots: offsets scaled per feature (Puppet)
-        ratio = (ex.deformer.feature_sizes() / sizes)[:, None]
-        offsets = np.stack([f["offsets"] for f in frames]) * ratio
-        closure = np.stack([f["look"].closure for f in frames])
-        controls = np.asarray(ex.solve(offsets, closure), np.float64)
-    weights = np.array([arkit_values(c, f["look"].iris) for c, f in zip(controls, frames)])
+    weights = _file_weights(track, ARKIT, "arkit")  # as run measured them, live's own
+    if weights is None:
+        controls = _file_weights(track, ex.names)
+        if controls is None:  # solved as the actor would play the knots: offsets scaled per feature (Puppet)
+            ratio = (ex.deformer.feature_sizes() / sizes)[:, None]
+            offsets = np.stack([f["offsets"] for f in frames]) * ratio
+            closure = np.stack([f["look"].closure for f in frames])
+            controls = np.asarray(ex.solve(offsets, closure), np.float64)
+        weights = np.array([arkit_values(c, f["look"].iris) for c, f in zip(controls, frames)])
     fields = np.zeros((len(ARKIT), *ex.fields.shape[1:]))
     for k, name in enumerate(ARKIT):
         if name in ex.names:

@@ -22,6 +22,9 @@ extends ``facemime.track/1`` compatibly with per-frame keys:
   what they do in :mod:`facemime.animate.expressions`), solved from the offsets and the look. A
   frame with ``weights`` and no ``offsets`` is played from its weights (a performance written by
   hand); the file then needs no ``model`` block (the generic head's knots are assumed);
+- ``arkit`` (``facemime run``): ARKit's 52 blendshapes as ``facemime live`` sends them, name ->
+  0..1 (the non-zero ones, 4 decimals; :mod:`facemime.animate.arkit`): what ``facemime export``
+  animates;
 
 and a top-level ``model``: ``unit`` (of the offsets and of the model), ``knots`` (the K model
 vertex indices the offsets belong to), ``feature_sizes`` (K widths of each knot's feature,
@@ -207,7 +210,7 @@ def track_document(
         (x, y) pixels) and optionally ``confidence`` (feature -> 0..1), ``lost`` (list of
         features), ``redetected`` (bool: the face landmark model put the contours right on this
         frame), ``face`` (bool), ``pose`` (key -> value, degrees and pixels), ``offsets`` ((K, 2)
-        model units), ``look``, ``weights`` and ``scene_departure`` with ``scene_departs``.
+        model units), ``look``, ``weights``, ``arkit`` and ``scene_departure`` with ``scene_departs``.
     timing
         The top-level ``timing`` entry (``processing_seconds``, ``frames_processed``); None leaves
         it out.
@@ -252,7 +255,7 @@ def track_entry(f: Mapping[str, Any]) -> dict[str, Any]:
     -------
     dict
         The JSON-ready entry: coordinates and offsets to 0.001, confidences, pose values, look,
-        weights and scene departure to 4 decimals.
+        weights, ARKit values and scene departure to 4 decimals.
     """
     entry: dict[str, Any] = {
         "index": int(f["index"]),
@@ -272,8 +275,9 @@ def track_entry(f: Mapping[str, Any]) -> dict[str, Any]:
         entry["offsets"] = np.round(np.asarray(f["offsets"], float), 3).tolist()
     if "look" in f:
         entry["look"] = {k: round(float(v), 4) for k, v in f["look"].items()}
-    if "weights" in f:
-        entry["weights"] = {k: round(float(v), 4) for k, v in f["weights"].items()}
+    for key in ("weights", "arkit"):
+        if key in f:
+            entry[key] = {k: round(float(v), 4) for k, v in f[key].items()}
     if "scene_departure" in f:
         entry["scene_departure"] = round(float(f["scene_departure"]), 4)
         entry["scene_departs"] = bool(f["scene_departs"])
