@@ -151,6 +151,12 @@ def test_bad_input_is_refused_in_one_line(generic_export, tmp_path, capsys):
     (tmp_path / "bad_weight.json").write_text(
         json.dumps({**doc, "frames": [{**f, "weights": {"jawOpen": 2.0}} for f in doc["frames"]]})
     )
+    (tmp_path / "bool_pose.json").write_text(
+        json.dumps({**doc, "frames": [{**f, "pose": {**f["pose"], "yaw": True}} for f in doc["frames"]]})
+    )
+    (tmp_path / "late.json").write_text(
+        json.dumps({**doc, "frames": [{**f, "index": f["index"] + 10**9} for f in doc["frames"]]})
+    )
     (tmp_path / "bad_arkit.json").write_text(
         json.dumps({**doc, "frames": [{**f, "arkit": {"tongueIn": 0.5}} for f in doc["frames"]]})
     )
@@ -164,6 +170,8 @@ def test_bad_input_is_refused_in_one_line(generic_export, tmp_path, capsys):
         ((str(tmp_path / "bad_fps.json"), "--out", str(tmp_path / "a.glb")), "'fps' must be"),
         ((str(tmp_path / "bad_weight.json"), "--out", str(tmp_path / "a.glb")), "must be a number in [0, 1]"),
         ((str(tmp_path / "bad_arkit.json"), "--out", str(tmp_path / "a.glb")), "'arkit' names 'tongueIn'"),
+        ((str(tmp_path / "bool_pose.json"), "--out", str(tmp_path / "a.glb")), "needs a 'pose' with yaw"),
+        ((str(tmp_path / "late.json"), "--out", str(tmp_path / "a.glb")), "too late for glTF's times"),
         (
             (str(track), "--actor", str(tmp_path / "bad.actor"), "--out", str(tmp_path / "a.glb")),
             "not a facemime actor",

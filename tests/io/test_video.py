@@ -93,6 +93,18 @@ def test_existing_outputs_are_not_overwritten_without_force(tmp_path):
     assert (tmp_path / "a.png").read_bytes() == b"mine"
 
 
+def test_long_output_names_are_written_and_too_long_ones_refused_in_one_line(tmp_path):
+    from facemime.io.outputs import NAME_MAX, Outputs
+
+    longest = tmp_path / ("b" * (NAME_MAX - 4) + ".vrm")  # a legal name: its temporary one is cut to fit
+    with Outputs([longest], force=False) as out:
+        out.stage(longest).write_bytes(b"avatar")
+    assert longest.read_bytes() == b"avatar" and [p.name for p in tmp_path.iterdir()] == [longest.name]
+    with pytest.raises(InvalidInputError, match=f"its name is over {NAME_MAX} bytes long") as e:
+        check_outputs([tmp_path / ("a" * 300 + ".vrm")], force=False)
+    assert "\n" not in str(e.value)
+
+
 def _decoders() -> list[str]:
     return [t.name for t in threading.enumerate() if t.name.startswith("decoder ")]
 

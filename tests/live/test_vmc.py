@@ -87,7 +87,17 @@ def test_addresses_are_checked_and_resolved():
     assert parse_address("127.0.0.1:39539") == ("127.0.0.1", 39539)
     assert parse_address("[::1]:9000") == ("::1", 9000)
     assert parse_address("localhost:9000")[1] == 9000
-    for bad in ("39539", "127.0.0.1", ":39539", "127.0.0.1:0", "127.0.0.1:70000", "127.0.0.1:port", "host.invalid:9"):
+    bad_ports = ("127.0.0.1:²", "127.0.0.1:" + "9" * 5000, "127.0.0.1:" + "\u0663" * 3)  # not ASCII digits, too many
+    for bad in (
+        "39539",
+        "127.0.0.1",
+        ":39539",
+        "127.0.0.1:0",
+        "127.0.0.1:70000",
+        "127.0.0.1:port",
+        "host.invalid:9",
+        *bad_ports,
+    ):
         with pytest.raises(InvalidInputError) as e:
             parse_address(bad)
         assert "\n" not in str(e.value) and ("HOST:PORT" in str(e.value) or "cannot be found" in str(e.value))

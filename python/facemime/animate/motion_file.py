@@ -140,6 +140,8 @@ def read_motion(path: str | Path) -> tuple[dict[str, Any], dict[str, Any], list[
             except (TypeError, ValueError) as e:
                 raise ContourFileError(f"{where}: frame entry {n}: {e}") from None
         try:
+            if any(isinstance(pose[key], bool) for key in POSE_KEYS):  # JSON's true is not a number here
+                raise TypeError
             values = {key: float(pose[key]) for key in POSE_KEYS}
             arr = np.asarray(offsets, dtype=np.float64)
         except (TypeError, KeyError, ValueError, OverflowError):

@@ -47,7 +47,7 @@ def live(source: str, vmc: str, loop: bool) -> None:
     with Live(source, vmc, loop) as session:
         click.echo(
             f"sending {session.source.name} ({session.source.size[0]}x{session.source.size[1]}, "
-            f"{session.source.fps:g} frames/s) to {session.sender.host}:{session.sender.port} over VMC; Ctrl-C stops",
+            f"{session.source.fps:g} frames/s) to {session.sender.address} over VMC; Ctrl-C stops",
             err=True,
         )
         try:

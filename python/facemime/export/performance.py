@@ -286,6 +286,10 @@ def load_performance(track: str | Path, actor: Actor | None = None) -> Performan
     index = np.array([f["index"] for f in frames])
     if index.dtype.kind != "i" or (len(index) > 1 and (np.diff(index) <= 0).any()) or index[0] < 0:
         raise ContourFileError(f"{track}: frame indices must be whole numbers, increasing")
+    if len(index) > 1 and (np.diff((index / fps).astype(np.float32)) <= 0).any():  # glTF's key times
+        raise ContourFileError(
+            f"{track}: frame indices up to {index[-1]} at {fps:g} frames/s are too late for glTF's times"
+        )
     actor = actor or generic_actor(size)
     model = actor.model
     try:

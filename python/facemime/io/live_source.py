@@ -17,6 +17,8 @@ from facemime.io.video import VideoReader
 
 #: Frame rate assumed for a camera that does not tell its own, frames/s.
 CAMERA_FPS = 30.0
+#: The largest camera number (OpenCV's device index) tried.
+MAX_CAMERA = 9999
 
 
 class FileSource:
@@ -100,6 +102,8 @@ class CameraSource:
         level = cv2.utils.logging.getLogLevel()
         cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_SILENT)  # no lines of OpenCV's on a failure
         try:
+            if not 0 <= index <= MAX_CAMERA:
+                raise InputFileError(f"camera {index} cannot be opened (camera numbers are 0-{MAX_CAMERA})")
             self._cap = cv2.VideoCapture(index)
             ok, frame = self._cap.read() if self._cap.isOpened() else (False, None)
         finally:
@@ -155,6 +159,6 @@ def open_source(source: str, loop: bool = False) -> FileSource | CameraSource:
     FileSource or CameraSource
         The source, open.
     """
-    if source.isdigit() and not Path(source).exists():
+    if source.isascii() and source.isdigit() and not Path(source).exists():
         return CameraSource(int(source))
     return FileSource(source, loop)

@@ -41,6 +41,10 @@ def check_image_suffix(path: str | Path) -> None:
         raise InvalidInputError(f"cannot write image {path}: its name must end in one of {', '.join(IMAGE_SUFFIXES)}")
 
 
+#: The longest file name (bytes) outputs may have: the common file systems' limit.
+NAME_MAX = 255
+
+
 def _same(a: Path, b: Path) -> bool:
     """Whether two paths name one file: the same real path (symbolic links followed), or, both
     existing, the same file on disk (hard links)."""
@@ -76,6 +80,9 @@ def check_outputs(paths: Iterable[str | Path], force: bool, inputs: Iterable[str
         for q in files[i + 1 :]:
             if _same(p, q):
                 raise InvalidInputError(f"two outputs are one file: {p} and {q}")
+    for p in files:
+        if len(p.name.encode()) > NAME_MAX:
+            raise InvalidInputError(f"cannot write {p}: its name is over {NAME_MAX} bytes long")
     existing = [str(p) for p in files if p.exists()]
     if existing and not force:
         raise OutputExistsError(
@@ -103,12 +110,15 @@ def temporary_sibling(path: Path) -> Path:
     Returns
     -------
     Path
-        The temporary file, ``.<stem>.<random>.part<suffix>`` in ``path``'s folder, created empty
-        with the usual mode (0666 less the umask).
+        The temporary file, ``.<stem>.<random>.part<suffix>`` in ``path``'s folder (the stem cut
+        to keep the name within :data:`NAME_MAX` bytes), created empty with the usual mode (0666
+        less the umask).
     """
+    room = NAME_MAX - len(f"..{'x' * 8}.part{path.suffix}".encode())  # mkstemp adds 8 characters
+    stem = path.stem.encode()[: max(room, 1)].decode(errors="ignore")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".part{path.suffix}", dir=path.parent)
+        fd, tmp = tempfile.mkstemp(prefix=f".{stem}.", suffix=f".part{path.suffix}", dir=path.parent)
     except OSError as e:
         raise OutputFileError(f"cannot write {path}: {e.strerror or e}") from None
     os.close(fd)

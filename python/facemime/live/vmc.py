@@ -64,7 +64,8 @@ def parse_address(text: str) -> tuple[str, int]:
     host, sep, port_text = text.rpartition(":")
     if host.startswith("[") and host.endswith("]"):
         host = host[1:-1]
-    if not sep or not host or not port_text.isdigit() or not 1 <= int(port_text) <= 65535:
+    digits = port_text.isascii() and port_text.isdigit() and len(port_text) <= 5
+    if not sep or not host or not digits or not 1 <= int(port_text) <= 65535:
         raise InvalidInputError(f"the VMC address must be HOST:PORT with a port 1-65535, got {text!r}")
     port = int(port_text)
     try:
@@ -178,6 +179,11 @@ class VmcSender:
         if family == socket.AF_INET:  # a broadcast address reaches every receiver of the network
             self._socket.setsockopt(socket.SOL_SOCKET, socket.SO_BROADCAST, 1)
 
+    @property
+    def address(self) -> str:
+        """The receiver as ``HOST:PORT`` (an IPv6 host in brackets)."""
+        return f"[{self.host}]:{self.port}" if ":" in self.host else f"{self.host}:{self.port}"
+
     def send(self, datagram: bytes) -> None:
         """Send one datagram (a receiver not listening loses it: UDP says nothing).
 
@@ -189,9 +195,7 @@ class VmcSender:
         try:
             self._socket.sendto(datagram, (self.host, self.port))
         except OSError as e:  # e.g. no route to the host
-            raise InvalidInputError(
-                f"cannot send to the VMC receiver {self.host}:{self.port}: {e.strerror or e}"
-            ) from None
+            raise InvalidInputError(f"cannot send to the VMC receiver {self.address}: {e.strerror or e}") from None
 
     def close(self) -> None:
         self._socket.close()
