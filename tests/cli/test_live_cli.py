@@ -108,6 +108,18 @@ def test_bad_input_gives_one_line(shared, tmp_path, capsys, monkeypatch, args, m
     assert message in err
 
 
+def test_a_live_run_stops_within_a_frame_when_asked_from_another_thread(shared, receiver):
+    from facemime.app.live import Live
+
+    with Live(str(shared / "video" / "lp_d0.mp4"), f"127.0.0.1:{receiver.port}", loop=True) as live:
+        threading.Timer(1.0, live.stop).start()
+        t0 = time.monotonic()
+        stats = live.run()
+        assert time.monotonic() - t0 < 1.5  # the pace is 25 frames/s: stopped within a frame or two
+    assert 10 < stats.frames < 40 and stats.face_frames == stats.frames
+    assert 20 < stats.fps < 30 and 0 < stats.latency(50) < 100
+
+
 @pytest.mark.parametrize("presses", [1, 2])
 def test_live_stops_cleanly_on_ctrl_c(shared, receiver, presses):
     """Ctrl-C stops it in one line; pressed again while it stops (here at once), it exits at once,

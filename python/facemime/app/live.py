@@ -65,7 +65,7 @@ class LiveStats:
 class Live:
     """A live run: the VMC address checked and the source opened, and the first frame analysed
     (the actor fitted on it: a source without a face fails here, in one line); :meth:`run` sends
-    until the source ends or ``stop`` is set.
+    until the source ends or :meth:`stop` is called.
 
     Parameters
     ----------
