@@ -18,6 +18,7 @@ from facemime.export import load_performance
 from facemime.export.animation import node_keys
 from facemime.fit.actor import generic_actor
 from facemime.io.actor_file import load_actor
+from facemime.types.head import lip_strip
 from facemime.types.pose import rotation_matrix
 
 from .conftest import write_track
@@ -64,6 +65,17 @@ def check_round_trip(glb, track, actor):
     assert positions.shape == model.vertices.shape
     assert np.allclose(positions, model.vertices * 0.001, atol=1e-7)  # mm -> m
     assert np.allclose(accessor(gltf, blob, prim.attributes.TEXCOORD_0), model.uv, atol=1e-7)  # no v flip
+    # the mouth's opening, closed by a dark strip between the inner lips moving with the face
+    mouth = gltf.meshes[0].primitives[1]
+    assert gltf.materials[mouth.material].name == "mouth" and gltf.materials[mouth.material].doubleSided
+    assert mouth.attributes.POSITION == prim.attributes.POSITION and mouth.targets == prim.targets
+    strip = np.frombuffer(
+        blob,
+        np.uint16,
+        gltf.accessors[mouth.indices].count,
+        gltf.bufferViews[gltf.accessors[mouth.indices].bufferView].byteOffset,
+    ).reshape(-1, 3)
+    assert np.array_equal(strip, lip_strip(model))
     # ARKit's 52 names; the head's own controls move as facemime draws them, the rest are empty
     assert gltf.meshes[0].extras["targetNames"] == list(ARKIT) == list(perf.names)
     assert len(prim.targets) == len(ARKIT)

@@ -7,7 +7,7 @@ of the morphed vertices, in the pose :meth:`Puppet.pose` shows the measured one 
 
 The face region is where facemime's mesh covers the picture, less 2 pixels at its rim (the two
 rasterisers differ on edge pixels) and less the mouth's opening (facemime paints a cavity and
-teeth behind the lips; the file has no mouth interior). Measured (Chromium 14x, SwiftShader,
+teeth behind the lips; the file closes it with a dark strip). Measured (Chromium 14x, SwiftShader,
 three.js 0.187): 54.9-56.0 dB on the generic head (painted texture), 52.7-56.7 dB on the actor
 fitted on lp_d0 with a real track; a frame's picture against another frame's render scores
 below 30 dB, a texture flipped upside down below 25 dB.

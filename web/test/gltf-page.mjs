@@ -33,7 +33,7 @@ window.renderGlb = async (base64, time, background) => {
   renderer.setClearColor(new THREE.Color().setRGB(r / 255, g / 255, b / 255, THREE.SRGBColorSpace), 1);
   renderer.render(gltf.scene, camera);
   let mesh = null;
-  gltf.scene.traverse((o) => { if (o.isMesh) mesh = o; });
+  gltf.scene.traverse((o) => { if (o.isMesh && o.material.name === "face") mesh = o; });  // not the mouth's strip
   const names = Object.keys(mesh.morphTargetDictionary ?? {}).sort(
     (a, b2) => mesh.morphTargetDictionary[a] - mesh.morphTargetDictionary[b2]);
   const png = renderer.domElement.toDataURL("image/png");

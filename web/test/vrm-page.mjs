@@ -29,7 +29,7 @@ window.loadVrm = async (base64, { width, height, margin, background }) => {
   vrm = gltf.userData.vrm;
   if (!vrm) throw new Error("three-vrm found no VRM in the file");
   face = null;
-  vrm.scene.traverse((o) => { if (o.isMesh) face = o; });
+  vrm.scene.traverse((o) => { if (o.isMesh && o.material.name === "face") face = o; });  // not the mouth's strip
   vrm.scene.updateMatrixWorld(true);
   const box = new THREE.Box3().setFromPoints(window.faceVertices().map((p) => new THREE.Vector3(...p)));
   const size = box.getSize(new THREE.Vector3());

@@ -24,9 +24,9 @@ The pose's pixels are mapped relative to the first frame at the size the head is
 facemime's own picture with ``--mask-only`` (the measured scale times the ratio of the eye
 distances, :class:`facemime.animate.synth.Puppet`); ``scenes[0].extras.facemime`` records the
 video's ``size`` (pixels), ``metres_per_pixel`` and ``origin`` (the pixel on the world origin),
-what an orthographic camera needs to see each frame as facemime draws it. The mouth's interior
-(the cavity and teeth facemime paints behind the lips) and the irises (repainted in the texture)
-are not in the file.
+what an orthographic camera needs to see each frame as facemime draws it. The mouth's opening is
+closed by a strip in the cavity's colour, not the teeth facemime paints behind the lips, and the
+irises' motion (repainted in the texture) is not in the file.
 """
 
 from __future__ import annotations
@@ -48,8 +48,9 @@ from facemime.export.animation import POSE_KEYS, node_keys
 from facemime.export.gltf import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, Glb
 from facemime.fit.actor import generic_actor
 from facemime.io.contours_json import TRACK_FORMAT, ContourFileError, load_document
+from facemime.shared_constants import CAVITY
 from facemime.types.actor import Actor
-from facemime.types.head import model_iod
+from facemime.types.head import lip_strip, model_iod
 
 #: Metres per model unit, by the model's ``unit``.
 METRES = {"mm": 0.001, "cm": 0.01, "m": 1.0}
@@ -108,7 +109,10 @@ def add_face(g: Glb, perf: Performance) -> int:
     """Store the actor's textured mesh and its morph targets in a glTF document being built (the
     module docstring describes them): positions and targets in metres, texture coordinates from
     the image's top-left, the texture as an embedded PNG under an unlit material; the mesh's
-    ``weights`` are the first frame's. Adds ``KHR_materials_unlit`` to ``extensionsUsed``.
+    ``weights`` are the first frame's; a second primitive, where the actor has no mouth cap,
+    closes the mouth's opening with the strip between the inner lips in the cavity's colour
+    (:data:`~facemime.shared_constants.CAVITY`), moving with the same targets. Adds
+    ``KHR_materials_unlit`` to ``extensionsUsed``.
 
     Parameters
     ----------
@@ -159,6 +163,25 @@ def add_face(g: Glb, perf: Performance) -> int:
         },
     )
     g.doc["extensionsUsed"] = ["KHR_materials_unlit"]
+    # the mouth's opening: facemime draws a cavity behind the lips; the file closes it with a
+    # dark strip between the inner lips (a capped actor's strip is in the mesh, textured)
+    capped = {frozenset(t) for t in model.triangles.tolist()}
+    cavity = np.array([t for t in lip_strip(model).tolist() if frozenset(t) not in capped], np.int64)
+    if len(cavity):
+        linear = [((c / 255.0 + 0.055) / 1.055) ** 2.4 for c in CAVITY]  # glTF's colour factors are linear
+        inner = {k: v for k, v in primitive.items() if k != "attributes"}
+        inner["attributes"] = {"POSITION": attributes["POSITION"]}
+        inner["indices"] = g.accessor(cavity.astype(index_type).ravel(), ELEMENT_ARRAY_BUFFER)
+        inner["material"] = g.add(
+            "materials",
+            {
+                "name": "mouth",
+                "pbrMetallicRoughness": {"baseColorFactor": [*linear, 1.0], "metallicFactor": 0.0},
+                "doubleSided": True,
+                "extensions": {"KHR_materials_unlit": {}},
+            },
+        )
+        mesh["primitives"].append(inner)
     return g.add("meshes", mesh)
 
 
