@@ -444,21 +444,6 @@ class FrameSolver:
                 out[self.expressions.names.index(name)] = np.clip(float(closure[eye]), 0.0, 1.0)
         return out
 
-    def named(self, weights: np.ndarray) -> dict[str, float]:
-        """One frame's weights as a track file's ``weights`` object.
-
-        Parameters
-        ----------
-        weights
-            (E,) float array: weights in the order of the controls' ``names``.
-
-        Returns
-        -------
-        dict of str to float
-            Name -> weight rounded to 4 decimals, the weights that round to 0 left out.
-        """
-        return named_weights(self.expressions.names, weights)
-
 
 def named_weights(names: tuple[str, ...], weights: np.ndarray) -> dict[str, float]:
     """Weights as a track file's name -> weight object.
