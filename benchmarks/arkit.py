@@ -8,7 +8,7 @@ relative to frame 0's) marks frames **shut** (under 0.35) and **open and looking
 
 - **blinks**: how many shut eye-frames have ``eyeBlink`` > 0.5 and how many looking-down ones
   < 0.2 (issue 66's target on lp_d3), and the median ``eyeBlink`` of each; the counts over all
-  the videos last;
+  the videos last; and on how many eye-frames the eye model looked (``eye_model``);
 - **jaw**: the largest ``jawOpen`` and its correlation with the reference's chin drop
   (:func:`facemime.animate.arkit.chin_drop`) and with the gap between its inner lips' middles;
 - **look**: the correlation of ``eyeLookIn - eyeLookOut`` (per eye, signed towards image-right)
@@ -50,20 +50,25 @@ def main() -> None:
     at = {n: k for k, n in enumerate(NAMES)}
     results = {}
     for name in args.videos.split(","):
-        values, seconds = [], 0.0
+        values, seconds, looked = [], 0.0, 0
         with VideoReader(args.data / "video" / f"{name}.mp4") as reader:
             solver = None
-            for _, analysis, motion in analysed(reader, name, fps=reader.fps):
+            for _, analysis, motion in analysed(reader, name, fps=reader.fps, eye_model=True):
                 solver = solver or ArkitSolver(analysis.actor.model)
+                looked += 0 if motion.lid_closure is None else int(np.isfinite(motion.lid_closure).sum())
                 t0 = time.perf_counter()
-                values.append(solver.step(motion.offsets, motion.look, motion.landmark_closure, motion.landmark_jaw))
+                values.append(
+                    solver.step(
+                        motion.offsets, motion.look, motion.landmark_closure, motion.landmark_jaw, motion.lid_closure
+                    )
+                )
                 seconds += time.perf_counter() - t0
         w = np.array(values)
         ref = np.load(args.data / "video" / f"{name}.landmarks.npz")
         opening, iris = reference_eyes(ref["landmarks"])
         n = min(len(w), len(opening))
         w, opening, u, v = w[:n], opening[:n], iris[:n, :, 0], iris[:n, :, 1]
-        row: dict = {"ms_per_frame": round(1000 * seconds / n, 3)}
+        row: dict = {"ms_per_frame": round(1000 * seconds / n, 3), "eye_model": f"{looked}/{2 * len(values)}"}
         shut_ok = shut_n = down_ok = down_n = 0
         shut_values, down_values, look_u, look_v = [], [], [], []
         for eye, side in ((0, "Right"), (1, "Left")):

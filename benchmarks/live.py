@@ -6,8 +6,8 @@ H.264) and sent to a VMC receiver of our own on 127.0.0.1 (a UDP socket that cou
 
 - **sustained**: the clip's frames as fast as they are analysed (``paced=False``), frames/s from
   the first frame's arrival to the last bundle, decoding included; beside it, in the same run,
-  the analysis alone (:func:`facemime.animate.analysis.analysed`, no ARKit solve, no sending):
-  the ratio says what the VMC output costs;
+  the analysis alone (:func:`facemime.animate.analysis.analysed`, no eye model, no ARKit solve,
+  no sending): the ratio says what the blendshapes and the VMC output cost;
 - **latency**: the clip played at its own frame rate (as ``facemime live`` plays a file), ms from
   each frame's due time to its bundle sent: median and 95th percentile.
 

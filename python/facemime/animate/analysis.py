@@ -24,11 +24,12 @@ from typing import Any
 
 import numpy as np
 
-from facemime.animate.arkit import jaw_opening, landmark_openings
+from facemime.animate.arkit import LID_GATE, jaw_opening, landmark_openings, quick_closures
 from facemime.animate.deform import Deformer
 from facemime.animate.head_pose import PoseFollower
 from facemime.errors import NoFaceError
 from facemime.fit.actor import find_points, fit_actor, init_contours
+from facemime.networks.eyelids import eye_openings
 from facemime.track.eyes import EyeTracker
 from facemime.track.params import TrackerParams
 from facemime.track.redetect import FaceTracker
@@ -52,7 +53,12 @@ class FrameMotion:
     landmarks (1 - each eye's :func:`~facemime.animate.arkit.landmark_openings` over the first
     frame's; the subject's right eye first), None where the landmark pass measured none;
     ``landmark_jaw``: the jaw's opening in those landmarks
-    (:func:`~facemime.animate.arkit.jaw_opening`, mouth widths), None likewise.
+    (:func:`~facemime.animate.arkit.jaw_opening`, mouth widths), None likewise; ``lid_closure``:
+    (2,) the eye model's closures (:func:`~facemime.networks.eyelids.eye_openings` over the first
+    frame's, the two eyes' mean), measured only on an eye whose quick closure
+    (:func:`~facemime.animate.arkit.quick_closures`) is at least
+    :data:`~facemime.animate.arkit.LID_GATE`, NaN on the other; None where the landmark pass
+    measured none or the analysis does not use the eye model.
     """
 
     contours: dict[str, np.ndarray]
@@ -65,6 +71,7 @@ class FrameMotion:
     look: Look = field(default_factory=Look)
     landmark_closure: np.ndarray | None = None
     landmark_jaw: float | None = None
+    lid_closure: np.ndarray | None = None
 
 
 @dataclass
@@ -99,6 +106,9 @@ class Analysis:
         and scene are this frame's. None: an actor is fitted on ``frame``.
     fps
         The video's frame rate, frames/s (at least 1 is used): sets the pose filter's time step.
+    eye_model
+        Look at closing eyes with the eye model (FrameMotion's ``lid_closure``, for the ARKit
+        blinks: up to 7 ms a frame); False: ``lid_closure`` is None.
     """
 
     def __init__(
@@ -108,6 +118,7 @@ class Analysis:
         params: TrackerParams | None = None,
         actor: Actor | None = None,
         fps: float = 25.0,
+        eye_model: bool = False,
     ):
         self.params = params
         self.timings = Timings()
@@ -127,6 +138,8 @@ class Analysis:
         self.pose = PoseFollower(frame, found.face.landmarks, self.actor.model, self.actor.pose, self.tracker, fps)
         self.timings.fit += time.perf_counter() - t0
         self._key_openings = landmark_openings(self.pose.key_landmarks)
+        # the eye model's opening of the key frame's eyes, their mean: None where it is not used
+        self._key_lids = float(eye_openings(frame, self.pose.key_landmarks).mean()) if eye_model else None
         self.last = FrameMotion(
             contours, dict.fromkeys(FEATURES, 1.0), [], True, self.actor.pose, np.zeros((len(self.deformer.knots), 2))
         )
@@ -160,15 +173,27 @@ class Analysis:
             self.eye_state = self.eyes.update(frame, pose)
             closure, iris = self.eyes.look(self.eye_state)
             look = Look(closure, iris)
-            looking = time.perf_counter() - t2
-            self.timings.look += looking
-            elsewhere += looking
-            landmarks, lids, jaw = self.pose.landmarks, None, None
+            landmarks, lids, jaw, eyelids = self.pose.landmarks, None, None, None
             if landmarks is not None:
                 lids = 1.0 - landmark_openings(landmarks) / np.maximum(self._key_openings, 1e-6)
                 jaw = jaw_opening(landmarks, self.pose.key_landmarks)
+                if self._key_lids is not None:
+                    eyelids = self._lid_closures(frame, landmarks, quick_closures(closure, lids))
+            looking = time.perf_counter() - t2
+            self.timings.look += looking
+            elsewhere += looking
             self.last = FrameMotion(
-                result.contours, result.confidence, result.lost, True, pose, offsets, result.redetected, look, lids, jaw
+                result.contours,
+                result.confidence,
+                result.lost,
+                True,
+                pose,
+                offsets,
+                result.redetected,
+                look,
+                lids,
+                jaw,
+                eyelids,
             )
         else:
             self.frames_without_face += 1
@@ -184,6 +209,14 @@ class Analysis:
         self.timings.track += t1 - t0
         self.timings.pose += time.perf_counter() - t1 - elsewhere
         return self.last
+
+    def _lid_closures(self, frame: np.ndarray, landmarks: np.ndarray, quick: np.ndarray) -> np.ndarray:
+        """The eye model's closures (FrameMotion's ``lid_closure``) of the eyes whose ``quick``
+        closures are at least :data:`~facemime.animate.arkit.LID_GATE`; NaN for the other."""
+        out = np.full(2, np.nan)
+        eyes = np.flatnonzero(quick >= LID_GATE)
+        out[eyes] = 1.0 - eye_openings(frame, landmarks, eyes.tolist()) / max(self._key_lids or 0.0, 1e-6)
+        return out
 
     @property
     def model_block(self) -> dict:
@@ -210,7 +243,7 @@ def start_analysis(frame: np.ndarray, video: str, **options: Any) -> Analysis:
     video
         The video's name, in messages.
     **options
-        :class:`Analysis`'s keyword arguments (``params``, ``actor``, ``fps``).
+        :class:`Analysis`'s keyword arguments (``params``, ``actor``, ``fps``, ``eye_model``).
 
     Returns
     -------
@@ -238,7 +271,7 @@ def analysed(
     video
         The video's name, in messages.
     **options
-        :class:`Analysis`'s keyword arguments (``params``, ``actor``, ``fps``).
+        :class:`Analysis`'s keyword arguments (``params``, ``actor``, ``fps``, ``eye_model``).
 
     Yields
     ------

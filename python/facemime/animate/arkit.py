@@ -13,7 +13,9 @@ right are the subject's own, as ARKit's are. They come from three measures:
   :data:`LOOK_UP`; the subject's right eye is image-left, so its iris moving image-right looks in
   (towards the nose), the left eye's looks out;
 - the **blinks**, not the lid closure as it is: ARKit's ``eyeBlink*`` means shut, and a lid that
-  follows the eye looking down closes part of the way (:func:`blinks`).
+  follows the eye looking down closes part of the way (:func:`blinks`): where the quick measures
+  see an eye closing, MediaPipe's eye model (:mod:`facemime.networks.eyelids`) looks at its
+  lids.
 
 The names in :data:`UNMEASURED` are not measured by the analysis: they are always 0. The
 contours show no depth (``jawForward``), cheeks, nose wings or tongue, and neither lid's
@@ -123,16 +125,27 @@ LOOK_DOWN = 0.22
 LOOK_UP = 0.13
 # Blinks, measured against the Face Mesh references' lid openings on the ten shared videos (shut:
 # under 0.35 of frame 0's opening, 405 eye-frames; open and looking down: over 0.6, the iris 0.04
-# eye widths down, 905): the eye tracker's closure alone reads a lid that follows the eye down as
-# closing, the landmark pass reads a shut lid half shut (its eyes' points are coarse) but is not
-# fooled by a look down. Averaged, the landmarks' scaled by 2.5, and ramped from 0.35 to 0.5:
-# > 0.5 on 88% of the shut eye-frames and < 0.2 on 87% of those looking down, the best of the
-# least of the two over scales 0-3 and ramps 0.2-0.4 to 0.5-0.8 (lp_d3: 240 of 244, 41 of 76;
-# the eye tracker's alone at its best ramp, 0.3-0.7: 231 of 244, 32 of 76).
-#: Closure (the two measures' mean) at which a blink starts (0) and is full (1).
+# eye widths down, 905). The quick measures, made every frame, cannot tell the two apart: the eye
+# tracker's closure reads a lid that follows the eye down as closing, the landmark pass reads a
+# shut lid half shut (its eyes' points are coarse). Averaged, the landmarks' scaled by 2.5, and
+# ramped from 0.35 to 0.5 they gave > 0.5 on 355 of the shut eye-frames and < 0.2 on 784 of those
+# looking down (lp_d3: 240 of 244, 41 of 76). The eye model's lids tell them apart: its closure
+# ramped from 0.4 to 0.475 gives 379 of 405 and 902 of 905 (lp_d3: 228 of 244, 76 of 76), and
+# > 0.2 on none of the 5,206 eye-frames open wider than 0.8; the shut frames it misses are eyes
+# nearly closed (the ramp from 0.375 gave 383 and 895, lp_d3 231 and 70: an eye looking down
+# read as half shut). Its opening is taken over the mean of the two eyes' key-frame openings,
+# not each eye's own (lp_d3 so: 224 and 70 from 0.425): a key frame with one eye opened wider
+# reads that eye as closing sooner. It costs 3.4 ms an eye (one core), so it looks only at eyes
+# whose quick closure is 0.2 or more: 26% of the eye-frames, none of the counts above lost.
+#: The quick closure (the eye tracker's and the landmarks' mean) at which a blink starts (0) and
+#: is full (1), where the eye model did not look.
 BLINK_FROM, BLINK_TO = 0.35, 0.5
 #: The landmark pass's closure is multiplied by this before it is averaged with the eye tracker's.
 LANDMARK_SCALE = 2.5
+#: The eye model looks at an eye whose quick closure is at least this.
+LID_GATE = 0.2
+#: The eye model's closure at which a blink starts (0) and is full (1).
+LID_FROM, LID_TO = 0.4, 0.475
 #: Pairs of controls that move the same knots opposite ways.
 OPPOSITES = (("mouthLeft", "mouthRight"), ("jawLeft", "jawRight"))
 # Face Mesh points of the nose's bridge and the chin's tip, and of the inner lips' middles.
@@ -214,8 +227,9 @@ def jaw_opening(landmarks: np.ndarray, key: np.ndarray) -> float:
     return chin_drop(landmarks, key) + gap
 
 
-def blinks(closure: np.ndarray, landmark_closure: np.ndarray | None = None) -> np.ndarray:
-    """ARKit's ``eyeBlinkRight``/``eyeBlinkLeft`` of a frame's lid closures.
+def quick_closures(closure: np.ndarray, landmark_closure: np.ndarray | None = None) -> np.ndarray:
+    """Each eye's closure by the measures made every frame: the eye tracker's and the landmark
+    pass's, averaged.
 
     Parameters
     ----------
@@ -229,15 +243,44 @@ def blinks(closure: np.ndarray, landmark_closure: np.ndarray | None = None) -> n
     Returns
     -------
     (2,) float64 array
-        Right eye, left eye, 0..1: the closure ramped from :data:`BLINK_FROM` to
-        :data:`BLINK_TO` (averaged first with :data:`LANDMARK_SCALE` times the landmarks' closure
-        where it is measured).
+        Right eye, left eye: the mean of the eye tracker's closure and :data:`LANDMARK_SCALE`
+        times the landmarks' (the eye tracker's alone where those are not measured).
     """
     c = np.asarray(closure, np.float64)
-    if landmark_closure is not None:
-        lm = np.asarray(landmark_closure, np.float64)
-        c = np.where(np.isfinite(lm), (c + LANDMARK_SCALE * lm) / 2.0, c)
-    return np.clip((c - BLINK_FROM) / (BLINK_TO - BLINK_FROM), 0.0, 1.0)
+    if landmark_closure is None:
+        return c
+    lm = np.asarray(landmark_closure, np.float64)
+    return np.where(np.isfinite(lm), (c + LANDMARK_SCALE * lm) / 2.0, c)
+
+
+def blinks(
+    closure: np.ndarray, landmark_closure: np.ndarray | None = None, lid_closure: np.ndarray | None = None
+) -> np.ndarray:
+    """ARKit's ``eyeBlinkRight``/``eyeBlinkLeft`` of a frame's lid closures.
+
+    Parameters
+    ----------
+    closure
+        (2,) float array: the eye tracker's closures (:class:`~facemime.types.look.Look`'s; right
+        eye first).
+    landmark_closure
+        (2,) float array: the landmarks' closures, as :func:`quick_closures` takes them, or None.
+    lid_closure
+        (2,) float array: the eye model's closures (1 - its opening over the key frame's, the
+        two eyes' mean), NaN per eye where it did not look; or None where it looked at neither.
+
+    Returns
+    -------
+    (2,) float64 array
+        Right eye, left eye, 0..1: the eye model's closure ramped from :data:`LID_FROM` to
+        :data:`LID_TO` where it looked; elsewhere the :func:`quick_closures` ramped from
+        :data:`BLINK_FROM` to :data:`BLINK_TO`.
+    """
+    quick = np.clip((quick_closures(closure, landmark_closure) - BLINK_FROM) / (BLINK_TO - BLINK_FROM), 0.0, 1.0)
+    if lid_closure is None:
+        return quick
+    lid = np.asarray(lid_closure, np.float64)
+    return np.where(np.isfinite(lid), np.clip((lid - LID_FROM) / (LID_TO - LID_FROM), 0.0, 1.0), quick)
 
 
 def looks(iris: np.ndarray) -> dict[str, float]:
@@ -265,7 +308,12 @@ def looks(iris: np.ndarray) -> dict[str, float]:
     return out
 
 
-def arkit_values(controls: np.ndarray, iris: np.ndarray, landmark_closure: np.ndarray | None = None) -> np.ndarray:
+def arkit_values(
+    controls: np.ndarray,
+    iris: np.ndarray,
+    landmark_closure: np.ndarray | None = None,
+    lid_closure: np.ndarray | None = None,
+) -> np.ndarray:
     """A frame's 52 ARKit values.
 
     Parameters
@@ -277,6 +325,8 @@ def arkit_values(controls: np.ndarray, iris: np.ndarray, landmark_closure: np.nd
         (2, 2) float array: the frame's iris shifts (:class:`~facemime.types.look.Look`'s).
     landmark_closure
         (2,) float array or None: the landmark pass's closures, as :func:`blinks` takes them.
+    lid_closure
+        (2,) float array or None: the eye model's closures, as :func:`blinks` takes them.
 
     Returns
     -------
@@ -291,7 +341,7 @@ def arkit_values(controls: np.ndarray, iris: np.ndarray, landmark_closure: np.nd
         both = min(named[a], named[b])
         named[a], named[b] = named[a] - both, named[b] - both
     closure = np.array([named["eyeBlinkRight"], named["eyeBlinkLeft"]])
-    named["eyeBlinkRight"], named["eyeBlinkLeft"] = blinks(closure, landmark_closure).tolist()
+    named["eyeBlinkRight"], named["eyeBlinkLeft"] = blinks(closure, landmark_closure, lid_closure).tolist()
     named.update(looks(iris))
     return np.array([named.get(n, 0.0) for n in NAMES])
 
@@ -330,6 +380,7 @@ class ArkitSolver:
         look: Look,
         landmark_closure: np.ndarray | None = None,
         landmark_jaw: float | None = None,
+        lid_closure: np.ndarray | None = None,
     ) -> np.ndarray:
         """The next frame's values.
 
@@ -344,6 +395,8 @@ class ArkitSolver:
         landmark_jaw
             The landmarks' :func:`jaw_opening`, mouth widths, or None where not measured: the jaw
             then as the lips' solve has it.
+        lid_closure
+            (2,) float array or None: the eye model's closures (:func:`blinks`).
 
         Returns
         -------
@@ -358,4 +411,4 @@ class ArkitSolver:
             rest = mouth - jaw * self._patterns[0]
             w[self._jaw] = jaw
             w[self._lower] = BoxLeastSquares(self._lower_gram, 0.0).step(self._patterns[1:] @ rest)
-        return arkit_values(w, look.iris, landmark_closure)
+        return arkit_values(w, look.iris, landmark_closure, lid_closure)

@@ -91,7 +91,7 @@ class Live:
         self._stop = threading.Event()
         self._arrived = 0.0
         self._frames = self.source.frames(self._stop)
-        self._analysed = analysed(self._pictures(), self.source.name, fps=self.source.fps)
+        self._analysed = analysed(self._pictures(), self.source.name, fps=self.source.fps, eye_model=True)
         try:
             started = next(self._analysed, None)
             if started is None:
@@ -140,7 +140,9 @@ class Live:
         return self.stats
 
     def _send(self, motion: FrameMotion) -> None:
-        values = self._solver.step(motion.offsets, motion.look, motion.landmark_closure, motion.landmark_jaw)
+        values = self._solver.step(
+            motion.offsets, motion.look, motion.landmark_closure, motion.landmark_jaw, motion.lid_closure
+        )
         datagram = frame_bundle(
             values,
             unity_quaternion(motion.pose),

@@ -145,7 +145,7 @@ class SideBySide:
 
     def __iter__(self) -> Iterator[np.ndarray]:
         seconds, canvas, synth, puppet = self.seconds, None, None, None
-        frames = analysed(self._timed_frames(), self._name, params=self._params, fps=self._fps)
+        frames = analysed(self._timed_frames(), self._name, params=self._params, fps=self._fps, eye_model=True)
         for frame, analysis, motion in frames:
             h, w = frame.shape[:2]
             if self.analysis is None:
@@ -177,7 +177,9 @@ class SideBySide:
                 "offsets": motion.offsets,
                 "look": motion.look.as_dict(),
             }
-            values = solver.step(motion.offsets, motion.look, motion.landmark_closure, motion.landmark_jaw)
+            values = solver.step(
+                motion.offsets, motion.look, motion.landmark_closure, motion.landmark_jaw, motion.lid_closure
+            )
             self.weights.append(solver.controls)
             record["weights"] = named_weights(CONTROLS, solver.controls)
             record["arkit"] = named_weights(ARKIT, values)

@@ -1,6 +1,7 @@
 """Finding human faces and their landmarks with MediaPipe's face detector and face landmark
 model (shipped in ``models/``, run by OpenCV's ``cv2.dnn``): the automatic start of fitting and
-tracking, and the tracker's re-detection."""
+tracking, and the tracker's re-detection; and the eyes' lids with its eye model
+(:mod:`facemime.networks.eyelids`), for the blinks."""
 
 from facemime.networks.detector import Detection, detect_faces
 from facemime.networks.finder import FACE_SCORE, Face, find_face, follow_face

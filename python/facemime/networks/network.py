@@ -14,7 +14,7 @@ import cv2
 from facemime.errors import FacemimeError
 
 #: The shipped model files.
-MODELS = ("face_detection_short_range.tflite", "face_landmark.tflite")
+MODELS = ("face_detection_short_range.tflite", "face_landmark.tflite", "iris_landmark.tflite")
 _loaded = threading.local()
 
 
