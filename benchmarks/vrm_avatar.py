@@ -7,13 +7,15 @@ For a shared video (default lp_d3): ``facemime fit`` on its first frame gives th
 own on 127.0.0.1, which keeps every frame's bundle: the head's rotation, the root's translation and
 ARKit's 52 values, as VMC software gets them. Three frames are chosen from what was received: a
 neutral one (the least turn and values), the one turned most (largest ``|yaw|``) and the one
-with the jaw open widest (largest ``jawOpen``).
+with the jaw open widest (largest ``jawOpen``); ``--extra`` adds rows at frames of one's choice
+(lp_d3's 90, eyes open and looking down, and 120, shut: the blinks told apart).
 three-vrm in headless Chromium (``web/test/vrm-page.mjs``, as ``tests/export/test_vrm.py`` drives
 it) renders each from the front; the avatar faces the camera, so the subject's left is the picture's right, as in the
 video. Each row of the sheet: the video frame, cropped to the region the avatar's picture shows
 (the face's box in the first frame, grown by the same margin) | the avatar.
 
     python benchmarks/vrm_avatar.py [--data ../shared/data] [--video lp_d3] [--out docs/live_vrm.png]
+                                    [--extra 90,120]
 
 Needs Node with ``web/node_modules`` (``npm ci`` in web/) and Debian's chromium. Prints the
 .vrm's size and the frames chosen; last, one JSON line with every figure.
@@ -145,7 +147,9 @@ def main() -> None:
     parser.add_argument("--video", default="lp_d3")
     parser.add_argument("--out", type=Path, default=ROOT / "docs" / "live_vrm.png")
     parser.add_argument("--size", type=int, default=240, help="pixels a side of each picture")
+    parser.add_argument("--extra", default="", help="more frames to show, comma-separated")
     args = parser.parse_args()
+    extra = [int(t) for t in args.extra.split(",") if t]
     video = args.data / "video" / f"{args.video}.mp4"
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
@@ -161,8 +165,11 @@ def main() -> None:
     sent = received_frames(video)
     if len(sent) != len(records):
         raise RuntimeError(f"live sent {len(sent)} frames of the video's {len(records)}")
+    if any(not 0 <= t < len(sent) for t in extra):
+        raise SystemExit(f"--extra: frames are 0 to {len(sent) - 1}")
     chosen = chosen_frames(sent)
-    rows_at = [chosen[k] for k in ("neutral", "turned", "open")]
+    names = ["neutral", "turned", "open"] + ["asked"] * len(extra)
+    rows_at = [chosen[k] for k in ("neutral", "turned", "open")] + extra
     pictures = render(vrm, [sent[t] for t in rows_at], args.size)
     wanted = set(rows_at)
     frames: dict[int, np.ndarray] = {}
@@ -174,11 +181,13 @@ def main() -> None:
                 break
     rows = [caption(2 * args.size, f"{args.video}: video | VRM avatar in three-vrm, as live sent it")]
     figures = []
-    for what, t, avatar in zip(("neutral", "turned", "open"), rows_at, pictures):
+    for what, t, avatar in zip(names, rows_at, pictures):
         f = {"row": what, "frame": t, "yaw": round(yaw_of(sent[t]["head"]), 1)}
         f.update({k: round(float(sent[t]["values"][k]), 3) for k in ("jawOpen", "eyeBlinkLeft", "eyeBlinkRight")})
         figures.append(f)
-        rows.append(caption(2 * args.size, f"{what}: frame {t}, yaw {f['yaw']:+.0f} deg, jawOpen {f['jawOpen']:.2f}"))
+        blinks = f"blink {f['eyeBlinkRight']:.2f} {f['eyeBlinkLeft']:.2f}"
+        text = f"{what}: frame {t}, yaw {f['yaw']:+.0f} deg, jawOpen {f['jawOpen']:.2f}, {blinks}"
+        rows.append(caption(2 * args.size, text))
         rows.append(np.hstack([face_crop(frames[t], perf.actor.model.vertices, poses[0], args.size), avatar]))
     sheet = np.vstack(rows)
     ok, png = cv2.imencode(".png", cv2.cvtColor(sheet, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_PNG_COMPRESSION, 9])
@@ -186,7 +195,10 @@ def main() -> None:
     args.out.write_bytes(png.tobytes())
     print(f"{args.video}: fit, run and export in {seconds:.1f} s; the .vrm {len(vrm):,} bytes")
     for f in figures:
-        print(f"  {f['row']:8s} frame {f['frame']:4d}: yaw {f['yaw']:+6.1f} deg, jawOpen {f['jawOpen']:.3f}")
+        print(
+            f"  {f['row']:8s} frame {f['frame']:4d}: yaw {f['yaw']:+6.1f} deg, jawOpen {f['jawOpen']:.3f},"
+            f" eyeBlink right {f['eyeBlinkRight']:.3f} left {f['eyeBlinkLeft']:.3f}"
+        )
     print(f"wrote {args.out} ({len(png):,} bytes)")
     print(json.dumps({"video": args.video, "vrm_bytes": len(vrm), "png_bytes": len(png), "rows": figures}))
 
