@@ -6,7 +6,8 @@ import assert from 'node:assert/strict';
 import { test } from 'node:test';
 import type { Picture, SampleGroup } from '../src/render/actor';
 import type { Model } from '../src/render/geometry';
-import { interiorUv, lipStrip, SamplePainter, sentSamples } from '../src/render/samples';
+import { lipStrip } from '../src/render/geometry';
+import { interiorUv, SamplePainter, sentSamples } from '../src/render/samples';
 
 /** Inner lips of three knots sharing their corners (vertices 0 and 2); outer lips 4-7. */
 const MODEL: Model = {

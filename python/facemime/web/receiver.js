@@ -894,6 +894,16 @@ void main() {
     const a = g[0], b = g[g.length - 1];
     return Math.hypot(vertices[3 * b] - vertices[3 * a], vertices[3 * b + 1] - vertices[3 * a + 1]);
   }
+  function lipStrip(model) {
+    const upper = model.groups.mouth_inner_upper ?? [], lower = model.groups.mouth_inner_lower ?? [];
+    if (upper.length !== lower.length) return new Uint32Array(0);
+    const out = [];
+    for (let i2 = 0; i2 + 1 < upper.length; i2++) {
+      const [a, b, c, d] = [upper[i2], upper[i2 + 1], lower[i2 + 1], lower[i2]];
+      for (const t of [[a, b, c], [a, c, d]]) if (new Set(t).size === 3) out.push(...t);
+    }
+    return Uint32Array.from(out);
+  }
   var Deformer = class {
     constructor(model) {
       this.model = model;
@@ -907,6 +917,13 @@ void main() {
       const u4 = g.mouth_inner_upper, l = g.mouth_inner_lower;
       this.inner = [u4.slice(1, -1), l.slice(1, -1)];
       this.weights = this.spread();
+      const key = (a, b, c) => [a, b, c].sort((x2, y) => x2 - y).join(",");
+      const strip = lipStrip(model), tri = model.triangles;
+      const inStrip = /* @__PURE__ */ new Set();
+      for (let t = 0; t < strip.length; t += 3) inStrip.add(key(strip[t], strip[t + 1], strip[t + 2]));
+      let capped = false;
+      for (let t = 0; t < tri.length && !capped; t += 3) capped = inStrip.has(key(tri[t], tri[t + 1], tri[t + 2]));
+      this.capped = capped;
     }
     spread() {
       const m = this.model, g = m.groups, v2 = m.vertices;
@@ -970,14 +987,26 @@ void main() {
       }
     }
     /** ``vertices`` with the lips shut where the inner lips lie closer than ``closed`` times the
-     * mouth's width (Deformer.sealed): a copy. */
+     * mouth's width (Deformer.sealed): a copy. On a capped mouth what this does to the model's own
+     * vertices is taken back, so that the key frame's mouth is drawn as it was fitted. */
     sealed(vertices, closed) {
+      const close = this.closing(vertices, closed);
+      if (close === null) return vertices;
+      const rest = this.capped ? this.closing(this.model.vertices, closed) : null;
+      if (rest !== null) for (let i2 = 0; i2 < close.length; i2++) close[i2] -= rest[i2];
+      const out = Float64Array.from(vertices);
+      this.add(out, close, 1);
+      return out;
+    }
+    /** The K*2 knot moves that shut the lips of ``vertices`` as sealed says, model units (null where
+     * the inner lips' knot counts differ or the mouth has no width). */
+    closing(vertices, closed) {
       const [upper, lower] = this.inner;
       const g = this.model.groups.mouth_outer_upper;
       const c0 = g[0], c1 = g[g.length - 1];
       const ax = vertices[3 * c1] - vertices[3 * c0], ay = vertices[3 * c1 + 1] - vertices[3 * c0 + 1];
       const width = mouthWidth(this.model, vertices);
-      if (upper.length !== lower.length || width <= 0) return vertices;
+      if (upper.length !== lower.length || width <= 0) return null;
       const ux = -ay / width, uy = ax / width;
       const limit = closed * width;
       const close = new Float64Array(this.knots.length * 2);
@@ -992,9 +1021,7 @@ void main() {
         close[2 * sl] = half * ux;
         close[2 * sl + 1] = half * uy;
       });
-      const out = Float64Array.from(vertices);
-      this.add(out, close, 1);
-      return out;
+      return close;
     }
   };
   function closeLids(m, vertices, closure) {
@@ -2077,16 +2104,6 @@ void main() {
     }
     for (const vertex of upper) if (lower.includes(vertex)) uv[2 * vertex + 1] = 0.5;
     return uv;
-  }
-  function lipStrip(model) {
-    const upper = model.groups.mouth_inner_upper ?? [], lower = model.groups.mouth_inner_lower ?? [];
-    if (upper.length !== lower.length) return new Uint32Array(0);
-    const out = [];
-    for (let i2 = 0; i2 + 1 < upper.length; i2++) {
-      const [a, b, c, d] = [upper[i2], upper[i2 + 1], lower[i2 + 1], lower[i2]];
-      for (const t of [[a, b, c], [a, c, d]]) if (new Set(t).size === 3) out.push(...t);
-    }
-    return Uint32Array.from(out);
   }
   function roundHalfEven(x2) {
     const f = Math.floor(x2), d = x2 - f;

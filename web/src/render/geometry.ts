@@ -62,6 +62,21 @@ export function mouthWidth(m: Model, vertices: Float64Array): number {
   return Math.hypot(vertices[3 * b] - vertices[3 * a], vertices[3 * b + 1] - vertices[3 * a + 1]);
 }
 
+/** The strip between the inner lips, knot to knot (facemime.types.head.lip_strip): per pair of
+ * knots i, i + 1 the triangles (upper i, upper i + 1, lower i + 1) and (upper i, lower i + 1,
+ * lower i), leaving out any whose vertices repeat (the corners the lips share); none where the
+ * inner lips' knot counts differ. */
+export function lipStrip(model: Model): Uint32Array {
+  const upper = model.groups.mouth_inner_upper ?? [], lower = model.groups.mouth_inner_lower ?? [];
+  if (upper.length !== lower.length) return new Uint32Array(0);
+  const out: number[] = [];
+  for (let i = 0; i + 1 < upper.length; i++) {
+    const [a, b, c, d] = [upper[i], upper[i + 1], lower[i + 1], lower[i]];
+    for (const t of [[a, b, c], [a, c, d]]) if (new Set(t).size === 3) out.push(...t);
+  }
+  return Uint32Array.from(out);
+}
+
 /** Drives a model by its knots (facemime.animate.deform.Deformer). */
 export class Deformer {
   readonly knots: number[];
@@ -69,6 +84,8 @@ export class Deformer {
   readonly weights: Float64Array;
   private readonly slot = new Map<number, number>();
   private readonly inner: [number[], number[]];
+  /** Whether the model's mouth is capped (facemime.fit.actor.mouth_cap): see sealed. */
+  private readonly capped: boolean;
 
   constructor(readonly model: Model) {
     const g = model.groups;
@@ -80,6 +97,13 @@ export class Deformer {
     const u = g.mouth_inner_upper, l = g.mouth_inner_lower;
     this.inner = [u.slice(1, -1), l.slice(1, -1)];
     this.weights = this.spread();
+    const key = (a: number, b: number, c: number) => [a, b, c].sort((x, y) => x - y).join(',');
+    const strip = lipStrip(model), tri = model.triangles;
+    const inStrip = new Set<string>();
+    for (let t = 0; t < strip.length; t += 3) inStrip.add(key(strip[t], strip[t + 1], strip[t + 2]));
+    let capped = false;
+    for (let t = 0; t < tri.length && !capped; t += 3) capped = inStrip.has(key(tri[t], tri[t + 1], tri[t + 2]));
+    this.capped = capped;
   }
 
   private spread(): Float64Array {
@@ -144,14 +168,27 @@ export class Deformer {
   }
 
   /** ``vertices`` with the lips shut where the inner lips lie closer than ``closed`` times the
-   * mouth's width (Deformer.sealed): a copy. */
+   * mouth's width (Deformer.sealed): a copy. On a capped mouth what this does to the model's own
+   * vertices is taken back, so that the key frame's mouth is drawn as it was fitted. */
   sealed(vertices: Float64Array, closed: number): Float64Array {
+    const close = this.closing(vertices, closed);
+    if (close === null) return vertices;
+    const rest = this.capped ? this.closing(this.model.vertices, closed) : null;
+    if (rest !== null) for (let i = 0; i < close.length; i++) close[i] -= rest[i];
+    const out = Float64Array.from(vertices);
+    this.add(out, close, 1);
+    return out;
+  }
+
+  /** The K*2 knot moves that shut the lips of ``vertices`` as sealed says, model units (null where
+   * the inner lips' knot counts differ or the mouth has no width). */
+  private closing(vertices: Float64Array, closed: number): Float64Array | null {
     const [upper, lower] = this.inner;
     const g = this.model.groups.mouth_outer_upper;
     const c0 = g[0], c1 = g[g.length - 1];
     const ax = vertices[3 * c1] - vertices[3 * c0], ay = vertices[3 * c1 + 1] - vertices[3 * c0 + 1];
     const width = mouthWidth(this.model, vertices);
-    if (upper.length !== lower.length || width <= 0) return vertices;
+    if (upper.length !== lower.length || width <= 0) return null;
     const ux = -ay / width, uy = ax / width;
     const limit = closed * width;
     const close = new Float64Array(this.knots.length * 2);
@@ -164,9 +201,7 @@ export class Deformer {
       close[2 * su] = -half * ux; close[2 * su + 1] = -half * uy;
       close[2 * sl] = half * ux; close[2 * sl + 1] = half * uy;
     });
-    const out = Float64Array.from(vertices);
-    this.add(out, close, 1);
-    return out;
+    return close;
   }
 }
 

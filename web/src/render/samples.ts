@@ -40,21 +40,6 @@ export function interiorUv(model: Model): Float64Array {
   return uv;
 }
 
-/** The strip between the inner lips, knot to knot (facemime.types.head.lip_strip): per pair of
- * knots i, i + 1 the triangles (upper i, upper i + 1, lower i + 1) and (upper i, lower i + 1,
- * lower i), leaving out any whose vertices repeat (the corners the lips share); none where the
- * inner lips' knot counts differ. */
-export function lipStrip(model: Model): Uint32Array {
-  const upper = model.groups.mouth_inner_upper ?? [], lower = model.groups.mouth_inner_lower ?? [];
-  if (upper.length !== lower.length) return new Uint32Array(0);
-  const out: number[] = [];
-  for (let i = 0; i + 1 < upper.length; i++) {
-    const [a, b, c, d] = [upper[i], upper[i + 1], lower[i + 1], lower[i]];
-    for (const t of [[a, b, c], [a, c, d]]) if (new Set(t).size === 3) out.push(...t);
-  }
-  return Uint32Array.from(out);
-}
-
 /** ``x`` rounded to the nearest integer, halves to the even one (Python's round). */
 function roundHalfEven(x: number): number {
   const f = Math.floor(x), d = x - f;

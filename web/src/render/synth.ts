@@ -10,11 +10,11 @@
  */
 import type { Header } from '../stream';
 import type { Actor, Picture } from './actor';
-import { closeLids, Deformer, mouthWidth, poseFromValues, project, shownPose, type Pose } from './geometry';
+import { closeLids, Deformer, lipStrip, mouthWidth, poseFromValues, project, shownPose, type Pose } from './geometry';
 import { LookPainter } from './eyes';
 import { Renderer, type Layer } from './gl';
 import { mouthPatch, teethUncovered } from './mouth';
-import { interiorUv, lipStrip, SamplePainter, sentSamples } from './samples';
+import { interiorUv, SamplePainter, sentSamples } from './samples';
 import { SceneMesh } from './scene';
 import { BACKGROUND, BASIS_ONE, LOOK_NAMES, NO_FACE_DIM, SAMPLE_GROUPS, SEAL, SLOW } from '../shared_constants';
 
