@@ -14,11 +14,10 @@ import cv2
 import numpy as np
 
 from facemime.errors import InvalidInputError, NoFaceError
-from facemime.fit.adjust import Fit, fit_model
+from facemime.fit.adjust import OPEN_LIPS, Fit, fit_model
 from facemime.fit.auto import AutoPoints, auto_points
 from facemime.head.generic import generic_head
 from facemime.head.texture import painted_texture
-from facemime.shared_constants import SEAL
 from facemime.types.actor import Actor
 from facemime.types.contours import CONTOUR_NAMES
 from facemime.types.head import HeadModel, lip_strip, mouth_up, mouth_width
@@ -32,12 +31,13 @@ TEXTURE_MAX_SIDE = 1024
 #: The scene (the whole source photo) is shrunk, if needed, to at most this many pixels a side.
 SCENE_MAX_SIDE = 2048
 #: A photo whose inner lips stand further apart than this share of the mouth's width somewhere
-#: (twice the gap the synthesis seals, :data:`~facemime.shared_constants.SEAL`: an opening it
-#: shows at its full size) has the opening closed in the actor's mesh by triangles between the
-#: inner lips (:func:`mouth_cap`), so that the actor shows the photo's own teeth and mouth where
-#: the synthesis would otherwise draw an interior over them. Of the shared videos' first frames
-#: only st_aoc's is that open (0.35); the others are at most 0.03.
-CAP_OPENING = 2 * SEAL
+#: (the fit's open mouth, :data:`~facemime.fit.adjust.OPEN_LIPS`: twice the gap the synthesis
+#: seals, an opening it shows at its full size) has the opening closed in the actor's mesh by
+#: triangles between the inner lips (:func:`mouth_cap`), so that the actor shows the photo's own
+#: teeth and mouth where the synthesis would otherwise draw an interior over them. Of the shared
+#: videos' first frames, st_aoc's, st_kh's, mt_sun's and vr_2's are that open (0.13-0.45 by the
+#: landmarks); the others at most 0.044.
+CAP_OPENING = OPEN_LIPS
 
 
 def smear_texture(model: HeadModel, photo: np.ndarray, fit: Fit, points: ReferencePoints, source: dict) -> Actor:
