@@ -142,5 +142,8 @@ def test_live_stops_cleanly_on_ctrl_c(shared, receiver, presses):
         assert time.monotonic() - t0 < 3
     finally:
         proc.kill()
-    assert proc.returncode == 130 and "Traceback" not in err and "Exception ignored" not in err, err
+    # 130; or, where a second press lands while the interpreter finalises (it puts the default
+    # handler back), killed by that SIGINT at once: a shell reports that as 130 too
+    assert proc.returncode in ((130,) if presses == 1 else (130, -signal.SIGINT)), (proc.returncode, err)
+    assert "Traceback" not in err and "Exception ignored" not in err, err
     assert err.strip().splitlines()[-1] == "facemime: interrupted"
