@@ -9,7 +9,7 @@ from facemime.animate.deform import Deformer
 from facemime.animate.synth import Puppet
 from facemime.fit.actor import fit_actor, mouth_cap
 from facemime.io.video import VideoReader
-from facemime.types.head import model_iod
+from facemime.types.head import model_iod, mouth_capped
 from facemime.types.pose import project
 
 
@@ -37,6 +37,7 @@ def test_the_key_frame_shows_the_photos_own_open_mouth(open_mouth):
     cap = mouth_cap(actor.model, actor.model.vertices, project(actor.model.vertices, actor.pose)[0])
     assert len(cap) == 18  # two triangles between each of the 10 pairs of knots, none at the corners
     assert {frozenset(t) for t in cap.tolist()} <= {frozenset(t) for t in actor.model.triangles.tolist()}
+    assert mouth_capped(actor.model)
     puppet = Puppet(actor, Deformer(actor.model).feature_sizes(), model_iod(actor.model))
     shown = puppet.render(actor.pose, np.zeros((len(puppet.deformer.knots), 2)), (frame.shape[1], frame.shape[0]))
     x0, y0, x1, y1 = mouth_box(actor)
@@ -49,6 +50,7 @@ def test_the_key_frame_shows_the_photos_own_open_mouth(open_mouth):
 def test_a_closed_mouth_gets_no_cap_and_a_refit_drops_an_earlier_one(open_mouth, actor, lp_d0):
     _, opened = open_mouth
     assert len(actor.model.triangles) == len(opened.model.triangles) - 18  # lp_d0's closed mouth: no cap
+    assert not mouth_capped(actor.model)
     # the open actor's model refitted on a closed mouth loses the cap it had, rather than keep it
     frame, points, _ = lp_d0
     refit = fit_actor(frame, "lp_d0", points, model=opened.model)[0]

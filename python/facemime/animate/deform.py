@@ -22,7 +22,7 @@ import numpy as np
 from facemime.errors import InvalidInputError
 from facemime.metrics import resample
 from facemime.shared_constants import CONTOUR_GROUPS, REACH, SOFTEN
-from facemime.types.head import HeadModel, lip_strip, model_iod, mouth_up, mouth_width
+from facemime.types.head import HeadModel, model_iod, mouth_capped, mouth_up, mouth_width
 from facemime.types.pose import Pose, head_plane
 
 UPPER = ("mouth_outer_upper", "mouth_inner_upper")
@@ -59,8 +59,8 @@ class Deformer:
         # the inner lips' knots between the corners, and their slots (see sealed)
         self._inner = (g["mouth_inner_upper"][1:-1], g["mouth_inner_lower"][1:-1])
         self._inner_slots = tuple(np.array([self._slot[int(i)] for i in idx], np.int64) for idx in self._inner)
-        strip = {frozenset(t) for t in lip_strip(model).tolist()}
-        self._capped = any(frozenset(t) in strip for t in model.triangles.tolist())  # see sealed
+        self._capped = mouth_capped(model)  # see sealed
+        self._rest: dict[float, np.ndarray | None] = {}  # per share closed, the model's own _closing
         self.weights = self._spread()
 
     def _spread(self) -> np.ndarray:
@@ -171,7 +171,11 @@ class Deformer:
         close = self._closing(vertices, closed)
         if close is None:
             return vertices
-        rest = self._closing(self.model.vertices, closed) if self._capped else None
+        rest = None
+        if self._capped:
+            if closed not in self._rest:
+                self._rest[closed] = self._closing(self.model.vertices, closed)
+            rest = self._rest[closed]
         out = vertices.copy()
         out[:, :2] += self.weights @ (close if rest is None else close - rest)
         return out

@@ -38,7 +38,7 @@ from facemime.io.video import VideoReader
 from facemime.progress import track as progress
 from facemime.shared_constants import CAVITY, INTERIOR_SIZE, SEAL
 from facemime.types.actor import Actor
-from facemime.types.head import HeadModel, model_iod, mouth_up, mouth_width
+from facemime.types.head import HeadModel, model_iod, mouth_capped, mouth_up, mouth_width
 from facemime.types.pose import Pose, project, rotation_matrix
 from facemime.types.samples import GROUPS, SampleGroup, Samples
 
@@ -244,9 +244,7 @@ class _Regions:
         model = actor.model
         assert model.uv is not None  # an actor's model has texture coordinates
         self.strip_uv, self.strip = interior_strip(model)
-        strip = {frozenset(t) for t in self.strip.tolist()}
-        cap = np.array([frozenset(t) in strip for t in model.triangles.tolist()], bool)
-        if cap.any():  # a capped mouth (fit.actor.mouth_cap) shows the photo's own opening, as it is
+        if mouth_capped(model):  # a capped mouth (fit.actor.mouth_cap) shows the photo's own opening, as it is
             self.strip = self.strip[:0]
         self.triangles = tri = np.asarray(model.triangles)
         v = model.vertices

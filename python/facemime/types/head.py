@@ -262,3 +262,22 @@ def lip_strip(model: HeadModel) -> np.ndarray:
     quads = [(upper[i], upper[i + 1], lower[i + 1], lower[i]) for i in range(len(upper) - 1)]
     triangles = [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d)) if len({*t}) == 3]
     return np.array(triangles, np.int64).reshape(-1, 3)
+
+
+def mouth_capped(model: HeadModel) -> bool:
+    """Whether a model's mouth is capped: its triangles close the opening between the inner lips
+    (:func:`facemime.fit.actor.mouth_cap`, on a photo whose mouth was open), so that its texture
+    shows that opening.
+
+    Parameters
+    ----------
+    model
+        The head, with the inner lips' groups.
+
+    Returns
+    -------
+    bool
+        True when any of its triangles is one of :func:`lip_strip`'s, in either winding.
+    """
+    strip = {frozenset(t) for t in lip_strip(model).tolist()}
+    return any(frozenset(t) in strip for t in np.asarray(model.triangles).tolist())

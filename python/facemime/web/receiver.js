@@ -904,10 +904,19 @@ void main() {
     }
     return Uint32Array.from(out);
   }
+  function mouthCapped(model) {
+    const key = (a, b, c) => [a, b, c].sort((x2, y) => x2 - y).join(",");
+    const strip = lipStrip(model), tri = model.triangles, inStrip = /* @__PURE__ */ new Set();
+    for (let t = 0; t < strip.length; t += 3) inStrip.add(key(strip[t], strip[t + 1], strip[t + 2]));
+    for (let t = 0; t < tri.length; t += 3) if (inStrip.has(key(tri[t], tri[t + 1], tri[t + 2]))) return true;
+    return false;
+  }
   var Deformer = class {
     constructor(model) {
       this.model = model;
       this.slot = /* @__PURE__ */ new Map();
+      /** Per share closed, the model's own closing (sealed takes it back on a capped mouth). */
+      this.rest = /* @__PURE__ */ new Map();
       const g = model.groups;
       for (const name of [...CONTOUR_GROUPS, "eye_left", "eye_right"]) {
         if (!g[name]) throw new Error(`the actor's head model lacks the group ${name}`);
@@ -917,13 +926,7 @@ void main() {
       const u4 = g.mouth_inner_upper, l = g.mouth_inner_lower;
       this.inner = [u4.slice(1, -1), l.slice(1, -1)];
       this.weights = this.spread();
-      const key = (a, b, c) => [a, b, c].sort((x2, y) => x2 - y).join(",");
-      const strip = lipStrip(model), tri = model.triangles;
-      const inStrip = /* @__PURE__ */ new Set();
-      for (let t = 0; t < strip.length; t += 3) inStrip.add(key(strip[t], strip[t + 1], strip[t + 2]));
-      let capped = false;
-      for (let t = 0; t < tri.length && !capped; t += 3) capped = inStrip.has(key(tri[t], tri[t + 1], tri[t + 2]));
-      this.capped = capped;
+      this.capped = mouthCapped(model);
     }
     spread() {
       const m = this.model, g = m.groups, v2 = m.vertices;
@@ -992,7 +995,8 @@ void main() {
     sealed(vertices, closed) {
       const close = this.closing(vertices, closed);
       if (close === null) return vertices;
-      const rest = this.capped ? this.closing(this.model.vertices, closed) : null;
+      if (this.capped && !this.rest.has(closed)) this.rest.set(closed, this.closing(this.model.vertices, closed));
+      const rest = this.capped ? this.rest.get(closed) ?? null : null;
       if (rest !== null) for (let i2 = 0; i2 < close.length; i2++) close[i2] -= rest[i2];
       const out = Float64Array.from(vertices);
       this.add(out, close, 1);

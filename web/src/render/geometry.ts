@@ -77,6 +77,16 @@ export function lipStrip(model: Model): Uint32Array {
   return Uint32Array.from(out);
 }
 
+/** Whether the model's mouth is capped: one of its triangles is one of lipStrip's, in either
+ * winding (facemime.types.head.mouth_capped). */
+export function mouthCapped(model: Model): boolean {
+  const key = (a: number, b: number, c: number) => [a, b, c].sort((x, y) => x - y).join(',');
+  const strip = lipStrip(model), tri = model.triangles, inStrip = new Set<string>();
+  for (let t = 0; t < strip.length; t += 3) inStrip.add(key(strip[t], strip[t + 1], strip[t + 2]));
+  for (let t = 0; t < tri.length; t += 3) if (inStrip.has(key(tri[t], tri[t + 1], tri[t + 2]))) return true;
+  return false;
+}
+
 /** Drives a model by its knots (facemime.animate.deform.Deformer). */
 export class Deformer {
   readonly knots: number[];
@@ -84,8 +94,10 @@ export class Deformer {
   readonly weights: Float64Array;
   private readonly slot = new Map<number, number>();
   private readonly inner: [number[], number[]];
-  /** Whether the model's mouth is capped (facemime.fit.actor.mouth_cap): see sealed. */
+  /** Whether the model's mouth is capped (facemime.types.head.mouth_capped): see sealed. */
   private readonly capped: boolean;
+  /** Per share closed, the model's own closing (sealed takes it back on a capped mouth). */
+  private readonly rest = new Map<number, Float64Array | null>();
 
   constructor(readonly model: Model) {
     const g = model.groups;
@@ -97,13 +109,7 @@ export class Deformer {
     const u = g.mouth_inner_upper, l = g.mouth_inner_lower;
     this.inner = [u.slice(1, -1), l.slice(1, -1)];
     this.weights = this.spread();
-    const key = (a: number, b: number, c: number) => [a, b, c].sort((x, y) => x - y).join(',');
-    const strip = lipStrip(model), tri = model.triangles;
-    const inStrip = new Set<string>();
-    for (let t = 0; t < strip.length; t += 3) inStrip.add(key(strip[t], strip[t + 1], strip[t + 2]));
-    let capped = false;
-    for (let t = 0; t < tri.length && !capped; t += 3) capped = inStrip.has(key(tri[t], tri[t + 1], tri[t + 2]));
-    this.capped = capped;
+    this.capped = mouthCapped(model);
   }
 
   private spread(): Float64Array {
@@ -173,7 +179,8 @@ export class Deformer {
   sealed(vertices: Float64Array, closed: number): Float64Array {
     const close = this.closing(vertices, closed);
     if (close === null) return vertices;
-    const rest = this.capped ? this.closing(this.model.vertices, closed) : null;
+    if (this.capped && !this.rest.has(closed)) this.rest.set(closed, this.closing(this.model.vertices, closed));
+    const rest = this.capped ? (this.rest.get(closed) ?? null) : null;
     if (rest !== null) for (let i = 0; i < close.length; i++) close[i] -= rest[i];
     const out = Float64Array.from(vertices);
     this.add(out, close, 1);
